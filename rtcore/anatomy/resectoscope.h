@@ -1,0 +1,34 @@
+// The resectoscope model of the paper's benchmark: a sheath of 158 triangles and a resecting loop of
+// 330 (488 in all). Tool frame: the sheath's axis is +z (the direction of insertion), its tip at the
+// origin, the shaft extending toward -z; the loop's wire hangs below the axis (-y) in front of the tip.
+#pragma once
+
+#include "rtcore/mesh/triangle_mesh.h"
+
+namespace resecto {
+
+/// Dimensions of the tool, metres.
+struct ResectoscopeShape {
+  double sheath_diameter_m = 0.00867;  ///< 26 Fr
+  double sheath_length_m = 0.120;      ///< the distal part that can reach the model
+  double loop_span_m = 0.006;          ///< width of the half-ring of wire
+  double wire_diameter_m = 0.00035;
+  double loop_travel_m = 0.0;          ///< 0 (retracted to the tip) .. 0.036
+  double loop_stem_length_m = 0.004;   ///< stem length between the tip and the half-ring at zero travel
+};
+
+inline constexpr int kSheathTriangles = 158;
+inline constexpr int kLoopTriangles = 330;
+
+/// The two rigid parts in the tool frame.
+struct ResectoscopeModel {
+  TriangleMesh sheath;  ///< closed, 158 triangles
+  TriangleMesh loop;    ///< closed, 330 triangles
+};
+
+ResectoscopeModel generate_resectoscope(const ResectoscopeShape& shape = {});
+
+/// Sheath then loop in one mesh: faces [0, 158) are the sheath, [158, 488) the loop.
+TriangleMesh combined_resectoscope_mesh(const ResectoscopeModel& model);
+
+}  // namespace resecto

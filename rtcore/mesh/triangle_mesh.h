@@ -1,0 +1,41 @@
+// TriangleMesh: an indexed triangle surface in flat arrays, the shape every part of the core shares
+// (anatomy generators write it, the loaders fill it, sphere trees and the tissue read it).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "rtcore/geometry/vec3.h"
+
+namespace resecto {
+
+using Triangle = std::array<std::uint32_t, 3>;
+
+/// An indexed triangle mesh; positions in metres, triangles counter-clockwise seen from outside.
+struct TriangleMesh {
+  std::vector<Vec3> positions;
+  std::vector<Triangle> triangles;
+
+  std::size_t vertex_count() const { return positions.size(); }
+  std::size_t triangle_count() const { return triangles.size(); }
+};
+
+/// Axis-aligned box.
+struct Aabb {
+  Vec3 min{0.0};
+  Vec3 max{0.0};
+  Vec3 size() const { return max - min; }
+};
+
+/// Area-weighted (unnormalised: twice the area) normal of triangle t.
+Vec3 triangle_normal_x2(const TriangleMesh& mesh, std::size_t t);
+double triangle_area(const TriangleMesh& mesh, std::size_t t);
+double surface_area(const TriangleMesh& mesh);
+/// Signed enclosed volume by the divergence theorem; positive for a closed, outward-oriented mesh.
+double signed_volume(const TriangleMesh& mesh);
+Aabb bounding_box(const TriangleMesh& mesh);
+/// Appends `other` to `mesh`, offsetting its indices.
+void append_mesh(TriangleMesh& mesh, const TriangleMesh& other);
+
+}  // namespace resecto

@@ -1,0 +1,28 @@
+// Tetrahedralization of a closed surface with TetGen (library mode), and region labelling.
+#pragma once
+
+#include <optional>
+
+#include "rtcore/base/result.h"
+#include "rtcore/mesh/triangle_mesh.h"
+#include "rtcore/tissue/tet_mesh.h"
+
+namespace resecto {
+
+/// TetGen's quality constraints and the capsule labelling, SI units.
+struct TetrahedralizeOptions {
+  double max_radius_edge_ratio = 1.8;   ///< TetGen's -q bound (>= 1.0; smaller is better shaped)
+  double min_dihedral_deg = 10.0;       ///< TetGen's -q second bound
+  double max_volume_m3 = 0.0;           ///< TetGen's -a bound; 0 = no volume constraint
+  double capsule_thickness_m = 0.0025;  ///< tetrahedra whose centroid is this close to the outer surface are capsule
+  /// The urethral channel's axis (apex point, bladder-neck point): boundary faces facing it are the
+  /// channel wall, not the capsule. Without it, every boundary face is outer surface.
+  std::optional<std::pair<Vec3, Vec3>> channel_axis;
+};
+
+/// Fills the closed surface with tetrahedra, keeping its boundary faces exactly (TetGen -pY), so the
+/// tissue's surface is the input surface. Errors: a surface TetGen cannot mesh (self-intersecting,
+/// open), reported with TetGen's reason.
+Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const TetrahedralizeOptions& options = {});
+
+}  // namespace resecto
