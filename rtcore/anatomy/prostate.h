@@ -15,9 +15,9 @@ namespace resecto {
 
 /// Shape of the gland; every length in metres. Defaults: a 45 g hyperplastic gland.
 struct ProstateShape {
-  double width_m = 0.052;            ///< transverse (x) extent of the gland
-  double height_m = 0.040;           ///< anteroposterior (y) extent
-  double length_m = 0.044;           ///< craniocaudal (z) extent, bladder neck to apex
+  double width_m = 0.049;            ///< transverse (x) extent of the gland
+  double height_m = 0.0375;          ///< anteroposterior (y) extent
+  double length_m = 0.0415;          ///< craniocaudal (z) extent, bladder neck to apex
   double posterior_offset_m = 0.006; ///< gland centre lies posterior (-y) of the urethra
   double apex_taper = 0.30;          ///< fraction by which the gland narrows toward the apex
   double channel_radius_m = 0.0046;  ///< urethral lumen where no lobe bulges (just over 26 Fr / 2)

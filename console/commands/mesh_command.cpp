@@ -1,0 +1,193 @@
+// `resecto mesh ...`: the procedural models (prostate, resectoscope), validation of a user's surface,
+// and TetGen's volumetric model with region labels. Lengths on the command line are millimetres.
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "console/commands/command_registry.h"
+#include "rtcore/anatomy/prostate.h"
+#include "rtcore/anatomy/resectoscope.h"
+#include "rtcore/base/units.h"
+#include "rtcore/mesh/mesh_io.h"
+#include "rtcore/mesh/mesh_validation.h"
+#include "rtcore/tissue/tetrahedralize.h"
+
+namespace resecto::cli {
+namespace {
+
+/// The landmarks file written beside a mesh: prostate.off -> prostate.landmarks.json.
+std::filesystem::path landmarks_path_for(const std::filesystem::path& mesh_path) {
+  std::filesystem::path p = mesh_path;
+  p.replace_extension(".landmarks.json");
+  return p;
+}
+
+void print_surface_report(const SurfaceReport& r) {
+  std::printf("  triangles        %zu\n  vertices         %zu\n  edges            %zu\n", r.triangles, r.vertices, r.edges);
+  std::printf("  components       %d\n  genus            %d\n", r.components, r.genus);
+  std::printf("  area             %.1f mm^2\n  volume           %.2f ml\n", r.area_m2 * 1e6, units::m3_to_ml(r.volume_m3));
+  std::printf("  edge length      %.3f .. %.3f mm\n  smallest angle   %.2f deg\n", units::m_to_mm(r.min_edge_m),
+              units::m_to_mm(r.max_edge_m), r.min_angle_deg);
+}
+
+[[noreturn]] void fail(const std::string& message) { throw std::runtime_error(message); }
+
+SurfaceReport validated(const TriangleMesh& mesh, const std::string& what) {
+  Result<SurfaceReport> report = validate_closed_surface(mesh);
+  if (!report) fail(what + ": " + report.error());
+  return *report;
+}
+
+void write_or_fail(const std::filesystem::path& path, const TriangleMesh& mesh) {
+  if (Status written = write_surface_mesh(path, mesh); !written) fail(written.error());
+}
+
+void register_prostate(CLI::App& mesh) {
+  struct Options {
+    int triangles = 8640;
+    std::string output;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* cmd = mesh.add_subcommand("prostate", "Write the procedural hyperplastic prostate (and its landmarks JSON beside it)");
+  cmd->add_option("--triangles", options->triangles, "Target surface triangle count (result within 1%)")
+      ->check(CLI::Range(200, 5'000'000))->capture_default_str();
+  cmd->add_option("-o,--output", options->output, "Mesh file (.off, .obj, .ply, .stl), millimetres")->required();
+  cmd->callback([options] {
+    const ProstateModel model = generate_prostate(options->triangles);
+    const SurfaceReport report = validated(model.surface, "generated prostate");
+    write_or_fail(options->output, model.surface);
+    const auto landmarks = landmarks_path_for(options->output);
+    {
+      std::ofstream out(landmarks, std::ios::binary);
+      out << landmarks_to_json(model);
+      if (!out.flush()) fail(landmarks.string() + ": cannot write the landmarks");
+    }
+    const ProstateShape& s = model.shape;
+    std::printf("prostate %s (landmarks %s)\n", options->output.c_str(), landmarks.string().c_str());
+    std::printf("  grid             %d around the channel x %d along the meridian\n", model.meridian_segments, model.profile_segments);
+    print_surface_report(report);
+    std::printf("  mass             %.1f g at %.0f kg/m^3\n", report.volume_m3 * s.tissue_density_kg_m3 * units::kGramsPerKilogram,
+                s.tissue_density_kg_m3);
+    std::printf("  size             %.1f x %.1f x %.1f mm (width x height x length)\n", units::m_to_mm(s.width_m),
+                units::m_to_mm(s.height_m), units::m_to_mm(s.length_m));
+    std::printf("  channel radius   %.2f mm, narrowest %.2f mm at the lateral lobes\n", units::m_to_mm(s.channel_radius_m),
+                units::m_to_mm(channel_radius_at(s, 0.55 * s.length_m, 0.0)));
+  });
+}
+
+void register_resectoscope(CLI::App& mesh) {
+  struct Options {
+    double loop_travel_mm = 0.0;
+    std::string output;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* cmd = mesh.add_subcommand("resectoscope", "Write the 488-triangle resectoscope: faces 0-157 sheath, 158-487 loop");
+  cmd->add_option("--loop-travel", options->loop_travel_mm, "Loop travel out of the sheath tip, mm")
+      ->check(CLI::Range(0.0, 36.0))->capture_default_str();
+  cmd->add_option("-o,--output", options->output, "Mesh file (.off, .obj, .ply, .stl), millimetres")->required();
+  cmd->callback([options] {
+    ResectoscopeShape shape;
+    shape.loop_travel_m = units::mm_to_m(options->loop_travel_mm);
+    const ResectoscopeModel model = generate_resectoscope(shape);
+    const SurfaceReport sheath = validated(model.sheath, "generated sheath");
+    const SurfaceReport loop = validated(model.loop, "generated loop");
+    write_or_fail(options->output, combined_resectoscope_mesh(model));
+    std::printf("resectoscope %s: %zu triangles (sheath faces 0-%zu, loop faces %zu-%zu), loop travel %.1f mm\n",
+                options->output.c_str(), sheath.triangles + loop.triangles, sheath.triangles - 1, sheath.triangles,
+                sheath.triangles + loop.triangles - 1, options->loop_travel_mm);
+    std::printf("sheath: %.2f mm across (26 Fr), %.0f mm long\n", units::m_to_mm(shape.sheath_diameter_m), units::m_to_mm(shape.sheath_length_m));
+    print_surface_report(sheath);
+    std::printf("loop: %.1f mm span, %.2f mm wire\n", units::m_to_mm(shape.loop_span_m), units::m_to_mm(shape.wire_diameter_m));
+    print_surface_report(loop);
+  });
+}
+
+void register_check(CLI::App& mesh) {
+  auto path = std::make_shared<std::string>();
+  CLI::App* cmd = mesh.add_subcommand("check", "Validate a surface: closed, manifold, oriented outward, no degenerate or crossing faces");
+  cmd->add_option("file", *path, "Mesh file (.off, .obj, .ply, .stl), millimetres")->required();
+  cmd->callback([path] {
+    Result<TriangleMesh> mesh = read_surface_mesh(*path);
+    if (!mesh) fail(mesh.error());
+    const SurfaceReport report = validated(*mesh, *path);
+    std::printf("%s: valid closed surface\n", path->c_str());
+    print_surface_report(report);
+  });
+}
+
+void register_tetra(CLI::App& mesh) {
+  struct Options {
+    std::string input;
+    std::string output;
+    double radius_edge = 1.8;
+    double min_dihedral_deg = 10.0;
+    double max_volume_mm3 = 0.0;
+    double capsule_mm = 2.5;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* cmd = mesh.add_subcommand("tetra", "Fill a closed surface with tetrahedra (TetGen), labelled capsule or adenoma");
+  cmd->add_option("input", options->input, "Closed surface (.off, .obj, .ply, .stl), millimetres")->required();
+  cmd->add_option("-o,--output", options->output, "Tetrahedral mesh, legacy VTK (.vtk), millimetres")->required();
+  cmd->add_option("--radius-edge", options->radius_edge, "Largest radius-edge ratio TetGen may leave (-q)")
+      ->check(CLI::Range(1.0, 10.0))->capture_default_str();
+  cmd->add_option("--min-dihedral", options->min_dihedral_deg, "Smallest dihedral angle TetGen aims for, degrees (-q)")
+      ->check(CLI::Range(0.0, 30.0))->capture_default_str();
+  cmd->add_option("--max-volume", options->max_volume_mm3, "Largest tetrahedron volume, mm^3 (-a); 0 = unbounded")
+      ->check(CLI::Range(0.0, 1e9))->capture_default_str();
+  cmd->add_option("--capsule", options->capsule_mm, "Capsule shell thickness, mm")->check(CLI::Range(0.0, 20.0))->capture_default_str();
+  cmd->callback([options] {
+    if (std::filesystem::path(options->output).extension() != ".vtk") fail(options->output + ": the output must be a .vtk file");
+    Result<TriangleMesh> surface = read_surface_mesh(options->input);
+    if (!surface) fail(surface.error());
+    const SurfaceReport report = validated(*surface, options->input);
+
+    TetrahedralizeOptions tet;
+    tet.max_radius_edge_ratio = options->radius_edge;
+    tet.min_dihedral_deg = options->min_dihedral_deg;
+    tet.max_volume_m3 = options->max_volume_mm3 * 1e-9;
+    tet.capsule_thickness_m = units::mm_to_m(options->capsule_mm);
+    // The generator's landmarks, when present, say where the urethral channel runs.
+    const auto landmarks = landmarks_path_for(options->input);
+    if (std::filesystem::exists(landmarks)) {
+      try {
+        const auto doc = nlohmann::json::parse(std::ifstream(landmarks));
+        auto point = [](const nlohmann::json& a) { return Vec3(a.at(0).get<double>(), a.at(1).get<double>(), a.at(2).get<double>()) * units::kMetresPerMillimetre; };
+        tet.channel_axis = {point(doc.at("channel_axis").at("apex")), point(doc.at("channel_axis").at("bladder_neck"))};
+      } catch (const nlohmann::json::exception& e) {
+        fail(landmarks.string() + ": malformed landmarks file: " + e.what());
+      }
+    }
+    const auto start = std::chrono::steady_clock::now();
+    Result<TetMesh> tetra = tetrahedralize(*surface, tet);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!tetra) fail(options->input + ": " + tetra.error());
+    if (Status written = write_vtk(options->output, *tetra); !written) fail(written.error());
+    const TetMeshStats stats = compute_stats(*tetra);
+    const double volume_error = (stats.volume_m3 - report.volume_m3) / report.volume_m3;
+    std::printf("tetrahedra %s: %zu tetrahedra over %zu nodes in %.2f s%s\n", options->output.c_str(), stats.tetrahedra, stats.nodes,
+                seconds, tet.channel_axis ? " (channel axis from the landmarks file)" : "");
+    std::printf("  volume           %.3f ml (surface %.3f ml, %+.4f%%)\n", units::m3_to_ml(stats.volume_m3),
+                units::m3_to_ml(report.volume_m3), 100.0 * volume_error);
+    std::printf("  capsule          %.3f ml (shell %.1f mm)\n  adenoma          %.3f ml\n", units::m3_to_ml(stats.capsule_volume_m3),
+                options->capsule_mm, units::m3_to_ml(stats.adenoma_volume_m3));
+    std::printf("  dihedral angles  %.2f .. %.2f deg\n  radius-edge max  %.2f\n", stats.min_dihedral_deg, stats.max_dihedral_deg,
+                stats.max_radius_edge_ratio);
+  });
+}
+
+void register_mesh_commands(CLI::App& app) {
+  CLI::App& mesh = subcommand_family(app, "mesh", "Procedural models and mesh tools");
+  register_prostate(mesh);
+  register_resectoscope(mesh);
+  register_check(mesh);
+  register_tetra(mesh);
+}
+
+const RegisterCommand kRegister{"mesh", &register_mesh_commands};
+
+}  // namespace
+}  // namespace resecto::cli
