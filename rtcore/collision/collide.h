@@ -1,0 +1,108 @@
+// The paper's dual descent (section 3.2, Figure 11): two sphere trees walked together to find every
+// intersecting triangle pair between the tissue and a rigid tool, and the colliding leaf lists L1 and
+// L2 the penalty response reads. Runs in the 60 Hz core step, so a query allocates nothing.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "rtcore/collision/sphere_tree.h"
+
+namespace resecto {
+
+/// A rigid placement of the tool: world = rotation * tool + translation (rotation row-major).
+struct RigidTransform {
+  double rotation[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  Vec3 translation{0.0};
+};
+
+/// The one way a tool point reaches the world: every caller (query, brute force) rounds alike.
+inline Vec3 transform_point(const RigidTransform& pose, const Vec3& p) {
+  const auto& r = pose.rotation;
+  return {r[0][0] * p.x + r[0][1] * p.y + r[0][2] * p.z + pose.translation.x,
+          r[1][0] * p.x + r[1][1] * p.y + r[1][2] * p.z + pose.translation.y,
+          r[2][0] * p.x + r[2][1] * p.y + r[2][2] * p.z + pose.translation.z};
+}
+
+/// An intersecting pair: a tissue triangle and a tool triangle (indices into their meshes).
+struct TrianglePair {
+  std::uint32_t tissue = 0;
+  std::uint32_t tool = 0;
+  friend bool operator==(const TrianglePair&, const TrianglePair&) = default;
+  friend auto operator<=>(const TrianglePair&, const TrianglePair&) = default;
+};
+
+/// Work counters of the last query.
+struct CollisionStats {
+  std::int64_t sphere_tests = 0;
+  std::int64_t triangle_tests = 0;
+};
+
+/// Runs the dual descent. Holds every buffer a query needs; after reserve() (or the first queries
+/// on trees of a given size) a query allocates nothing. A query whose pairs exceed the reserved
+/// capacity sets overflowed() and returns false rather than allocating.
+class Collider {
+ public:
+  Collider() { reserve(4096, 16384); }
+
+  /// Room for `max_pairs` intersecting pairs and `max_tested_pairs` distinct triangle pairs tested.
+  void reserve(std::int32_t max_pairs, std::int32_t max_tested_pairs);
+
+  /// Finds every pair of intersecting closed triangles between the tissue and the tool placed at
+  /// `tool_pose` (the tool tree is in tool coordinates; its spheres move with the pose, never
+  /// refitted). Pairs come out sorted by (tissue, tool), each once. False on overflow.
+  bool collide(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
+               const TriangleMesh& tool, const RigidTransform& tool_pose);
+
+  std::span<const TrianglePair> pairs() const { return {pairs_.data(), pair_count_}; }
+  /// L1: the tissue leaves whose spheres met a tool leaf sphere, each once, in the order found.
+  std::span<const std::int32_t> tissue_leaves() const { return {l1_.data(), l1_count_}; }
+  /// L2: the tool leaves whose spheres met a tissue leaf sphere, each once, in the order found.
+  std::span<const std::int32_t> tool_leaves() const { return {l2_.data(), l2_count_}; }
+  bool overflowed() const { return overflowed_; }
+  const CollisionStats& stats() const { return stats_; }
+
+ private:
+  struct NodePair {
+    std::int32_t tissue;
+    std::int32_t tool;
+  };
+  void prepare(const SphereTree& tissue_tree, const SphereTree& tool_tree, const TriangleMesh& tool);
+  const Vec3& tool_center(const SphereTree& tool_tree, std::int32_t node);
+  const Vec3& tool_vertex(const TriangleMesh& tool, std::uint32_t v);
+  bool first_test_of(std::uint32_t tissue_triangle, std::uint32_t tool_triangle);
+  void test_triangles(const TriangleMesh& tissue, const TriangleMesh& tool, std::uint32_t a, std::uint32_t b);
+  void next_stamp();
+
+  RigidTransform pose_;
+  double radius_scale_ = 1.0;  // bounds how much the pose's matrix can stretch a tool sphere
+  std::uint32_t stamp_ = 0;    // per-query mark: an entry is set for this query when it equals stamp_
+
+  std::vector<Vec3> tool_centers_;  // tool node centres in the world, filled on first use
+  std::vector<std::uint32_t> tool_center_stamp_;
+  std::vector<Vec3> tool_vertices_;  // tool vertices in the world, filled on first use
+  std::vector<std::uint32_t> tool_vertex_stamp_;
+  std::vector<std::uint32_t> l1_stamp_;
+  std::vector<std::uint32_t> l2_stamp_;
+  std::vector<std::int32_t> l1_;
+  std::vector<std::int32_t> l2_;
+  std::size_t l1_count_ = 0;
+  std::size_t l2_count_ = 0;
+
+  std::vector<std::uint64_t> tested_keys_;  // open addressing: triangle pairs tested this query
+  std::vector<std::uint32_t> tested_stamp_;
+  std::size_t tested_count_ = 0;
+  std::vector<TrianglePair> pairs_;
+  std::size_t pair_count_ = 0;
+  std::vector<NodePair> stack_;
+  bool overflowed_ = false;
+  CollisionStats stats_;
+};
+
+/// Every intersecting pair by testing every tissue triangle against every tool triangle (with a
+/// box-overlap prefilter, exact on the coordinates), sorted: the oracle and the benchmark baseline.
+std::vector<TrianglePair> collide_brute_force(const TriangleMesh& tissue, const TriangleMesh& tool,
+                                              const RigidTransform& tool_pose);
+
+}  // namespace resecto

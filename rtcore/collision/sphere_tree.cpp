@@ -1,0 +1,373 @@
+// Sphere-tree construction (top-down, principal-component splits), bottom-up refit, and O(log n)
+// insertion and removal of triangles, all over one flat node array with a free list.
+#include "rtcore/collision/sphere_tree.h"
+
+#include <algorithm>
+#include <array>
+#include <cassert>
+#include <cmath>
+
+namespace resecto {
+namespace {
+
+// Rounding in a sphere's centre and radius is a few ulps; growing every radius by far more than
+// that (relative, plus a floor tied to the coordinates' magnitude) makes the cover conservative.
+Sphere inflated(const Vec3& center, double radius) {
+  const double magnitude = std::max({std::abs(center.x), std::abs(center.y), std::abs(center.z), radius});
+  return {center, radius * (1.0 + 1e-12) + magnitude * 1e-15};
+}
+
+// The smallest sphere holding both spheres.
+Sphere merge(const Sphere& a, const Sphere& b) {
+  const Vec3 offset = b.center - a.center;
+  const double distance = length(offset);
+  if (distance + b.radius <= a.radius) return a;
+  if (distance + a.radius <= b.radius) return b;
+  const double radius = 0.5 * (distance + a.radius + b.radius);
+  return inflated(a.center + offset * ((radius - a.radius) / distance), radius);
+}
+
+// A sphere around points: the better of the box centre and the centroid.
+template <std::size_t N>
+Sphere sphere_around(const std::array<Vec3, N>& points) {
+  Vec3 lo = points[0];
+  Vec3 hi = points[0];
+  Vec3 sum{0.0};
+  for (const Vec3& p : points) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+    sum += p;
+  }
+  const std::array<Vec3, 2> centers{0.5 * (lo + hi), sum / static_cast<double>(N)};
+  Sphere best{centers[0], INFINITY};
+  for (const Vec3& c : centers) {
+    double r2 = 0.0;
+    for (const Vec3& p : points) r2 = std::max(r2, length_squared(p - c));
+    const double r = std::sqrt(r2);
+    if (r < best.radius) best = {c, r};
+  }
+  return inflated(best.center, best.radius);
+}
+
+}  // namespace
+
+int SphereTree::slice_count(const TriangleMesh& mesh, std::uint32_t t, std::uint8_t& apex) {
+  const Triangle& tri = mesh.triangles[t];
+  const std::array<Vec3, 3> v{mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]]};
+  // The edge opposite vertex i runs from v[i+1] to v[i+2]; slabs are cut parallel to the shortest.
+  double shortest = INFINITY;
+  for (int i = 0; i < 3; ++i) {
+    const double edge = length(v[(i + 2) % 3] - v[(i + 1) % 3]);
+    if (edge < shortest) {
+      shortest = edge;
+      apex = static_cast<std::uint8_t>(i);
+    }
+  }
+  const Vec3 base = v[(apex + 2) % 3] - v[(apex + 1) % 3];
+  if (!(shortest > 0.0)) return 1;
+  const double height = length(cross(base, v[apex] - v[(apex + 1) % 3])) / shortest;
+  const double slices = std::ceil(height / (kSliceAspect * shortest));
+  return static_cast<int>(std::clamp(slices, 1.0, static_cast<double>(kMaxSlices)));
+}
+
+Sphere SphereTree::piece_sphere(const TriangleMesh& mesh, const LeafPiece& piece) {
+  const Triangle& tri = mesh.triangles[piece.triangle];
+  const Vec3& b = mesh.positions[tri[piece.apex]];
+  const Vec3& x = mesh.positions[tri[(piece.apex + 1) % 3]];
+  const Vec3& y = mesh.positions[tri[(piece.apex + 2) % 3]];
+  if (piece.slices == 1) return sphere_around(std::array<Vec3, 3>{b, x, y});
+  // The slab between the lines at t0 and t1 (t: the weight of the apex) is the hull of these four.
+  const double t0 = static_cast<double>(piece.slice) / piece.slices;
+  const double t1 = static_cast<double>(piece.slice + 1) / piece.slices;
+  return sphere_around(std::array<Vec3, 4>{x * (1.0 - t0) + b * t0, y * (1.0 - t0) + b * t0,
+                                           x * (1.0 - t1) + b * t1, y * (1.0 - t1) + b * t1});
+}
+
+std::int32_t SphereTree::allocate_node() {
+  ++live_nodes_;
+  if (free_list_ != kNoNode) {
+    const std::int32_t node = free_list_;
+    free_list_ = links_[node].left;
+    links_[node] = SphereTreeLinks{};
+    next_leaf_[node] = kNoNode;
+    return node;
+  }
+  spheres_.emplace_back();
+  links_.emplace_back();
+  pieces_.emplace_back();
+  next_leaf_.push_back(kNoNode);
+  return static_cast<std::int32_t>(links_.size()) - 1;
+}
+
+void SphereTree::free_node(std::int32_t node) {
+  --live_nodes_;
+  links_[node] = SphereTreeLinks{kNoNode, free_list_, kNoNode, -1};  // height -1 marks a free slot
+  free_list_ = node;
+}
+
+std::int32_t SphereTree::free_node_count() const {
+  std::int32_t count = 0;
+  for (std::int32_t n = free_list_; n != kNoNode; n = links_[n].left) ++count;
+  return count;
+}
+
+void SphereTree::add_triangle_leaves(const TriangleMesh& mesh, std::uint32_t t, bool insert) {
+  if (first_leaf_.size() <= t) first_leaf_.resize(t + 1, kNoNode);
+  assert(first_leaf_[t] == kNoNode && "triangle already in the tree");
+  std::uint8_t apex = 0;
+  const int slices = slice_count(mesh, t, apex);
+  for (int s = slices - 1; s >= 0; --s) {  // pushed front-first so the chain runs slice 0, 1, ...
+    const std::int32_t leaf = allocate_node();
+    pieces_[leaf] = {t, static_cast<std::uint16_t>(s), static_cast<std::uint16_t>(slices), apex};
+    spheres_[leaf] = piece_sphere(mesh, pieces_[leaf]);
+    next_leaf_[leaf] = first_leaf_[t];
+    first_leaf_[t] = leaf;
+    ++leaf_count_;
+    if (insert) insert_leaf(leaf);
+  }
+}
+
+// ---- Build ------------------------------------------------------------------------------------
+
+void SphereTree::build(const TriangleMesh& mesh) {
+  spheres_.clear();
+  links_.clear();
+  pieces_.clear();
+  next_leaf_.clear();
+  first_leaf_.assign(mesh.triangle_count(), kNoNode);
+  root_ = kNoNode;
+  free_list_ = kNoNode;
+  leaf_count_ = 0;
+  live_nodes_ = 0;
+  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) add_triangle_leaves(mesh, t, false);
+  std::vector<std::int32_t> leaves(static_cast<std::size_t>(leaf_count_));
+  for (std::int32_t i = 0; i < leaf_count_; ++i) leaves[i] = i;  // leaves were allocated first
+  if (!leaves.empty()) root_ = build_range(leaves.data(), leaves.data() + leaves.size(), kNoNode);
+  order_dirty_ = true;
+  built_mean_internal_radius_ = quality().mean_internal_radius;
+}
+
+std::int32_t SphereTree::build_range(std::int32_t* first, std::int32_t* last, std::int32_t parent) {
+  const std::ptrdiff_t count = last - first;
+  if (count == 1) {
+    links_[*first].parent = parent;
+    return *first;
+  }
+  // Principal component of the leaf centres: power iteration on their covariance, started from
+  // the longest side of their box (deterministic: fixed start, fixed iteration count).
+  Vec3 mean{0.0};
+  Vec3 lo{INFINITY};
+  Vec3 hi{-INFINITY};
+  for (const std::int32_t* n = first; n != last; ++n) {
+    const Vec3& c = spheres_[*n].center;
+    mean += c;
+    lo = glm::min(lo, c);
+    hi = glm::max(hi, c);
+  }
+  mean /= static_cast<double>(count);
+  double cxx = 0, cxy = 0, cxz = 0, cyy = 0, cyz = 0, czz = 0;
+  for (const std::int32_t* n = first; n != last; ++n) {
+    const Vec3 d = spheres_[*n].center - mean;
+    cxx += d.x * d.x, cxy += d.x * d.y, cxz += d.x * d.z;
+    cyy += d.y * d.y, cyz += d.y * d.z, czz += d.z * d.z;
+  }
+  const Vec3 extent = hi - lo;
+  Vec3 axis = extent.x >= extent.y && extent.x >= extent.z ? Vec3{1, 0, 0}
+              : extent.y >= extent.z                       ? Vec3{0, 1, 0}
+                                                           : Vec3{0, 0, 1};
+  for (int i = 0; i < 12; ++i) {
+    const Vec3 next{cxx * axis.x + cxy * axis.y + cxz * axis.z, cxy * axis.x + cyy * axis.y + cyz * axis.z,
+                    cxz * axis.x + cyz * axis.y + czz * axis.z};
+    const double norm = length(next);
+    if (!(norm > 0.0)) break;
+    axis = next / norm;
+  }
+  // Split at the middle of the leaf set's extent along that axis.
+  double pmin = INFINITY;
+  double pmax = -INFINITY;
+  for (const std::int32_t* n = first; n != last; ++n) {
+    const double p = dot(spheres_[*n].center, axis);
+    pmin = std::min(pmin, p);
+    pmax = std::max(pmax, p);
+  }
+  const double middle = 0.5 * (pmin + pmax);
+  std::int32_t* split =
+      std::partition(first, last, [&](std::int32_t n) { return dot(spheres_[n].center, axis) < middle; });
+  if (split == first || split == last) {
+    // Everything on one side (coincident centres): the median by projection, ties by node index.
+    split = first + count / 2;
+    std::nth_element(first, split, last, [&](std::int32_t a, std::int32_t b) {
+      const double pa = dot(spheres_[a].center, axis);
+      const double pb = dot(spheres_[b].center, axis);
+      return pa < pb || (pa == pb && a < b);
+    });
+  }
+  const std::int32_t node = allocate_node();
+  links_[node].parent = parent;
+  const std::int32_t left = build_range(first, split, node);
+  const std::int32_t right = build_range(split, last, node);
+  links_[node].left = left;
+  links_[node].right = right;
+  links_[node].height = 1 + std::max(links_[left].height, links_[right].height);
+  cover_leaves(node, first, last);
+  return node;
+}
+
+// The paper's rule: a node's sphere covers every leaf sphere below it directly, which is tighter
+// than covering the two child spheres; the smaller of the two covers is kept.
+void SphereTree::cover_leaves(std::int32_t node, const std::int32_t* first, const std::int32_t* last) {
+  Vec3 lo{INFINITY};
+  Vec3 hi{-INFINITY};
+  for (const std::int32_t* n = first; n != last; ++n) {
+    const Sphere& s = spheres_[*n];
+    lo = glm::min(lo, s.center - s.radius);
+    hi = glm::max(hi, s.center + s.radius);
+  }
+  const Vec3 center = 0.5 * (lo + hi);
+  double radius = 0.0;
+  for (const std::int32_t* n = first; n != last; ++n) {
+    radius = std::max(radius, length(spheres_[*n].center - center) + spheres_[*n].radius);
+  }
+  const Sphere direct = inflated(center, radius);
+  const Sphere merged = merge(spheres_[links_[node].left], spheres_[links_[node].right]);
+  spheres_[node] = direct.radius < merged.radius ? direct : merged;
+}
+
+// ---- Refit ------------------------------------------------------------------------------------
+
+void SphereTree::refit_node(std::int32_t node) {
+  const SphereTreeLinks& l = links_[node];
+  spheres_[node] = merge(spheres_[l.left], spheres_[l.right]);
+  links_[node].height = 1 + std::max(links_[l.left].height, links_[l.right].height);
+}
+
+void SphereTree::refit_upward(std::int32_t node) {
+  for (; node != kNoNode; node = links_[node].parent) refit_node(node);
+}
+
+void SphereTree::update_refit_order() {
+  refit_order_.clear();
+  if (root_ == kNoNode) return;
+  // Pre-order with the right child visited first, reversed: every child precedes its parent.
+  stack_.clear();
+  stack_.push_back(root_);
+  while (!stack_.empty()) {
+    const std::int32_t node = stack_.back();
+    stack_.pop_back();
+    refit_order_.push_back(node);
+    if (!is_leaf(node)) {
+      stack_.push_back(links_[node].left);
+      stack_.push_back(links_[node].right);
+    }
+  }
+  std::reverse(refit_order_.begin(), refit_order_.end());
+  order_dirty_ = false;
+}
+
+void SphereTree::refit(const TriangleMesh& mesh) {
+  if (order_dirty_) update_refit_order();
+  // Children before parents (the order above), so each merge reads refitted children.
+  for (const std::int32_t node : refit_order_) {
+    if (is_leaf(node)) {
+      spheres_[node] = piece_sphere(mesh, pieces_[node]);
+    } else {
+      const SphereTreeLinks& l = links_[node];
+      spheres_[node] = merge(spheres_[l.left], spheres_[l.right]);
+    }
+  }
+}
+
+// ---- Insert and remove ------------------------------------------------------------------------
+
+void SphereTree::insert_leaf(std::int32_t leaf) {
+  order_dirty_ = true;
+  if (root_ == kNoNode) {
+    root_ = leaf;
+    links_[leaf].parent = kNoNode;
+    return;
+  }
+  // Descend to the lowest level: at each node, the side of the plane halfway between the children's
+  // centres, across the line joining them (the node's principal direction).
+  const Vec3 c = spheres_[leaf].center;
+  std::int32_t node = root_;
+  while (!is_leaf(node)) {
+    const Sphere& a = spheres_[links_[node].left];
+    const Sphere& b = spheres_[links_[node].right];
+    const bool to_right = dot(c - 0.5 * (a.center + b.center), b.center - a.center) > 0.0;
+    node = to_right ? links_[node].right : links_[node].left;
+  }
+  const std::int32_t parent = allocate_node();
+  const std::int32_t grandparent = links_[node].parent;
+  links_[parent] = SphereTreeLinks{grandparent, node, leaf, 1};
+  links_[node].parent = parent;
+  links_[leaf].parent = parent;
+  if (grandparent == kNoNode) {
+    root_ = parent;
+  } else if (links_[grandparent].left == node) {
+    links_[grandparent].left = parent;
+  } else {
+    links_[grandparent].right = parent;
+  }
+  refit_upward(parent);
+}
+
+void SphereTree::insert_triangle(const TriangleMesh& mesh, std::uint32_t t) { add_triangle_leaves(mesh, t, true); }
+
+void SphereTree::remove_triangle(std::uint32_t t) {
+  if (t >= first_leaf_.size()) return;
+  std::int32_t leaf = first_leaf_[t];
+  first_leaf_[t] = kNoNode;
+  while (leaf != kNoNode) {
+    const std::int32_t next = next_leaf_[leaf];
+    const std::int32_t parent = links_[leaf].parent;
+    if (parent == kNoNode) {
+      root_ = kNoNode;
+    } else {
+      // The sibling takes the parent's place under the grandparent.
+      const std::int32_t sibling = links_[parent].left == leaf ? links_[parent].right : links_[parent].left;
+      const std::int32_t grandparent = links_[parent].parent;
+      links_[sibling].parent = grandparent;
+      if (grandparent == kNoNode) {
+        root_ = sibling;
+      } else if (links_[grandparent].left == parent) {
+        links_[grandparent].left = sibling;
+      } else {
+        links_[grandparent].right = sibling;
+      }
+      free_node(parent);
+      refit_upward(grandparent);
+    }
+    free_node(leaf);
+    --leaf_count_;
+    leaf = next;
+  }
+  order_dirty_ = true;
+}
+
+// ---- Quality ----------------------------------------------------------------------------------
+
+SphereTreeQuality SphereTree::quality() const {
+  SphereTreeQuality q;
+  q.leaves = leaf_count_;
+  q.height = root_ == kNoNode ? -1 : links_[root_].height;
+  q.height_bound = 2.0 * std::log2(std::max(2.0, static_cast<double>(leaf_count_))) + 4.0;
+  double sum = 0.0;
+  std::int32_t internal = 0;
+  // Node order: the same sum on every run.
+  for (std::int32_t n = 0; n < node_capacity(); ++n) {
+    if (links_[n].height > 0) {
+      sum += spheres_[n].radius;
+      ++internal;
+    }
+  }
+  q.mean_internal_radius = internal > 0 ? sum / internal : 0.0;
+  q.radius_growth = built_mean_internal_radius_ > 0.0 ? q.mean_internal_radius / built_mean_internal_radius_ : 1.0;
+  return q;
+}
+
+bool SphereTree::should_rebuild() const {
+  const SphereTreeQuality q = quality();
+  return q.height > q.height_bound || q.radius_growth > 2.0;
+}
+
+}  // namespace resecto

@@ -1,0 +1,129 @@
+// SphereTree: the paper's bounding-sphere hierarchy (section 3) over a triangle surface. Small leaf
+// spheres cover every triangle (a long thin triangle gets a row of them), nodes live in one flat
+// array with children by index, and the tree refits after deformation and takes insertions and
+// removals of triangles for cutting, each O(log n).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "rtcore/mesh/triangle_mesh.h"
+
+namespace resecto {
+
+/// A bounding sphere, in the units of the mesh it covers.
+struct Sphere {
+  Vec3 center{0.0};
+  double radius = 0.0;
+};
+
+/// Which part of a triangle a leaf covers: the triangle is cut into `slices` slabs by lines
+/// parallel to its shortest edge; the leaf covers slab `slice` (0 .. slices-1). `apex` is the local
+/// index (0..2) of the vertex opposite that edge. Affine in the vertices, so it follows deformation.
+struct LeafPiece {
+  std::uint32_t triangle = 0;
+  std::uint16_t slice = 0;
+  std::uint16_t slices = 1;
+  std::uint8_t apex = 0;
+};
+
+/// Links of one node. A leaf has left == kNoNode; freed nodes chain through `left` in the free list.
+struct SphereTreeLinks {
+  std::int32_t parent = -1;
+  std::int32_t left = -1;
+  std::int32_t right = -1;
+  std::int32_t height = 0;  ///< 0 for a leaf, 1 + the taller child's height otherwise
+};
+
+/// A snapshot of a tree's shape for the rebuild policy.
+struct SphereTreeQuality {
+  std::int32_t leaves = 0;
+  std::int32_t height = 0;          ///< of the root (0 for a single leaf, -1 when empty)
+  double height_bound = 0.0;        ///< the height the policy tolerates for this many leaves
+  double mean_internal_radius = 0;  ///< mean radius of the internal nodes
+  double radius_growth = 1.0;       ///< mean_internal_radius over its value at the last build
+};
+
+/// The sphere tree of one object's surface. It does not own the mesh: build, refit and insert read
+/// the mesh passed in, whose triangle indices the leaves refer to.
+class SphereTree {
+ public:
+  static constexpr std::int32_t kNoNode = -1;
+  /// A triangle whose slab across its shortest edge is longer than this many times that edge is
+  /// split into more leaves (at most kMaxSlices).
+  static constexpr double kSliceAspect = 1.0;
+  static constexpr int kMaxSlices = 256;
+
+  /// Builds top-down over every triangle of `mesh`, splitting at the middle of the principal
+  /// component of the leaf centres (median split when one side would be empty).
+  void build(const TriangleMesh& mesh);
+
+  /// Recomputes every sphere bottom-up from the mesh's current vertex positions (section 3.4).
+  /// Allocates nothing once the tree's size has been seen before.
+  void refit(const TriangleMesh& mesh);
+
+  /// Adds the leaves of triangle `t` of `mesh`, each descending by the principal direction of the
+  /// nodes it passes (the line between their children's centres), then refits the path (3.5).
+  void insert_triangle(const TriangleMesh& mesh, std::uint32_t t);
+
+  /// Removes every leaf of triangle `t`: each leaf's sibling takes its parent's place, the
+  /// ancestors are refitted, and the two freed nodes go to the free list (3.5).
+  void remove_triangle(std::uint32_t t);
+
+  /// The current shape and how far it has drifted from the last build.
+  SphereTreeQuality quality() const;
+  /// True when the tree is taller than the policy tolerates (over 2 log2(n) + 4) or its internal
+  /// spheres have grown on average to more than twice their size at the last build.
+  bool should_rebuild() const;
+
+  std::int32_t root() const { return root_; }
+  bool empty() const { return root_ == kNoNode; }
+  bool is_leaf(std::int32_t node) const { return links_[node].left == kNoNode; }
+  /// Every slot of the node array, live or free; node indices are below this.
+  std::int32_t node_capacity() const { return static_cast<std::int32_t>(links_.size()); }
+  std::int32_t leaf_count() const { return leaf_count_; }
+  std::int32_t live_node_count() const { return live_nodes_; }
+  std::int32_t free_node_count() const;
+
+  const std::vector<Sphere>& spheres() const { return spheres_; }
+  const std::vector<SphereTreeLinks>& links() const { return links_; }
+  const std::vector<LeafPiece>& pieces() const { return pieces_; }
+  /// First leaf of triangle t (kNoNode if none); the rest follow through next_leaf_of_triangle().
+  std::int32_t first_leaf_of_triangle(std::uint32_t t) const {
+    return t < first_leaf_.size() ? first_leaf_[t] : kNoNode;
+  }
+  std::int32_t next_leaf_of_triangle(std::int32_t leaf) const { return next_leaf_[leaf]; }
+
+  /// The sphere of one leaf piece of the mesh's current geometry (inflated a hair so rounding can
+  /// never leave a point of the piece outside it).
+  static Sphere piece_sphere(const TriangleMesh& mesh, const LeafPiece& piece);
+  /// The pieces a triangle is covered by.
+  static int slice_count(const TriangleMesh& mesh, std::uint32_t t, std::uint8_t& apex);
+
+ private:
+  std::int32_t allocate_node();
+  void free_node(std::int32_t node);
+  std::int32_t build_range(std::int32_t* first, std::int32_t* last, std::int32_t parent);
+  void cover_leaves(std::int32_t node, const std::int32_t* first, const std::int32_t* last);
+  void refit_node(std::int32_t node);
+  void refit_upward(std::int32_t node);
+  void insert_leaf(std::int32_t leaf);
+  void add_triangle_leaves(const TriangleMesh& mesh, std::uint32_t t, bool insert);
+  void update_refit_order();
+
+  std::vector<Sphere> spheres_;         // hot: per node
+  std::vector<SphereTreeLinks> links_;  // per node
+  std::vector<LeafPiece> pieces_;       // per node (leaves only)
+  std::vector<std::int32_t> next_leaf_;   // per node: next leaf of the same triangle
+  std::vector<std::int32_t> first_leaf_;  // per triangle
+  std::vector<std::int32_t> refit_order_;  // children before parents; rebuilt when topology changes
+  std::vector<std::int32_t> stack_;        // scratch for update_refit_order
+  std::int32_t root_ = kNoNode;
+  std::int32_t free_list_ = kNoNode;
+  std::int32_t leaf_count_ = 0;
+  std::int32_t live_nodes_ = 0;
+  bool order_dirty_ = true;
+  double built_mean_internal_radius_ = 0.0;
+};
+
+}  // namespace resecto

@@ -1,0 +1,181 @@
+// The dual descent against brute force: the procedural gland and resectoscope over random poses in
+// the channel, random triangle soups full of touching and coplanar faces, and a deformed gland.
+#include "rtcore/collision/collide.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+
+#include "scene.h"
+
+namespace resecto {
+namespace {
+
+using testing::random_channel_pose;
+
+std::vector<TrianglePair> pairs_of(const Collider& collider) {
+  return {collider.pairs().begin(), collider.pairs().end()};
+}
+
+// L1 and L2 hold each leaf once, and every pair's triangles have a leaf in them.
+void expect_leaf_lists(const Collider& collider, const SphereTree& tissue_tree, const SphereTree& tool_tree) {
+  std::set<std::int32_t> l1(collider.tissue_leaves().begin(), collider.tissue_leaves().end());
+  std::set<std::int32_t> l2(collider.tool_leaves().begin(), collider.tool_leaves().end());
+  ASSERT_EQ(l1.size(), collider.tissue_leaves().size()) << "a tissue leaf is listed twice";
+  ASSERT_EQ(l2.size(), collider.tool_leaves().size()) << "a tool leaf is listed twice";
+  std::set<std::uint32_t> l1_triangles;
+  std::set<std::uint32_t> l2_triangles;
+  for (std::int32_t n : l1) {
+    ASSERT_TRUE(tissue_tree.is_leaf(n));
+    l1_triangles.insert(tissue_tree.pieces()[n].triangle);
+  }
+  for (std::int32_t n : l2) {
+    ASSERT_TRUE(tool_tree.is_leaf(n));
+    l2_triangles.insert(tool_tree.pieces()[n].triangle);
+  }
+  for (const TrianglePair& p : collider.pairs()) {
+    ASSERT_TRUE(l1_triangles.count(p.tissue)) << "tissue triangle " << p.tissue << " has no leaf in L1";
+    ASSERT_TRUE(l2_triangles.count(p.tool)) << "tool triangle " << p.tool << " has no leaf in L2";
+  }
+}
+
+struct ProstateScene {
+  ProstateModel prostate;
+  TriangleMesh tool;
+  SphereTree tissue_tree;
+  SphereTree tool_tree;
+  explicit ProstateScene(int triangles) : prostate(generate_prostate(triangles)) {
+    tool = combined_resectoscope_mesh(generate_resectoscope());
+    tissue_tree.build(prostate.surface);
+    tool_tree.build(tool);
+  }
+};
+
+TEST(Collide, EqualsBruteForceOnTheGlandOverThousandsOfPoses) {
+  ProstateScene scene(1296);
+  Collider collider;
+  std::mt19937_64 rng(7);
+  std::int64_t total_pairs = 0;
+  int poses_with_pairs = 0;
+  const int poses = 2000;
+  for (int i = 0; i < poses; ++i) {
+    const RigidTransform pose = random_channel_pose(rng);
+    ASSERT_TRUE(collider.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
+    const auto expected = collide_brute_force(scene.prostate.surface, scene.tool, pose);
+    ASSERT_EQ(pairs_of(collider), expected) << "pose " << i;
+    if (i % 50 == 0) expect_leaf_lists(collider, scene.tissue_tree, scene.tool_tree);
+    total_pairs += static_cast<std::int64_t>(expected.size());
+    poses_with_pairs += expected.empty() ? 0 : 1;
+  }
+  // The poses must actually press the tool into the wall most of the time.
+  EXPECT_GT(poses_with_pairs, poses / 2);
+  EXPECT_GT(total_pairs, 10 * poses);
+}
+
+TEST(Collide, EqualsBruteForceOnALargerGlandWithTheLoopPressedIn) {
+  ProstateScene scene(8640);
+  Collider collider;
+  std::mt19937_64 rng(11);
+  for (int i = 0; i < 60; ++i) {
+    const RigidTransform pose = random_channel_pose(rng);
+    ASSERT_TRUE(collider.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
+    ASSERT_EQ(pairs_of(collider), collide_brute_force(scene.prostate.surface, scene.tool, pose)) << "pose " << i;
+    expect_leaf_lists(collider, scene.tissue_tree, scene.tool_tree);
+  }
+}
+
+// Triangles on a coarse integer grid: shared vertices, shared edges, coplanar overlaps and pure
+// touching are everywhere. Poses are exact (quarter turns, integer shifts) so nothing is rounded.
+TEST(Collide, EqualsBruteForceOnTouchingAndCoplanarSoups) {
+  std::mt19937_64 rng(3);
+  std::uniform_int_distribution<int> grid(0, 6);
+  Collider collider;
+  std::int64_t total = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const auto soup = [&](int triangles) {
+      TriangleMesh mesh;
+      for (int t = 0; t < triangles; ++t) {
+        const auto base = static_cast<std::uint32_t>(mesh.positions.size());
+        for (int k = 0; k < 3; ++k) {
+          mesh.positions.push_back(Vec3(grid(rng), grid(rng), trial % 3 == 0 ? 0 : grid(rng)));
+        }
+        if (cross(mesh.positions[base + 1] - mesh.positions[base], mesh.positions[base + 2] - mesh.positions[base]) ==
+            Vec3(0.0)) {
+          mesh.positions[base + 2] += Vec3(1, 2, trial % 3 == 0 ? 0 : 3);  // keep some area
+        }
+        mesh.triangles.push_back({base, base + 1, base + 2});
+      }
+      // Reuse vertices across triangles: shared-vertex configurations within and across soups.
+      for (Triangle& tri : mesh.triangles) {
+        if (grid(rng) == 0) tri[0] = mesh.triangles[0][1];
+      }
+      return mesh;
+    };
+    TriangleMesh tissue = soup(40);
+    TriangleMesh tool = soup(25);
+    SphereTree tissue_tree;
+    SphereTree tool_tree;
+    tissue_tree.build(tissue);
+    tool_tree.build(tool);
+    RigidTransform pose;
+    const int quarter = trial % 4;  // rotation by quarter * 90 degrees about z: exact entries
+    const double c = quarter == 0 ? 1 : quarter == 2 ? -1 : 0;
+    const double s = quarter == 1 ? 1 : quarter == 3 ? -1 : 0;
+    pose.rotation[0][0] = c, pose.rotation[0][1] = -s, pose.rotation[1][0] = s, pose.rotation[1][1] = c;
+    pose.translation = Vec3(grid(rng) - 3, grid(rng) - 3, trial % 3 == 0 ? 0 : grid(rng) - 3);
+    ASSERT_TRUE(collider.collide(tissue_tree, tissue, tool_tree, tool, pose));
+    const auto expected = collide_brute_force(tissue, tool, pose);
+    ASSERT_EQ(pairs_of(collider), expected) << "trial " << trial;
+    expect_leaf_lists(collider, tissue_tree, tool_tree);
+    total += static_cast<std::int64_t>(expected.size());
+  }
+  EXPECT_GT(total, 1000);
+}
+
+// A smooth displacement of up to 2 mm, then a refit: the pairs still equal brute force on the
+// moved surface (a refit that let a child poke out of its parent would lose pairs here).
+TEST(Collide, EqualsBruteForceAfterDeformationAndRefit) {
+  ProstateScene scene(2816);
+  TriangleMesh& surface = scene.prostate.surface;
+  const std::vector<Vec3> rest = surface.positions;
+  Collider collider;
+  std::mt19937_64 rng(5);
+  for (int step = 1; step <= 8; ++step) {
+    const double amplitude = 0.00025 * step;  // up to 2 mm
+    for (std::size_t v = 0; v < rest.size(); ++v) {
+      const Vec3& p = rest[v];
+      surface.positions[v] = p + amplitude * Vec3(std::sin(180 * p.z + step), std::cos(150 * p.x - step),
+                                                  std::sin(120 * p.y + 0.5 * step));
+    }
+    scene.tissue_tree.refit(surface);
+    testing::expect_tree_invariants(scene.tissue_tree);
+    for (int i = 0; i < 40; ++i) {
+      const RigidTransform pose = random_channel_pose(rng);
+      ASSERT_TRUE(collider.collide(scene.tissue_tree, surface, scene.tool_tree, scene.tool, pose));
+      ASSERT_EQ(pairs_of(collider), collide_brute_force(surface, scene.tool, pose)) << "step " << step << " pose " << i;
+    }
+  }
+}
+
+TEST(Collide, OverflowIsReportedNotAllocated) {
+  ProstateScene scene(1296);
+  Collider collider;
+  collider.reserve(2, 8);
+  std::mt19937_64 rng(9);
+  RigidTransform pose;
+  std::vector<TrianglePair> expected;
+  while (expected.size() < 10) {
+    pose = random_channel_pose(rng);
+    expected = collide_brute_force(scene.prostate.surface, scene.tool, pose);
+  }
+  EXPECT_FALSE(collider.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
+  EXPECT_TRUE(collider.overflowed());
+  collider.reserve(1 << 14, 1 << 16);
+  EXPECT_TRUE(collider.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
+  EXPECT_EQ(pairs_of(collider), expected);
+}
+
+}  // namespace
+}  // namespace resecto
