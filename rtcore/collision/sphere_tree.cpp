@@ -130,6 +130,20 @@ void SphereTree::add_triangle_leaves(const TriangleMesh& mesh, std::uint32_t t, 
 // ---- Build ------------------------------------------------------------------------------------
 
 void SphereTree::build(const TriangleMesh& mesh) {
+  std::vector<std::uint32_t> all(mesh.triangle_count());
+  for (std::uint32_t t = 0; t < all.size(); ++t) all[t] = t;
+  build_over(mesh, all);
+}
+
+void SphereTree::rebuild(const TriangleMesh& mesh) {
+  std::vector<std::uint32_t> present;
+  for (std::uint32_t t = 0; t < first_leaf_.size(); ++t) {
+    if (first_leaf_[t] != kNoNode) present.push_back(t);
+  }
+  build_over(mesh, present);
+}
+
+void SphereTree::build_over(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles) {
   spheres_.clear();
   links_.clear();
   pieces_.clear();
@@ -139,7 +153,7 @@ void SphereTree::build(const TriangleMesh& mesh) {
   free_list_ = kNoNode;
   leaf_count_ = 0;
   live_nodes_ = 0;
-  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) add_triangle_leaves(mesh, t, false);
+  for (const std::uint32_t t : triangles) add_triangle_leaves(mesh, t, false);
   std::vector<std::int32_t> leaves(static_cast<std::size_t>(leaf_count_));
   for (std::int32_t i = 0; i < leaf_count_; ++i) leaves[i] = i;  // leaves were allocated first
   if (!leaves.empty()) root_ = build_range(leaves.data(), leaves.data() + leaves.size(), kNoNode);

@@ -58,6 +58,9 @@ class SphereTree {
   /// component of the leaf centres (median split when one side would be empty).
   void build(const TriangleMesh& mesh);
 
+  /// The rebuild policy's action: builds afresh, top-down, over the triangles now in the tree.
+  void rebuild(const TriangleMesh& mesh);
+
   /// Recomputes every sphere bottom-up from the mesh's current vertex positions (section 3.4).
   /// Allocates nothing once the tree's size has been seen before.
   void refit(const TriangleMesh& mesh);
@@ -108,6 +111,7 @@ class SphereTree {
   void refit_node(std::int32_t node);
   void refit_upward(std::int32_t node);
   void insert_leaf(std::int32_t leaf);
+  void build_over(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles);
   void add_triangle_leaves(const TriangleMesh& mesh, std::uint32_t t, bool insert);
   void update_refit_order();
 
