@@ -62,7 +62,9 @@ class Emulator {
   /// Suspends the main loop for the next `duration_us` (the interrupts keep capturing).
   void stall_main_loop(uint64_t duration_us);
 
-  /// Takes the oldest queued 64-byte input report, if any.
+  /// Takes the oldest queued 64-byte input report, if any. The board queues 256 reports; a host that
+  /// reads less often than that holds the main loop back and, past LP3500_MAX_STALL_MS, loses data
+  /// (flagged OVERRUN), exactly as a real board whose USB endpoint is not polled.
   std::optional<std::array<uint8_t, LP3500_INPUT_REPORT_SIZE>> read_input_report();
 
   /// GET_FEATURE: the report's bytes, or empty for an unknown id.
