@@ -1,0 +1,181 @@
+// `resecto collide`: the sphere-tree collision query between a tissue mesh and a tool mesh over a
+// file of tool poses, with the pairs found and the query timings (DESIGN.md "Contracts").
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "console/commands/command_registry.h"
+#include "rtcore/collision/collide.h"
+#include "rtcore/mesh/mesh_io.h"
+
+namespace resecto::cli {
+namespace {
+
+[[noreturn]] void fail(const std::string& message) { throw std::runtime_error(message); }
+
+struct CollideOptions {
+  std::string tissue;
+  std::string tool;
+  std::string poses;
+  std::string pairs;
+  int repeat = 1;
+  bool json = false;
+};
+
+// Units as in the file: the query is scale-free, so the meshes and poses are read unconverted.
+constexpr double kFileUnits = 1.0;
+
+TriangleMesh read_mesh_or_fail(const std::string& path) {
+  Result<TriangleMesh> mesh = read_surface_mesh(path, kFileUnits);
+  if (!mesh) fail(mesh.error());
+  return std::move(mesh).value();
+}
+
+// One pose a line: 12 numbers, row-major [R|t]; blank lines and '#' comments skipped. The rotation
+// must be orthonormal to 1e-4 (a rigid transform, as the contract says).
+std::vector<RigidTransform> read_poses_or_fail(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) fail(path + ": cannot open the poses file");
+  std::vector<RigidTransform> poses;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    const std::size_t start = line.find_first_not_of(" \t\r");
+    if (start == std::string::npos || line[start] == '#') continue;
+    const std::string where = path + ":" + std::to_string(number) + ": ";
+    double values[12];
+    const char* cursor = line.c_str();
+    int count = 0;
+    for (;;) {
+      while (*cursor == ' ' || *cursor == '\t' || *cursor == ',' || *cursor == '\r') ++cursor;
+      if (*cursor == '\0') break;
+      char* end = nullptr;
+      const double v = std::strtod(cursor, &end);
+      if (end == cursor) fail(where + "'" + std::string(cursor).substr(0, 20) + "' is not a number");
+      if (!std::isfinite(v)) fail(where + "value " + std::to_string(count + 1) + " is not finite");
+      if (count == 12) fail(where + "more than 12 numbers (expected r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz)");
+      values[count++] = v;
+      cursor = end;
+    }
+    if (count != 12) {
+      fail(where + "expected 12 numbers (r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz), found " + std::to_string(count));
+    }
+    RigidTransform pose;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) pose.rotation[i][j] = values[4 * i + j];
+      pose.translation[i] = values[4 * i + 3];
+    }
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        const double rtr = pose.rotation[0][i] * pose.rotation[0][j] + pose.rotation[1][i] * pose.rotation[1][j] +
+                           pose.rotation[2][i] * pose.rotation[2][j];
+        if (std::abs(rtr - (i == j ? 1.0 : 0.0)) > 1e-4) fail(where + "the 3x3 rotation is not orthonormal");
+      }
+    }
+    poses.push_back(pose);
+  }
+  if (poses.empty()) fail(path + ": no poses (12 numbers a line)");
+  return poses;
+}
+
+// Nearest-rank percentile of sorted values.
+double percentile(const std::vector<double>& sorted, double fraction) {
+  const auto rank = static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(sorted.size())));
+  return sorted[std::clamp<std::size_t>(rank, 1, sorted.size()) - 1];
+}
+
+void run_collide(const CollideOptions& options) {
+  using Clock = std::chrono::steady_clock;
+  const TriangleMesh tissue = read_mesh_or_fail(options.tissue);
+  const TriangleMesh tool = read_mesh_or_fail(options.tool);
+  const std::vector<RigidTransform> poses = read_poses_or_fail(options.poses);
+
+  const auto build_start = Clock::now();
+  SphereTree tissue_tree;
+  SphereTree tool_tree;
+  tissue_tree.build(tissue);
+  tool_tree.build(tool);
+  const double build_ms = std::chrono::duration<double, std::milli>(Clock::now() - build_start).count();
+
+  Collider collider;
+  collider.reserve(1 << 16, 1 << 18);
+  std::vector<std::vector<TrianglePair>> found(poses.size());
+  std::vector<double> times_us;
+  times_us.reserve(poses.size() * static_cast<std::size_t>(options.repeat));
+  std::size_t most_pairs = 1 << 16;
+  for (int r = 0; r < options.repeat; ++r) {
+    for (std::size_t p = 0; p < poses.size(); ++p) {
+      auto start = Clock::now();
+      while (!collider.collide(tissue_tree, tissue, tool_tree, tool, poses[p])) {
+        most_pairs *= 4;  // more pairs than room: grow (off the timed path) and run this pose again
+        collider.reserve(static_cast<std::int32_t>(most_pairs), static_cast<std::int32_t>(4 * most_pairs));
+        start = Clock::now();
+      }
+      times_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
+      if (r == 0) found[p].assign(collider.pairs().begin(), collider.pairs().end());
+    }
+  }
+  std::size_t total_pairs = 0;
+  for (const auto& f : found) total_pairs += f.size();
+
+  if (!options.pairs.empty()) {
+    std::ofstream out(options.pairs, std::ios::binary);
+    out << "pose,tissue_face,tool_face\n";
+    for (std::size_t p = 0; p < found.size(); ++p) {
+      for (const TrianglePair& pair : found[p]) out << p << ',' << pair.tissue << ',' << pair.tool << '\n';
+    }
+    if (!out.flush()) fail(options.pairs + ": cannot write the pairs file");
+  }
+
+  std::sort(times_us.begin(), times_us.end());
+  const double median = percentile(times_us, 0.5);
+  const double p95 = percentile(times_us, 0.95);
+  if (options.json) {
+    nlohmann::json report = {
+        {"tissue_triangles", tissue.triangle_count()},
+        {"tool_triangles", tool.triangle_count()},
+        {"tissue_leaves", tissue_tree.leaf_count()},
+        {"tool_leaves", tool_tree.leaf_count()},
+        {"poses", poses.size()},
+        {"repeat", options.repeat},
+        {"pairs", total_pairs},
+        {"build_ms", build_ms},
+        {"query_us", {{"median", median}, {"p95", p95}, {"max", times_us.back()}}},
+    };
+    std::printf("%s\n", report.dump().c_str());
+    return;
+  }
+  std::printf("tissue triangles  %zu (%d leaf spheres)\n", tissue.triangle_count(), tissue_tree.leaf_count());
+  std::printf("tool triangles    %zu (%d leaf spheres)\n", tool.triangle_count(), tool_tree.leaf_count());
+  std::printf("poses             %zu x %d repeats\n", poses.size(), options.repeat);
+  std::printf("pairs             %zu (over all poses)\n", total_pairs);
+  std::printf("tree build        %.3f ms\n", build_ms);
+  std::printf("query             median %.1f us, p95 %.1f us\n", median, p95);
+}
+
+void register_collide(CLI::App& app) {
+  auto options = std::make_shared<CollideOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "collide", "Find every intersecting tissue/tool triangle pair over a file of tool poses (sphere trees)");
+  cmd->add_option("--tissue", options->tissue, "Tissue surface mesh (.off, .obj, .ply, .stl)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--tool", options->tool, "Tool surface mesh, in tool coordinates")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--poses", options->poses, "Tool poses: 12 numbers a line, row-major 3x4 [R|t]")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--pairs", options->pairs, "Write the pairs as CSV: pose,tissue_face,tool_face");
+  cmd->add_option("--repeat", options->repeat, "Run every pose this many times for the timings")
+      ->check(CLI::Range(1, 1'000'000))->capture_default_str();
+  cmd->add_flag("--json", options->json, "Print one JSON object instead of text");
+  cmd->callback([options] { run_collide(*options); });
+}
+
+const RegisterCommand kRegister{"collide", &register_collide};
+
+}  // namespace
+}  // namespace resecto::cli
