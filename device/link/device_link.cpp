@@ -218,7 +218,8 @@ void DeviceLink::handle_report(std::int64_t host_ns, std::span<const std::uint8_
   }
 
   DeviceSample& sample = decoded.sample;
-  sample.sequence = unwrapped;
+  // The tracker counts from one wrap up; delivered samples are never older than the first one.
+  sample.sequence = unwrapped - (std::uint64_t{1} << 32);
   sample.host_time_ns = host_ns;
   if (have_last_sample_) {
     const std::uint64_t expected_us = (unwrapped - last_sequence_) * config_.report_period_us;

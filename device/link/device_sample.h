@@ -25,7 +25,7 @@ struct DeviceSample {
   LinkEvent event = LinkEvent::kSample;
   std::uint8_t pedals = 0;          ///< kPedal* bits
   std::uint16_t status = 0;         ///< the board's LP3500_STATUS_* flags for this report
-  std::uint64_t sequence = 0;       ///< the board's sequence number, unwrapped to 64 bits
+  std::uint64_t sequence = 0;       ///< the board's 32-bit sequence number, unwrapped to 64 bits
   std::uint64_t device_time_us = 0; ///< board clock at the end of the report's period
   std::int64_t host_time_ns = 0;    ///< host clock when the report was read
   DeviceJoints joints;              ///< calibrated joint values

@@ -16,7 +16,9 @@ namespace resecto {
 struct LinkCounters {
   std::uint64_t reports = 0;            ///< raw reports read from the transport (valid or not)
   std::uint64_t accepted = 0;           ///< delivered toward the core (in-order samples)
-  std::uint64_t lost = 0;               ///< sequence numbers skipped and never seen (late arrivals refund)
+  /// Sequence numbers never received intact: dropped in transit, or arrived corrupt (and so also
+  /// counted in `rejected`). Late arrivals are refunded. Gaps across a disconnection are not loss.
+  std::uint64_t lost = 0;
   std::uint64_t duplicates = 0;
   std::uint64_t out_of_order = 0;       ///< valid reports that arrived after a newer one (not delivered)
   std::uint64_t rejected = 0;           ///< sum over reasons

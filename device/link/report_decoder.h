@@ -26,7 +26,7 @@ const char* reject_reason_name(RejectReason reason);
 
 /// The host-side conversion from board units to joints.
 struct JointCalibration {
-  std::array<double, 3> encoder_counts_per_rev{4000.0, 4000.0, 4000.0};  ///< yaw, pitch, roll (4x quadrature)
+  std::array<double, 3> encoder_counts_per_rev{4096.0, 4096.0, 4096.0};  ///< yaw, pitch, roll (1024 lines, 4x)
   std::array<double, 3> encoder_zero_counts{0.0, 0.0, 0.0};  ///< counts at the joint's zero angle
   double insertion_at_zero_reading_m = 0.0;  ///< pivot-to-tip distance when the sheath reads 0 um
 };
