@@ -1,0 +1,236 @@
+// The calibration file: JSON in millimetres, read with errors naming the field, written atomically.
+#include "device/calibration/calibration.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "resecto/lp3500_sensors.h"
+
+namespace resecto::device {
+namespace {
+
+using nlohmann::json;
+
+constexpr const char* kFormat = "resecto-calibration";
+constexpr int kVersion = 1;
+
+/// Walks a JSON document, remembering the first failure with the dotted path of the field at fault.
+class FieldReader {
+ public:
+  FieldReader(const json& root, std::string source) : root_(root), source_(std::move(source)) {}
+
+  const json* at(const std::string& path) {
+    const json* node = &root_;
+    std::string::size_type start = 0;
+    while (start <= path.size()) {
+      const auto dot = path.find('.', start);
+      const std::string key = path.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+      if (!node->is_object() || !node->contains(key)) return fail(path, "missing"), nullptr;
+      node = &(*node)[key];
+      if (dot == std::string::npos) break;
+      start = dot + 1;
+    }
+    return node;
+  }
+
+  double number(const std::string& path) {
+    const json* node = at(path);
+    if (!node) return 0.0;
+    if (!node->is_number()) return fail(path, "not a number"), 0.0;
+    const double value = node->get<double>();
+    if (!std::isfinite(value)) return fail(path, "not finite"), 0.0;
+    return value;
+  }
+
+  /// A numeric array of exactly `count` entries.
+  std::vector<double> numbers(const std::string& path, size_t count) {
+    const json* node = at(path);
+    if (!node) return {};
+    if (!node->is_array() || node->size() != count) {
+      return fail(path, "must be an array of " + std::to_string(count) + " numbers"), std::vector<double>{};
+    }
+    std::vector<double> values;
+    for (size_t i = 0; i < count; ++i) {
+      if (!(*node)[i].is_number()) return fail(path + "[" + std::to_string(i) + "]", "not a number"), std::vector<double>{};
+      values.push_back((*node)[i].get<double>());
+    }
+    return values;
+  }
+
+  void fail(const std::string& path, const std::string& why) {
+    if (error_.empty()) error_ = source_ + ": " + path + ": " + why;
+  }
+  bool ok() const { return error_.empty(); }
+  const std::string& error() const { return error_; }
+
+ private:
+  const json& root_;
+  std::string source_;
+  std::string error_;
+};
+
+bool is_whole(double v, double lo, double hi) { return v == std::floor(v) && v >= lo && v <= hi; }
+
+}  // namespace
+
+Calibration default_calibration() { return from_board(lp3500_default_calibration, Calibration{}); }
+
+Calibration from_board(const lp3500_calibration& board, const Calibration& base) {
+  Calibration c = base;
+  c.sheath_gain_mm_per_count = board.sheath_gain_nm_per_count * 1e-6;
+  c.sheath_offset_mm = board.sheath_offset_um * 1e-3;
+  c.sheath_min_mm = board.sheath_min_um * 1e-3;
+  c.sheath_max_mm = board.sheath_max_um * 1e-3;
+  for (unsigned i = 0; i < LP3500_HALL_TABLE_POINTS; ++i) {
+    c.hall_sum_counts[i] = board.hall_sum[i];
+    c.loop_mm[i] = board.loop_um[i] * 1e-3;
+  }
+  return c;
+}
+
+Result<lp3500_calibration> to_board(const Calibration& c) {
+  lp3500_calibration b{};
+  auto to_int32 = [](double v, double scale, const char* field, int32_t& out) -> std::string {
+    const double scaled = std::round(v * scale);
+    if (!(std::abs(scaled) < 2147483647.0)) return std::string(field) + ": out of range";
+    out = static_cast<int32_t>(scaled);
+    return {};
+  };
+  for (const std::string& e : {to_int32(c.sheath_gain_mm_per_count, 1e6, "sheath.gain_mm_per_count", b.sheath_gain_nm_per_count),
+                               to_int32(c.sheath_offset_mm, 1e3, "sheath.offset_mm", b.sheath_offset_um),
+                               to_int32(c.sheath_min_mm, 1e3, "sheath.min_mm", b.sheath_min_um),
+                               to_int32(c.sheath_max_mm, 1e3, "sheath.max_mm", b.sheath_max_um)}) {
+    if (!e.empty()) return Error{e};
+  }
+  for (unsigned i = 0; i < LP3500_HALL_TABLE_POINTS; ++i) {
+    const double um = std::round(c.loop_mm[i] * 1e3);
+    if (!(um >= 0.0 && um <= 65535.0)) {
+      return Error{"hall_table.loop_mm[" + std::to_string(i) + "]: outside 0-65.535 mm"};
+    }
+    b.loop_um[i] = static_cast<uint16_t>(um);
+    b.hall_sum[i] = c.hall_sum_counts[i];
+  }
+  int bad = -1;
+  switch (lp3500_validate_calibration(&b, &bad)) {
+    case LP3500_OK: return b;
+    case LP3500_ERROR_SHEATH_RANGE:
+      return Error{"sheath: gain must be non-zero and within +-0.5 mm per count, and min_mm below max_mm"};
+    case LP3500_ERROR_NOT_MONOTONE:
+      return Error{"hall_table[" + std::to_string(bad) + "]: hall_sum_counts must be strictly monotone and loop_mm "
+                   "strictly increasing (points " + std::to_string(bad - 1) + " and " + std::to_string(bad) + ")"};
+    default: return Error{"calibration refused by the board's rules"};
+  }
+}
+
+Result<Calibration> parse_calibration(const std::string& text, const std::string& source) {
+  const json root = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (root.is_discarded()) return Error{source + ": not valid JSON"};
+  FieldReader in(root, source);
+  Calibration c;
+  if (const json* format = in.at("format"); format && (!format->is_string() || *format != kFormat)) {
+    in.fail("format", std::string("must be \"") + kFormat + "\"");
+  }
+  if (const double version = in.number("version"); in.ok() && version != kVersion) {
+    in.fail("version", "unsupported (this build reads version 1)");
+  }
+  c.sheath_gain_mm_per_count = in.number("sheath.gain_mm_per_count");
+  c.sheath_offset_mm = in.number("sheath.offset_mm");
+  c.sheath_min_mm = in.number("sheath.min_mm");
+  c.sheath_max_mm = in.number("sheath.max_mm");
+  const auto sums = in.numbers("hall_table.hall_sum_counts", LP3500_HALL_TABLE_POINTS);
+  const auto loops = in.numbers("hall_table.loop_mm", LP3500_HALL_TABLE_POINTS);
+  const auto cpr = in.numbers("encoders.counts_per_revolution", LP3500_ENCODER_COUNT);
+  const json* rotation = in.at("registration.rotation");
+  const auto translation = in.numbers("registration.translation_mm", 3);
+  if (!in.ok()) return Error{in.error()};
+  for (unsigned i = 0; i < LP3500_HALL_TABLE_POINTS; ++i) {
+    if (!is_whole(sums[i], 0, 8190)) in.fail("hall_table.hall_sum_counts[" + std::to_string(i) + "]", "not a whole number in 0-8190");
+    c.hall_sum_counts[i] = static_cast<uint16_t>(sums[i]);
+    c.loop_mm[i] = loops[i];
+  }
+  for (unsigned a = 0; a < LP3500_ENCODER_COUNT; ++a) {
+    if (!is_whole(cpr[a], 1, 1e9)) in.fail("encoders.counts_per_revolution[" + std::to_string(a) + "]", "not a positive whole number");
+    c.encoder_counts_per_revolution[a] = static_cast<int>(cpr[a]);
+  }
+  bool rotation_shape = rotation->is_array() && rotation->size() == 3;
+  for (unsigned r = 0; rotation_shape && r < 3; ++r) {
+    const json& row = (*rotation)[r];
+    rotation_shape = row.is_array() && row.size() == 3;
+    for (unsigned k = 0; rotation_shape && k < 3; ++k) {
+      rotation_shape = row[k].is_number();
+      if (rotation_shape) c.rotation[r][k] = row[k].get<double>();
+    }
+  }
+  if (!rotation_shape) in.fail("registration.rotation", "must be 3 rows of 3 numbers (row-major)");
+  for (unsigned k = 0; k < 3; ++k) c.translation_mm[k] = translation[k];
+  if (!in.ok()) return Error{in.error()};
+  // R^T R = I and det R = +1, to 1e-6: a registration must be a rotation, not a scale or mirror.
+  double worst = 0.0;
+  for (unsigned i = 0; i < 3; ++i) {
+    for (unsigned j = 0; j < 3; ++j) {
+      double dot = 0.0;
+      for (unsigned k = 0; k < 3; ++k) dot += c.rotation[k][i] * c.rotation[k][j];
+      worst = std::max(worst, std::abs(dot - (i == j ? 1.0 : 0.0)));
+    }
+  }
+  const auto& m = c.rotation;
+  const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                     m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+  if (worst > 1e-6 || det < 0.0) return Error{source + ": registration.rotation: not a proper rotation (orthonormal, det +1)"};
+  const auto board = to_board(c);
+  if (!board) return Error{source + ": " + board.error()};
+  return c;
+}
+
+Result<Calibration> read_calibration(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{path.string() + ": cannot open"};
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_calibration(text.str(), path.string());
+}
+
+std::string calibration_to_json(const Calibration& c) {
+  json j;
+  j["format"] = kFormat;
+  j["version"] = kVersion;
+  j["sheath"] = {{"gain_mm_per_count", c.sheath_gain_mm_per_count},
+                 {"offset_mm", c.sheath_offset_mm},
+                 {"min_mm", c.sheath_min_mm},
+                 {"max_mm", c.sheath_max_mm}};
+  j["hall_table"] = {{"hall_sum_counts", c.hall_sum_counts}, {"loop_mm", c.loop_mm}};
+  j["encoders"] = {{"counts_per_revolution", c.encoder_counts_per_revolution}};
+  j["registration"] = {{"rotation", c.rotation}, {"translation_mm", c.translation_mm}};
+  return j.dump(2) + "\n";
+}
+
+Status write_calibration(const Calibration& calibration, const std::filesystem::path& path) {
+  const std::string text = calibration_to_json(calibration);
+  std::filesystem::path temporary = path;
+  temporary += ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    if (!out) return Error{temporary.string() + ": cannot create"};
+    out << text;
+    out.flush();
+    if (!out) {
+      std::error_code ignored;
+      std::filesystem::remove(temporary, ignored);
+      return Error{temporary.string() + ": write failed"};
+    }
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) {
+    std::filesystem::remove(temporary, error);
+    return Error{path.string() + ": cannot replace: " + error.message()};
+  }
+  return Ok{};
+}
+
+}  // namespace resecto::device

@@ -1,0 +1,82 @@
+// A deliberately small CSV reader: comma-separated numbers under one header line, no quoting (the
+// measurement tables never need it), every failure reported as file:line with the column.
+#include "device/calibration/calibration_csv.h"
+
+#include <charconv>
+#include <fstream>
+#include <sstream>
+
+namespace resecto::device {
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto first = s.find_first_not_of(" \t\r");
+  if (first == std::string::npos) return {};
+  const auto last = s.find_last_not_of(" \t\r");
+  return s.substr(first, last - first + 1);
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> cells;
+  std::stringstream in(line);
+  std::string cell;
+  while (std::getline(in, cell, ',')) cells.push_back(trim(cell));
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  return cells;
+}
+
+}  // namespace
+
+int NumericCsv::column(const std::string& name) const {
+  for (size_t i = 0; i < columns.size(); ++i) {
+    if (columns[i] == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+Result<NumericCsv> parse_numeric_csv(const std::string& text, const std::string& source) {
+  NumericCsv table;
+  std::stringstream in(text);
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    const std::string content = trim(line);
+    if (content.empty() || content[0] == '#') continue;
+    const auto cells = split(content);
+    const std::string where = source + ":" + std::to_string(number);
+    if (table.columns.empty()) {
+      table.columns = cells;
+      continue;
+    }
+    if (cells.size() != table.columns.size()) {
+      return Error{where + ": expected " + std::to_string(table.columns.size()) + " values, found " +
+                   std::to_string(cells.size())};
+    }
+    std::vector<double> values;
+    for (size_t c = 0; c < cells.size(); ++c) {
+      double value = 0.0;
+      const char* begin = cells[c].data();
+      const char* end = begin + cells[c].size();
+      const auto [ptr, ec] = std::from_chars(begin, end, value);
+      if (ec != std::errc{} || ptr != end || cells[c].empty()) {
+        return Error{where + ": column " + table.columns[c] + ": not a number: '" + cells[c] + "'"};
+      }
+      values.push_back(value);
+    }
+    table.rows.push_back(std::move(values));
+    table.lines.push_back(number);
+  }
+  if (table.columns.empty()) return Error{source + ": empty (expected a header line)"};
+  return table;
+}
+
+Result<NumericCsv> read_numeric_csv(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{path.string() + ": cannot open"};
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_numeric_csv(text.str(), path.string());
+}
+
+}  // namespace resecto::device
