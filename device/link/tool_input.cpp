@@ -44,8 +44,10 @@ void ToolInput::latch(SpscRing<DeviceSample>& ring, double tick_s) {
         last_sequence_ = entry.sequence;
         last_device_time_us_ = entry.device_time_us;
         ++samples_latched_;
-        if (state_ == ToolInputState::kNoDevice) {
-          // The first reading places the tool; there is no earlier pose to jump from.
+        if (state_ == ToolInputState::kNoDevice || state_ == ToolInputState::kTracking) {
+          // Tracking follows every reading at once, so a disconnect later in this same tick freezes
+          // the tool at the last reading before it. The first reading places the tool: there is no
+          // earlier pose to jump from.
           joints_ = target_;
           state_ = ToolInputState::kTracking;
         } else if (state_ == ToolInputState::kFrozen) {
@@ -54,10 +56,7 @@ void ToolInput::latch(SpscRing<DeviceSample>& ring, double tick_s) {
         break;
     }
   }
-  if (!have_target_) return;
-  if (state_ == ToolInputState::kTracking) {
-    joints_ = target_;
-  } else if (state_ == ToolInputState::kReengaging) {
+  if (have_target_ && state_ == ToolInputState::kReengaging) {
     const double angle_step = limits_.max_angular_speed_rad_s * tick_s;
     const double linear_step = limits_.max_linear_speed_m_s * tick_s;
     bool done = approach(joints_.yaw_rad, target_.yaw_rad, angle_step);
