@@ -1,6 +1,7 @@
 // `resecto mesh ...`: the procedural models (prostate, resectoscope), validation of a user's surface,
 // and TetGen's volumetric model with region labels. Lengths on the command line are millimetres.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
@@ -170,8 +171,8 @@ void register_tetra(CLI::App& mesh) {
     const double volume_error = (stats.volume_m3 - report.volume_m3) / report.volume_m3;
     std::printf("tetrahedra %s: %zu tetrahedra over %zu nodes in %.2f s%s\n", options->output.c_str(), stats.tetrahedra, stats.nodes,
                 seconds, tet.channel_axis ? " (channel axis from the landmarks file)" : "");
-    std::printf("  volume           %.3f ml (surface %.3f ml, %+.4f%%)\n", units::m3_to_ml(stats.volume_m3),
-                units::m3_to_ml(report.volume_m3), 100.0 * volume_error);
+    std::printf("  volume           %.3f ml (surface %.3f ml, difference %.4f%%)\n", units::m3_to_ml(stats.volume_m3),
+                units::m3_to_ml(report.volume_m3), 100.0 * std::abs(volume_error));
     std::printf("  capsule          %.3f ml (shell %.1f mm)\n  adenoma          %.3f ml\n", units::m3_to_ml(stats.capsule_volume_m3),
                 options->capsule_mm, units::m3_to_ml(stats.adenoma_volume_m3));
     std::printf("  dihedral angles  %.2f .. %.2f deg\n  radius-edge max  %.2f\n", stats.min_dihedral_deg, stats.max_dihedral_deg,

@@ -135,7 +135,10 @@ Result<TetMesh> read_vtk(const std::filesystem::path& path) {
   TetMesh mesh;
   std::string line;
   int line_number = 0;
-  auto fail = [&](const std::string& what) { return Error{name + ":" + std::to_string(line_number) + ": " + what}; };
+  // A file cut mid-line ends without its newline: say so, it is the likeliest cause of a bad last line.
+  auto fail = [&](const std::string& what) {
+    return Error{name + ":" + std::to_string(line_number) + ": " + (in.eof() ? "truncated: " : "") + what};
+  };
   auto next_line = [&]() {
     ++line_number;
     return static_cast<bool>(std::getline(in, line));

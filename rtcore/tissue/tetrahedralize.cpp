@@ -14,6 +14,7 @@
 
 #include "rtcore/base/units.h"
 #include "rtcore/geometry/closest_point.h"
+#include "rtcore/mesh/mesh_validation.h"
 
 namespace resecto {
 namespace {
@@ -110,6 +111,10 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   if (!(options.min_dihedral_deg >= 0.0 && options.min_dihedral_deg < 70.0)) return Error{"minimum dihedral angle must be in [0, 70) degrees"};
   if (!(options.max_volume_m3 >= 0.0)) return Error{"maximum tetrahedron volume must not be negative"};
   if (!(options.capsule_thickness_m >= 0.0)) return Error{"capsule thickness must not be negative"};
+  // TetGen can crash (not throw) on some invalid surfaces, so nothing invalid reaches it.
+  if (Result<SurfaceReport> valid = validate_closed_surface(surface); !valid) {
+    return Error{"cannot tetrahedralize: " + valid.error()};
+  }
 
   // TetGen works in millimetres: its tolerances are tuned for coordinates of order one.
   tetgenio in;
@@ -154,6 +159,10 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   for (int v = 0; v < out.numberofpoints; ++v) {
     mesh.positions[v] = Vec3(out.pointlist[3 * v], out.pointlist[3 * v + 1], out.pointlist[3 * v + 2]) * units::kMetresPerMillimetre;
   }
+  // -Y keeps every input point, first and in order: give them back their exact input coordinates
+  // (the trip through millimetres rounds), so the tissue surface is bit-identical to the input.
+  if (mesh.positions.size() < surface.vertex_count()) return Error{"TetGen dropped input vertices"};
+  std::copy(surface.positions.begin(), surface.positions.end(), mesh.positions.begin());
   mesh.tetrahedra.resize(static_cast<std::size_t>(out.numberoftetrahedra));
   for (int t = 0; t < out.numberoftetrahedra; ++t) {
     Tetrahedron& tet = mesh.tetrahedra[t];

@@ -1,0 +1,178 @@
+// Loading surfaces in every supported format, and the errors broken files of each kind must give.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "rtcore/mesh/mesh_io.h"
+#include "rtcore/mesh/mesh_validation.h"
+
+namespace resecto {
+namespace {
+
+std::filesystem::path scratch(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("resecto_mesh_files_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  return dir / name;
+}
+
+std::filesystem::path write_file(const std::string& name, const std::string& text) {
+  const auto path = scratch(name);
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+// A unit cube (millimetres), 12 triangles, outward.
+const char* kCubeVertices = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n";
+const int kCubeFaces[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                               {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+
+std::string cube_off(int skip_face = -1, int flip_face = -1) {
+  std::string text = "OFF\n8 " + std::to_string(skip_face >= 0 ? 11 : 12) + " 0\n" + kCubeVertices;
+  for (int f = 0; f < 12; ++f) {
+    if (f == skip_face) continue;
+    const int* t = kCubeFaces[f];
+    text += f == flip_face ? "3 " + std::to_string(t[0]) + " " + std::to_string(t[2]) + " " + std::to_string(t[1]) + "\n"
+                           : "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + "\n";
+  }
+  return text;
+}
+
+std::string validation_error(const std::filesystem::path& path) {
+  Result<TriangleMesh> mesh = read_surface_mesh(path);
+  if (!mesh) return mesh.error();
+  Result<SurfaceReport> report = validate_closed_surface(*mesh);
+  return report ? std::string() : report.error();
+}
+
+TEST(MeshFiles, ReadsAValidCubeInEveryFormat) {
+  std::string obj, ply = "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+                         "element face 12\nproperty list uchar int vertex_indices\nend_header\n";
+  obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n";
+  ply += kCubeVertices;
+  std::string stl = "solid cube\n";
+  const double corner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  for (const auto& t : kCubeFaces) {
+    obj += "f " + std::to_string(t[0] + 1) + " " + std::to_string(t[1] + 1) + " " + std::to_string(t[2] + 1) + "\n";
+    ply += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + "\n";
+    stl += "facet normal 0 0 0\nouter loop\n";
+    for (int c = 0; c < 3; ++c) {
+      stl += "vertex " + std::to_string(corner[t[c]][0]) + " " + std::to_string(corner[t[c]][1]) + " " + std::to_string(corner[t[c]][2]) + "\n";
+    }
+    stl += "endloop\nendfacet\n";
+  }
+  stl += "endsolid cube\n";
+  for (const auto& [name, text] : {std::pair{"cube.off", cube_off()}, std::pair{"cube.obj", obj}, std::pair{"cube.ply", ply},
+                                   std::pair{"cube.stl", stl}}) {
+    SCOPED_TRACE(name);
+    Result<TriangleMesh> mesh = read_surface_mesh(write_file(name, text));
+    ASSERT_TRUE(mesh) << mesh.error();
+    EXPECT_EQ(mesh->triangle_count(), 12u);
+    Result<SurfaceReport> report = validate_closed_surface(*mesh);
+    ASSERT_TRUE(report) << report.error();
+    EXPECT_EQ(report->genus, 0);
+    EXPECT_NEAR(report->volume_m3, 1e-9, 1e-15);  // 1 mm^3
+  }
+}
+
+TEST(MeshFiles, PolygonsAreFanTriangulatedInFileOrder) {
+  const auto path = write_file("quads.off",
+                               "OFF\n8 6 0\n" + std::string(kCubeVertices) +
+                                   "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n");
+  Result<TriangleMesh> mesh = read_surface_mesh(path);
+  ASSERT_TRUE(mesh) << mesh.error();
+  ASSERT_EQ(mesh->triangle_count(), 12u);
+  EXPECT_EQ(mesh->triangles[0], (Triangle{0, 3, 2}));
+  EXPECT_EQ(mesh->triangles[1], (Triangle{0, 2, 1}));
+  EXPECT_EQ(mesh->triangles[2], (Triangle{4, 5, 6}));
+  EXPECT_TRUE(validate_closed_surface(*mesh));
+}
+
+TEST(MeshFiles, OpenSurfaceNamesTheEdgeAndFace) {
+  const std::string error = validation_error(write_file("open.off", cube_off(/*skip_face=*/5)));
+  EXPECT_NE(error.find("open surface"), std::string::npos) << error;
+  // Face 5 (0, 5, 4) is missing; of its neighbours, face 2 across (4, 5) comes first in the file.
+  EXPECT_NE(error.find("edge (4, 5) of face 2"), std::string::npos) << error;
+}
+
+TEST(MeshFiles, FlippedFaceIsInconsistentOrientation) {
+  const std::string error = validation_error(write_file("flipped.off", cube_off(-1, /*flip_face=*/7)));
+  EXPECT_NE(error.find("inconsistent orientation"), std::string::npos) << error;
+  EXPECT_NE(error.find("face 7"), std::string::npos) << error;
+}
+
+TEST(MeshFiles, InwardSurfaceIsRejected) {
+  std::string text = "OFF\n8 12 0\n" + std::string(kCubeVertices);
+  for (const auto& t : kCubeFaces) text += "3 " + std::to_string(t[0]) + " " + std::to_string(t[2]) + " " + std::to_string(t[1]) + "\n";
+  const std::string error = validation_error(write_file("inward.off", text));
+  EXPECT_NE(error.find("inward orientation"), std::string::npos) << error;
+  EXPECT_NE(error.find("face 0"), std::string::npos) << error;
+}
+
+TEST(MeshFiles, NonManifoldEdgeNamesTheFaces) {
+  // A cube plus a fin: an extra triangle on the cube's edge (0, 1) makes that edge three-way.
+  std::string text = "OFF\n9 13 0\n" + std::string(kCubeVertices) + "0.5 -1 -1\n";
+  for (const auto& t : kCubeFaces) text += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + "\n";
+  text += "3 0 1 8\n";
+  const std::string error = validation_error(write_file("fin.ply", std::string("ply\nformat ascii 1.0\nelement vertex 9\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 13\nproperty list uchar int vertex_indices\nend_header\n") +
+      text.substr(text.find('\n', 4) + 1)));
+  EXPECT_NE(error.find("non-manifold edge (0, 1)"), std::string::npos) << error;
+  EXPECT_NE(error.find("face 0"), std::string::npos) << error;
+}
+
+TEST(MeshFiles, BowtieVertexIsNonManifold) {
+  // Two tetrahedra sharing only vertex 0.
+  const std::string obj =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv -1 0 0\nv 0 -1 0\nv 0 0 -1\n"
+      "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+      "f 1 6 5\nf 1 5 7\nf 1 7 6\nf 5 6 7\n";
+  const std::string error = validation_error(write_file("bowtie.obj", obj));
+  EXPECT_NE(error.find("non-manifold vertex 0"), std::string::npos) << error;
+}
+
+TEST(MeshFiles, DegenerateTriangleIsNamed) {
+  // The cube with vertex 2 moved onto the edge from 0 to 1: face 0 (0, 2, 1) collapses to a segment.
+  std::string text = cube_off();
+  text.replace(text.find("1 1 0\n"), 6, "0.5 0 0\n");
+  const std::string error = validation_error(write_file("degenerate.off", text));
+  EXPECT_NE(error.find("degenerate triangle: face 0"), std::string::npos) << error;
+}
+
+TEST(MeshFiles, SelfIntersectionNamesBothFaces) {
+  // Two closed tetrahedra, the second pushed through the first.
+  const std::string off =
+      "OFF\n8 8 0\n0 0 0\n2 0 0\n0 2 0\n0 0 2\n0.2 0.2 0.2\n3 0.2 0.2\n0.2 3 0.2\n0.2 0.2 3\n"
+      "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n3 4 6 5\n3 4 5 7\n3 4 7 6\n3 5 6 7\n";
+  const std::string error = validation_error(write_file("crossing.off", off));
+  EXPECT_NE(error.find("self-intersection: face 3 crosses face"), std::string::npos) << error;
+}
+
+TEST(MeshFiles, BadIndexAndBadFilesAreNamed) {
+  EXPECT_NE(validation_error(write_file("badindex.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n")).find("badindex.off"),
+            std::string::npos);
+  EXPECT_NE(validation_error(write_file("empty.stl", "")).find("empty"), std::string::npos);
+  EXPECT_NE(validation_error(write_file("garbage.ply", "this is not a mesh\n")).find("garbage.ply"), std::string::npos);
+  EXPECT_NE(validation_error(scratch("missing.obj")).find("no such file"), std::string::npos);
+  EXPECT_NE(validation_error(write_file("mesh.xyz", "1 2 3\n")).find("unsupported"), std::string::npos);
+}
+
+TEST(MeshFiles, WriteThenReadRoundTripsEveryFormat) {
+  Result<TriangleMesh> cube = read_surface_mesh(write_file("rt.off", cube_off()));
+  ASSERT_TRUE(cube);
+  for (const char* ext : {".off", ".obj", ".ply", ".stl"}) {
+    SCOPED_TRACE(ext);
+    const auto path = scratch(std::string("roundtrip") + ext);
+    ASSERT_TRUE(write_surface_mesh(path, *cube));
+    Result<TriangleMesh> back = read_surface_mesh(path);
+    ASSERT_TRUE(back) << back.error();
+    ASSERT_EQ(back->triangle_count(), 12u);
+    Result<SurfaceReport> report = validate_closed_surface(*back);
+    ASSERT_TRUE(report) << report.error();
+    EXPECT_NEAR(report->volume_m3, 1e-9, 1e-15);
+  }
+}
+
+}  // namespace
+}  // namespace resecto
