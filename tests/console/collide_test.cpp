@@ -1,0 +1,129 @@
+// `resecto collide` through the command line: the contract's text, JSON and pairs CSV (checked
+// against brute force on the same files), and one-line errors naming the poses line or the face.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "rtcore/collision/collide.h"
+#include "rtcore/mesh/mesh_io.h"
+#include "tests/console/run_resecto.h"
+
+namespace resecto {
+namespace {
+
+using testing::read_text;
+using testing::run_resecto;
+using testing::scratch_directory;
+
+struct Files {
+  std::filesystem::path dir, tissue, tool, poses;
+};
+
+// The gland and the tool written by `resecto mesh` (millimetres), and poses that press the tool
+// into the channel wall; poses 2 and 4 sit in the file behind a comment and a blank line.
+Files make_files(const std::string& name) {
+  Files f;
+  f.dir = scratch_directory(name);
+  f.tissue = f.dir / "gland.off";
+  f.tool = f.dir / "tool.stl";
+  f.poses = f.dir / "poses.txt";
+  EXPECT_EQ(run_resecto("mesh prostate --triangles 1296 -o " + f.tissue.string()).exit_code, 0);
+  EXPECT_EQ(run_resecto("mesh resectoscope -o " + f.tool.string()).exit_code, 0);
+  std::ofstream out(f.poses);
+  out << "# r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz (mm)\n"
+      << "1 0 0 1.5 0 1 0 0 0 0 1 20\n"
+      << "\n"
+      << "0 -1 0 0 1 0 0 -2 0 0 1 30\n"
+      << "1 0 0 0 0 1 0 0 0 0 1 -500\n"
+      << "   0.9950041652780258 0 0.09983341664682815 0.5   0 1 0 1   -0.09983341664682815 0 0.9950041652780258 35\n";
+  return f;
+}
+
+std::string common_args(const Files& f) {
+  return "collide --tissue " + f.tissue.string() + " --tool " + f.tool.string() + " --poses " + f.poses.string();
+}
+
+TEST(CollideCommand, PairsCsvEqualsBruteForceOnTheSameFiles) {
+  const Files f = make_files("collide_pairs");
+  const auto pairs_path = f.dir / "pairs.csv";
+  const auto result = run_resecto(common_args(f) + " --pairs " + pairs_path.string() + " --repeat 3");
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("median"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("p95"), std::string::npos) << result.out;
+
+  const auto tissue = read_surface_mesh(f.tissue, 1.0);
+  const auto tool = read_surface_mesh(f.tool, 1.0);
+  ASSERT_TRUE(tissue.ok() && tool.ok());
+  const double rotations[4][12] = {{1, 0, 0, 1.5, 0, 1, 0, 0, 0, 0, 1, 20},
+                                   {0, -1, 0, 0, 1, 0, 0, -2, 0, 0, 1, 30},
+                                   {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, -500},
+                                   {0.9950041652780258, 0, 0.09983341664682815, 0.5, 0, 1, 0, 1, -0.09983341664682815, 0,
+                                    0.9950041652780258, 35}};
+  std::ostringstream expected;
+  expected << "pose,tissue_face,tool_face\n";
+  std::size_t total = 0;
+  for (int p = 0; p < 4; ++p) {
+    RigidTransform pose;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) pose.rotation[i][j] = rotations[p][4 * i + j];
+      pose.translation[i] = rotations[p][4 * i + 3];
+    }
+    for (const TrianglePair& pair : collide_brute_force(*tissue, *tool, pose)) {
+      expected << p << ',' << pair.tissue << ',' << pair.tool << '\n';
+      ++total;
+    }
+  }
+  EXPECT_GT(total, 100u);
+  EXPECT_EQ(read_text(pairs_path), expected.str());
+
+  const auto json_run = run_resecto(common_args(f) + " --json");
+  ASSERT_EQ(json_run.exit_code, 0) << json_run.err;
+  const auto report = nlohmann::json::parse(json_run.out);
+  EXPECT_EQ(report["tissue_triangles"], tissue->triangle_count());
+  EXPECT_EQ(report["tool_triangles"], 488);
+  EXPECT_EQ(report["poses"], 4);
+  EXPECT_EQ(report["pairs"], total);
+  EXPECT_GE(report["build_ms"].get<double>(), 0.0);
+  EXPECT_LE(report["query_us"]["median"].get<double>(), report["query_us"]["p95"].get<double>());
+}
+
+TEST(CollideCommand, MalformedPosesLineIsNamed) {
+  const Files f = make_files("collide_bad_poses");
+  std::ofstream(f.poses) << "# header\n1 0 0 0 0 1 0 0 0 0 1 0\n\n1 0 0 0 0 1 zero 0 0 0 1 0\n";
+  auto result = run_resecto(common_args(f));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.err.find("poses.txt:4:"), std::string::npos) << result.err;
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+
+  std::ofstream(f.poses) << "1 0 0 0 0 1 0 0 0 0 1\n";
+  result = run_resecto(common_args(f));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.err.find("poses.txt:1: expected 12 numbers"), std::string::npos) << result.err;
+
+  std::ofstream(f.poses) << "2 0 0 0 0 1 0 0 0 0 1 0\n";
+  result = run_resecto(common_args(f));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.err.find("poses.txt:1: the 3x3 rotation is not orthonormal"), std::string::npos) << result.err;
+}
+
+TEST(CollideCommand, MalformedMeshNamesTheFace) {
+  const Files f = make_files("collide_bad_mesh");
+  const auto bad = f.dir / "bad.off";
+  std::ofstream(bad) << "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 9\n";
+  const auto result = run_resecto("collide --tissue " + bad.string() + " --tool " + f.tool.string() + " --poses " + f.poses.string());
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.err.find("face 1"), std::string::npos) << result.err;
+}
+
+TEST(CollideCommand, MissingArgumentsFailWithHelpAvailable) {
+  EXPECT_NE(run_resecto("collide --tissue nowhere.off").exit_code, 0);
+  const auto help = run_resecto("collide --help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("--poses"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace resecto
