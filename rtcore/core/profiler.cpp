@@ -1,0 +1,117 @@
+// Histograms, statistics and the Chrome trace export of the frame-budget profiler.
+#include "rtcore/core/profiler.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+namespace resecto {
+namespace {
+
+constexpr double kSmallestUs = 0.01;     // 10 ns
+constexpr double kLargestUs = 1e8;       // 100 s
+constexpr double kBinGrowth = 1.01;      // 1% wide bins
+const double kLogGrowth = std::log(kBinGrowth);
+const int kBinCount = static_cast<int>(std::ceil(std::log(kLargestUs / kSmallestUs) / std::log(kBinGrowth))) + 2;
+
+int bin_of(double us) {
+  if (!(us > kSmallestUs)) return 0;
+  return std::min(kBinCount - 1, 1 + static_cast<int>(std::log(us / kSmallestUs) / kLogGrowth));
+}
+
+/// The upper edge of a bin, the value a quantile falling into it reports.
+double bin_upper_us(int bin) { return bin == 0 ? kSmallestUs : kSmallestUs * std::pow(kBinGrowth, bin); }
+
+}  // namespace
+
+const char* stage_name(Stage stage) {
+  switch (stage) {
+    case Stage::kInput: return "input";
+    case Stage::kKinematics: return "kinematics";
+    case Stage::kPhysics: return "physics";
+    case Stage::kRefit: return "refit";
+    case Stage::kQuery: return "query";
+    case Stage::kResponse: return "response";
+    case Stage::kPublish: return "publish";
+    case Stage::kTick: return "tick";
+  }
+  return "unknown";
+}
+
+LatencyHistogram::LatencyHistogram() : bins_(static_cast<std::size_t>(kBinCount), 0) {}
+
+void LatencyHistogram::add(double microseconds) {
+  ++bins_[static_cast<std::size_t>(bin_of(microseconds))];
+  ++count_;
+  max_us_ = std::max(max_us_, microseconds);
+}
+
+double LatencyHistogram::quantile(double q) const {
+  if (count_ == 0) return 0.0;
+  const auto rank = static_cast<std::uint64_t>(std::ceil(std::clamp(q, 0.0, 1.0) * static_cast<double>(count_)));
+  std::uint64_t seen = 0;
+  for (int b = 0; b < kBinCount; ++b) {
+    seen += bins_[static_cast<std::size_t>(b)];
+    if (seen >= std::max<std::uint64_t>(rank, 1)) return std::min(bin_upper_us(b), max_us_);
+  }
+  return max_us_;
+}
+
+FrameProfiler::FrameProfiler(const std::array<double, kStageCount>& budgets_us, std::size_t trace_capacity)
+    : budgets_us_(budgets_us), trace_(std::max<std::size_t>(trace_capacity, 1)) {}
+
+std::int64_t FrameProfiler::now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+void FrameProfiler::record(Stage stage, std::uint64_t tick, std::int64_t begin_ns, std::int64_t end_ns) {
+  const int s = static_cast<int>(stage);
+  const double us = static_cast<double>(end_ns - begin_ns) * 1e-3;
+  histograms_[s].add(us);
+  if (us > budgets_us_[s]) ++over_budget_[s];
+  trace_[trace_written_ % trace_.size()] = {begin_ns, end_ns - begin_ns, tick, stage};
+  ++trace_written_;
+}
+
+StageStatistics FrameProfiler::statistics(Stage stage) const {
+  const int s = static_cast<int>(stage);
+  const LatencyHistogram& h = histograms_[s];
+  return {h.quantile(0.5), h.quantile(0.95), h.quantile(0.99), h.max(), budgets_us_[s], h.count(), over_budget_[s]};
+}
+
+Status FrameProfiler::write_chrome_trace(const std::filesystem::path& path) const {
+  const std::uint64_t kept = std::min<std::uint64_t>(trace_written_, trace_.size());
+  const std::uint64_t first = trace_written_ - kept;
+  std::int64_t origin_ns = kept ? trace_[first % trace_.size()].begin_ns : 0;
+  for (std::uint64_t i = first; i < trace_written_; ++i) origin_ns = std::min(origin_ns, trace_[i % trace_.size()].begin_ns);
+
+  std::filesystem::path temporary = path;
+  temporary += ".partial";
+  {
+    std::ofstream out(temporary, std::ios::binary);
+    if (!out) return Error{path.string() + ": cannot open for writing"};
+    out << "{\"displayTimeUnit\":\"ms\",\"traceEvents\":[\n";
+    out << R"({"name":"process_name","ph":"M","pid":1,"tid":1,"args":{"name":"resecto core"}},)" << "\n";
+    out << R"json({"name":"thread_name","ph":"M","pid":1,"tid":1,"args":{"name":"core (fixed step)"}})json";
+    char line[256];
+    // Oldest first: the order the stages ran in.
+    for (std::uint64_t i = first; i < trace_written_; ++i) {
+      const StageTiming& t = trace_[i % trace_.size()];
+      std::snprintf(line, sizeof line,
+                    ",\n{\"name\":\"%s\",\"cat\":\"core\",\"ph\":\"X\",\"pid\":1,\"tid\":1,\"ts\":%.3f,\"dur\":%.3f,\"args\":{\"tick\":%llu}}",
+                    stage_name(t.stage), static_cast<double>(t.begin_ns - origin_ns) * 1e-3, static_cast<double>(t.duration_ns) * 1e-3,
+                    static_cast<unsigned long long>(t.tick));
+      out << line;
+    }
+    out << "\n]}\n";
+    if (!out.flush()) return Error{path.string() + ": write failed"};
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, path, ec);
+  if (ec) return Error{path.string() + ": cannot replace the file: " + ec.message()};
+  return Ok{};
+}
+
+}  // namespace resecto

@@ -1,0 +1,113 @@
+// The frame-budget profiler: scoped timers around the core's stages, fixed-memory running statistics
+// (median, p95, p99, max) against each stage's budget, and a ring of recent timings exported as Chrome
+// trace-event JSON that Perfetto opens. It observes the step; nothing it measures feeds back into it.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include "rtcore/base/result.h"
+
+namespace resecto {
+
+/// The stages of a core tick, in execution order.
+enum class Stage : std::uint8_t { kInput, kKinematics, kPhysics, kRefit, kQuery, kResponse, kPublish, kTick };
+inline constexpr int kStageCount = 8;
+
+/// Lower-case name used in reports and traces ("physics").
+const char* stage_name(Stage stage);
+
+/// Running distribution of durations in fixed memory: log-spaced bins 1% wide from 10 ns to 100 s,
+/// so percentiles are within 1% and adding a sample never allocates.
+class LatencyHistogram {
+ public:
+  LatencyHistogram();
+  void add(double microseconds);
+  /// The q-quantile (0..1) in microseconds; 0 when empty.
+  double quantile(double q) const;
+  double max() const { return max_us_; }
+  std::uint64_t count() const { return count_; }
+
+ private:
+  std::vector<std::uint32_t> bins_;
+  std::uint64_t count_ = 0;
+  double max_us_ = 0.0;
+};
+
+/// Percentiles of one stage against its budget, microseconds.
+struct StageStatistics {
+  double median_us = 0.0;
+  double p95_us = 0.0;
+  double p99_us = 0.0;
+  double max_us = 0.0;
+  double budget_us = 0.0;
+  std::uint64_t samples = 0;
+  std::uint64_t over_budget = 0;
+};
+
+/// One measured stage of one tick, for the trace.
+struct StageTiming {
+  std::int64_t begin_ns = 0;
+  std::int64_t duration_ns = 0;
+  std::uint64_t tick = 0;
+  Stage stage = Stage::kTick;
+};
+
+class FrameProfiler {
+ public:
+  /// Budgets per stage in microseconds; the trace keeps the last `trace_capacity` stage timings.
+  FrameProfiler(const std::array<double, kStageCount>& budgets_us, std::size_t trace_capacity);
+
+  /// Monotonic clock for timings, nanoseconds (never used by the simulation itself).
+  static std::int64_t now_ns();
+
+  /// Records one stage's duration; never allocates.
+  void record(Stage stage, std::uint64_t tick, std::int64_t begin_ns, std::int64_t end_ns);
+
+  StageStatistics statistics(Stage stage) const;
+  double budget_us(Stage stage) const { return budgets_us_[static_cast<int>(stage)]; }
+  /// Stage timings recorded so far that the trace ring no longer holds.
+  std::uint64_t trace_dropped() const { return trace_written_ > trace_.size() ? trace_written_ - trace_.size() : 0; }
+
+  /// Writes the trace ring as Chrome trace-event JSON (complete "X" events, microseconds).
+  Status write_chrome_trace(const std::filesystem::path& path) const;
+
+ private:
+  std::array<double, kStageCount> budgets_us_;
+  std::array<LatencyHistogram, kStageCount> histograms_;
+  std::array<std::uint64_t, kStageCount> over_budget_{};
+  std::vector<StageTiming> trace_;
+  std::uint64_t trace_written_ = 0;
+};
+
+/// Times a scope as one stage of one tick. With RESECTO_PROFILER_DISABLED defined the macro below
+/// compiles to nothing.
+class ScopedStage {
+ public:
+  ScopedStage(FrameProfiler* profiler, Stage stage, std::uint64_t tick)
+      : profiler_(profiler), stage_(stage), tick_(tick), begin_ns_(profiler ? FrameProfiler::now_ns() : 0) {}
+  ~ScopedStage() {
+    if (profiler_) profiler_->record(stage_, tick_, begin_ns_, FrameProfiler::now_ns());
+  }
+  ScopedStage(const ScopedStage&) = delete;
+  ScopedStage& operator=(const ScopedStage&) = delete;
+
+ private:
+  FrameProfiler* profiler_;
+  Stage stage_;
+  std::uint64_t tick_;
+  std::int64_t begin_ns_;
+};
+
+#ifdef RESECTO_PROFILER_DISABLED
+#define RESECTO_PROFILE_STAGE(profiler, stage, tick) ((void)0)
+#else
+#define RESECTO_PROFILE_STAGE_CONCAT2(a, b) a##b
+#define RESECTO_PROFILE_STAGE_CONCAT(a, b) RESECTO_PROFILE_STAGE_CONCAT2(a, b)
+#define RESECTO_PROFILE_STAGE(profiler, stage, tick) \
+  ::resecto::ScopedStage RESECTO_PROFILE_STAGE_CONCAT(resecto_stage_timer_, __LINE__)((profiler), (stage), (tick))
+#endif
+
+}  // namespace resecto

@@ -1,0 +1,68 @@
+// The frame-budget profiler: percentiles within the histogram's 1% resolution, budgets counted, and
+// a trace Perfetto can open.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "rtcore/core/profiler.h"
+
+namespace resecto {
+namespace {
+
+TEST(LatencyHistogram, QuantilesWithinOnePercentOfExact) {
+  std::mt19937_64 random(7);
+  std::lognormal_distribution<double> durations(4.0, 1.0);  // a long-tailed timing distribution, µs
+  std::vector<double> samples(20000);
+  LatencyHistogram histogram;
+  for (double& s : samples) {
+    s = durations(random);
+    histogram.add(s);
+  }
+  std::sort(samples.begin(), samples.end());
+  for (double q : {0.5, 0.95, 0.99}) {
+    const double exact = samples[static_cast<std::size_t>(std::ceil(q * samples.size())) - 1];
+    EXPECT_NEAR(histogram.quantile(q) / exact, 1.0, 0.011) << "q = " << q;
+  }
+  EXPECT_DOUBLE_EQ(histogram.max(), samples.back());
+  EXPECT_EQ(histogram.count(), samples.size());
+}
+
+TEST(FrameProfiler, CountsOverBudgetAndWritesATrace) {
+  std::array<double, kStageCount> budgets{};
+  budgets.fill(100.0);
+  FrameProfiler profiler(budgets, 8);
+  for (std::uint64_t tick = 0; tick < 10; ++tick) {
+    profiler.record(Stage::kPhysics, tick, 1'000'000 * tick, 1'000'000 * tick + (tick < 7 ? 50'000 : 150'000));
+    profiler.record(Stage::kQuery, tick, 1'000'000 * tick + 200'000, 1'000'000 * tick + 230'000);
+  }
+  const StageStatistics physics = profiler.statistics(Stage::kPhysics);
+  EXPECT_EQ(physics.samples, 10u);
+  EXPECT_EQ(physics.over_budget, 3u);
+  EXPECT_NEAR(physics.median_us, 50.0, 0.6);
+  EXPECT_DOUBLE_EQ(physics.max_us, 150.0);
+  EXPECT_EQ(profiler.trace_dropped(), 12u);  // 20 recorded, 8 kept
+
+  const auto path = std::filesystem::temp_directory_path() / ("resecto_trace_" + std::to_string(::getpid()) + ".json");
+  ASSERT_TRUE(profiler.write_chrome_trace(path));
+  const auto trace = nlohmann::json::parse(std::ifstream(path));
+  int complete = 0;
+  double last_ts = -1.0;
+  for (const auto& event : trace.at("traceEvents")) {
+    if (event.at("ph") != "X") continue;
+    ++complete;
+    EXPECT_GE(event.at("ts").get<double>(), last_ts);  // oldest first
+    last_ts = event.at("ts").get<double>();
+    EXPECT_GT(event.at("dur").get<double>(), 0.0);
+  }
+  EXPECT_EQ(complete, 8);
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace resecto

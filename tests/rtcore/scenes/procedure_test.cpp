@@ -1,0 +1,59 @@
+// Procedure files: the built-in demo, interpolation between keyframes, and errors naming the line.
+#include <gtest/gtest.h>
+
+#include "rtcore/scenes/procedure.h"
+
+namespace resecto {
+namespace {
+
+TEST(Procedure, DemoIsBuiltInAndWellFormed) {
+  Result<Procedure> demo = find_procedure("demo");
+  ASSERT_TRUE(demo) << demo.error();
+  EXPECT_DOUBLE_EQ(demo->duration_s(), 10.0);
+  bool cuts = false;
+  double deepest = 0.0;
+  for (const ProcedureKeyframe& k : demo->keyframes) {
+    cuts = cuts || k.cut;
+    deepest = std::max(deepest, k.insertion_mm);
+  }
+  EXPECT_TRUE(cuts);
+  EXPECT_GT(deepest, 150.0);  // past the apex (insertion 150 mm with the default registration)
+  EXPECT_LT(deepest, 191.5);  // short of the bladder neck
+}
+
+TEST(Procedure, JointsInterpolateAndPedalsHold) {
+  Result<Procedure> p = parse_procedure("0 0 0 0 100 0 0 0\n2 2 -4 90 140 10 1 0\n4 2 -4 90 140 10 0 1\n", "test");
+  ASSERT_TRUE(p) << p.error();
+  const ProcedureKeyframe mid = p->sample(1.0);
+  EXPECT_DOUBLE_EQ(mid.yaw_deg, 1.0);
+  EXPECT_DOUBLE_EQ(mid.pitch_deg, -2.0);
+  EXPECT_DOUBLE_EQ(mid.roll_deg, 45.0);
+  EXPECT_DOUBLE_EQ(mid.insertion_mm, 120.0);
+  EXPECT_DOUBLE_EQ(mid.loop_mm, 5.0);
+  EXPECT_FALSE(mid.cut);                 // the pedal goes down at t = 2, not before
+  EXPECT_TRUE(p->sample(2.0).cut);
+  EXPECT_TRUE(p->sample(3.9).cut);
+  EXPECT_TRUE(p->sample(4.0).coagulate);
+  EXPECT_DOUBLE_EQ(p->sample(-1.0).insertion_mm, 100.0);  // held before the first keyframe
+  EXPECT_DOUBLE_EQ(p->sample(99.0).insertion_mm, 140.0);  // and after the last
+}
+
+TEST(Procedure, ErrorsNameTheLine) {
+  auto error_of = [](const std::string& text) {
+    Result<Procedure> p = parse_procedure(text, "mine.txt");
+    return p ? std::string() : p.error();
+  };
+  EXPECT_EQ(error_of("# header\n0 0 0 0 100 0 0 0\n1 0 0 0 100 0\n").rfind("mine.txt:3: expected 8 columns", 0), 0u);
+  EXPECT_NE(error_of("0 0 0 0 100 0 0 0\n0 0 0 0 100 0 0 0\n").find("mine.txt:2: time_s must increase"), std::string::npos);
+  EXPECT_NE(error_of("0 0 0 0 300 0 0 0\n").find("mine.txt:1: insertion_mm 300 is outside [0, 230]"), std::string::npos);
+  EXPECT_NE(error_of("0 0 0 0 100 0 2 0\n").find("cut must be 0 or 1"), std::string::npos);
+  EXPECT_NE(error_of("0 0 zero 0 100 0 0 0\n").find("pitch_deg is not a number: 'zero'"), std::string::npos);
+  EXPECT_NE(error_of("# nothing\n").find("no keyframes"), std::string::npos);
+  Result<Procedure> unknown = find_procedure("tour");
+  ASSERT_FALSE(unknown);
+  EXPECT_NE(unknown.error().find("built-in: demo"), std::string::npos);
+  EXPECT_FALSE(find_procedure("/nonexistent/file.txt"));
+}
+
+}  // namespace
+}  // namespace resecto
