@@ -1,0 +1,20 @@
+// Absolute-deadline sleeping for the real-time scheduler.
+#include "rtcore/core/fixed_step_scheduler.h"
+
+#include <time.h>
+
+#include <cerrno>
+
+namespace resecto {
+
+void FixedStepScheduler::sleep_until(std::int64_t deadline_ns) {
+  // CLOCK_MONOTONIC is steady_clock's clock on Linux; an absolute deadline does not drift when a
+  // sleep is interrupted or a tick overruns.
+  timespec when{};
+  when.tv_sec = static_cast<time_t>(deadline_ns / 1'000'000'000);
+  when.tv_nsec = static_cast<long>(deadline_ns % 1'000'000'000);
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &when, nullptr) == EINTR) {
+  }
+}
+
+}  // namespace resecto

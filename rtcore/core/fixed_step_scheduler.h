@@ -1,0 +1,77 @@
+// FixedStepScheduler: runs the core's step at integer ticks. Real-time mode sleeps to absolute
+// deadlines (start + k * period, never accumulated), counts every tick that finishes after its
+// deadline and by how much, and catches up by running late ticks back to back, at most a bounded
+// number, before it re-anchors the schedule. Batch mode runs the same step as fast as it can.
+// The step never sees the clock: only which tick it is.
+#pragma once
+
+#include <cstdint>
+
+#include "rtcore/core/profiler.h"
+
+namespace resecto {
+
+struct SchedulerConfig {
+  std::int64_t period_ns = 1'041'667;  ///< one tick (960 Hz by default)
+  bool realtime = false;
+  /// Ticks the schedule may fall behind before it gives up catching up and starts afresh.
+  std::uint64_t max_catch_up_ticks = 8;
+};
+
+/// How well the real-time schedule held.
+struct DeadlineReport {
+  std::uint64_t ticks = 0;
+  std::uint64_t misses = 0;          ///< ticks that finished after their deadline
+  std::uint64_t resynchronizations = 0;
+  double max_late_us = 0.0;          ///< the worst miss
+  LatencyHistogram late_us;          ///< lateness of the missed ticks only
+};
+
+class FixedStepScheduler {
+ public:
+  explicit FixedStepScheduler(const SchedulerConfig& config) : config_(config) {}
+
+  /// Runs `step(tick)` for ticks [first, first + count), in order; `step` returns false to stop early.
+  template <class Step>
+  void run(std::uint64_t first, std::uint64_t count, Step&& step) {
+    std::int64_t anchor_ns = FrameProfiler::now_ns();
+    std::uint64_t anchor_tick = first;
+    for (std::uint64_t tick = first; tick < first + count; ++tick) {
+      if (config_.realtime) {
+        const std::int64_t start_ns = anchor_ns + static_cast<std::int64_t>(tick - anchor_tick) * config_.period_ns;
+        const std::int64_t now = FrameProfiler::now_ns();
+        if (now < start_ns) {
+          sleep_until(start_ns);
+        } else if (now - start_ns > static_cast<std::int64_t>(config_.max_catch_up_ticks) * config_.period_ns) {
+          // Too far behind to catch up without a burst: start the schedule afresh from here.
+          anchor_ns = now;
+          anchor_tick = tick;
+          ++report_.resynchronizations;
+        }
+      }
+      const bool go_on = step(tick);
+      ++report_.ticks;
+      if (config_.realtime) {
+        const std::int64_t deadline_ns = anchor_ns + static_cast<std::int64_t>(tick + 1 - anchor_tick) * config_.period_ns;
+        const std::int64_t late_ns = FrameProfiler::now_ns() - deadline_ns;
+        if (late_ns > 0) {
+          ++report_.misses;
+          const double late_us = static_cast<double>(late_ns) * 1e-3;
+          report_.late_us.add(late_us);
+          if (late_us > report_.max_late_us) report_.max_late_us = late_us;
+        }
+      }
+      if (!go_on) break;
+    }
+  }
+
+  const DeadlineReport& report() const { return report_; }
+
+ private:
+  static void sleep_until(std::int64_t deadline_ns);
+
+  SchedulerConfig config_;
+  DeadlineReport report_;
+};
+
+}  // namespace resecto
