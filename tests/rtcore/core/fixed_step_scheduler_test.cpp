@@ -50,7 +50,7 @@ TEST(FixedStepScheduler, FarBehindReanchorsInsteadOfBursting) {
     if (tick == 10) std::this_thread::sleep_for(std::chrono::milliseconds(20));
     return true;
   });
-  EXPECT_EQ(scheduler.report().resynchronizations, 1u);
+  EXPECT_GE(scheduler.report().resynchronizations, 1u);  // a loaded machine may add more
   EXPECT_GE(scheduler.report().misses, 1u);
 }
 
