@@ -14,6 +14,8 @@
 #include <nlohmann/json.hpp>
 
 #include "console/commands/command_registry.h"
+#include "device/calibration/calibration.h"
+#include "device/link/calibration_adapter.h"
 #include "device/link/device_link.h"
 #include "device/link/tool_input.h"
 #include "device/transport/fault_injection.h"
@@ -96,6 +98,7 @@ struct MonitorOptions {
   std::uint64_t seed = 1;
   bool json = false;
   std::string record;
+  std::string calibration;
   HidOptions hid;
 };
 
@@ -184,6 +187,16 @@ void run_monitor(const MonitorOptions& o) {
 #endif
   }
 
+  device::Calibration calibration = device::default_calibration();
+  if (!o.calibration.empty()) {
+    auto read = device::read_calibration(o.calibration);
+    if (!read) fail(read.error());
+    calibration = *read;
+  }
+  LinkConfig link_config;
+  link_config.calibration = joint_calibration_from(calibration);
+  const GimbalGeometry geometry = gimbal_geometry_from(calibration);
+
   FaultConfig faults;
   faults.drop_probability = o.drop;
   faults.duplicate_probability = o.duplicate;
@@ -200,7 +213,7 @@ void run_monitor(const MonitorOptions& o) {
     recorder.emplace(std::move(*created));
   }
 
-  DeviceLink link(faulty, clock);
+  DeviceLink link(faulty, clock, link_config);
   if (recorder) {
     // The recorder runs on the link thread; a monitor is not the real-time path, so its I/O is fine.
     link.set_raw_report_tap([&recorder](std::int64_t host_ns, std::span<const std::uint8_t> bytes) {
@@ -223,12 +236,14 @@ void run_monitor(const MonitorOptions& o) {
       next_print_ns += 250 * kNanosecondsPerMillisecond;
       const LinkCounters c = link.published_counters();
       const DeviceJoints& j = tool.joints();
+      const Vec3 tip_mm = sheath_tip_world(j, geometry) * units::kMillimetresPerMetre;
       std::printf("%7.2f s %-12s seq %8llu  yaw %6.1f pitch %6.1f roll %6.1f deg  sheath %6.1f loop %5.1f mm  %s"
-                  "  | %6.0f Hz lost %llu dup %llu rej %llu\n",
+                  "  tip (%6.1f %6.1f %6.1f) mm  | %6.0f Hz lost %llu dup %llu rej %llu\n",
                   static_cast<double>(now_ns - start_ns) * 1e-9, c.connected ? "connected" : "DISCONNECTED",
                   static_cast<unsigned long long>(tool.last_sequence()), units::rad_to_deg(j.yaw_rad),
                   units::rad_to_deg(j.pitch_rad), units::rad_to_deg(j.roll_rad), units::m_to_mm(j.insertion_m),
-                  units::m_to_mm(j.loop_travel_m), (tool.pedals() & kPedalCut) ? "CUT" : "   ", c.rate_hz,
+                  units::m_to_mm(j.loop_travel_m), (tool.pedals() & kPedalCut) ? "CUT" : "   ", tip_mm.x, tip_mm.y,
+                  tip_mm.z, c.rate_hz,
                   static_cast<unsigned long long>(c.lost), static_cast<unsigned long long>(c.duplicates),
                   static_cast<unsigned long long>(c.rejected));
       std::fflush(stdout);
@@ -268,6 +283,7 @@ void register_monitor(CLI::App& family) {
   cmd->add_option("--unplug", o->unplug, "Inject: probability per read that the cable is pulled for 300 ms")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--seed", o->seed, "Seed of the injected faults and the emulator's noise")->capture_default_str();
+  cmd->add_option("--calibration", o->calibration, "Calibration file (JSON; default: the board's compiled-in one)");
   cmd->add_option("--record", o->record, "Write every raw report to this file (text, timestamped)");
   cmd->add_flag("--json", o->json, "Print only a JSON summary at the end");
   add_hid_options(*cmd, o->hid);

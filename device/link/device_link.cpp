@@ -60,10 +60,13 @@ LinkCounters DeviceLink::published_counters() const {
 LinkCounters DeviceLink::counters() const {
   LinkCounters snapshot = counters_;
   snapshot.connected = link_up_;
-  if (counters_.accepted > 1 && last_accept_ns_ > first_accept_ns_) {
-    snapshot.rate_hz = static_cast<double>(counters_.accepted - 1) * 1e9 /
-                       static_cast<double>(last_accept_ns_ - first_accept_ns_);
+  std::int64_t span_ns = closed_span_ns_;
+  std::uint64_t intervals = closed_intervals_;
+  if (segment_accepted_ > 1) {
+    span_ns += last_accept_ns_ - segment_first_ns_;
+    intervals += segment_accepted_ - 1;
   }
+  if (span_ns > 0) snapshot.rate_hz = static_cast<double>(intervals) * 1e9 / static_cast<double>(span_ns);
   snapshot.latency_median_us = latency_.quantile(0.5);
   snapshot.latency_p99_us = latency_.quantile(0.99);
   snapshot.latency_max_us = latency_.max_us();
@@ -131,6 +134,11 @@ void DeviceLink::disconnect(std::int64_t now_ns, const std::string& reason, bool
   connected_.store(false, std::memory_order_release);
   ++counters_.disconnects;
   if (silence) ++counters_.silence_timeouts;
+  if (segment_accepted_ > 1) {
+    closed_span_ns_ += last_accept_ns_ - segment_first_ns_;
+    closed_intervals_ += segment_accepted_ - 1;
+  }
+  segment_accepted_ = 0;
   set_error(reason);
   if (sequence_.has_newest()) {
     have_sequence_before_disconnect_ = true;
@@ -233,7 +241,7 @@ void DeviceLink::handle_report(std::int64_t host_ns, std::span<const std::uint8_
   last_device_time_us_ = sample.device_time_us;
   last_valid_ns_ = host_ns;
   latency_.add(clock_offset_.observe(host_ns, sample.device_time_us));
-  if (first_accept_ns_ < 0) first_accept_ns_ = host_ns;
+  if (segment_accepted_++ == 0) segment_first_ns_ = host_ns;
   last_accept_ns_ = host_ns;
   ++counters_.accepted;
   if (flush_pending_event()) push(sample);

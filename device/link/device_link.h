@@ -96,8 +96,12 @@ class DeviceLink {
   std::int64_t next_open_ns_ = 0;
   std::int64_t backoff_ns_ = 0;
   std::int64_t last_valid_ns_ = 0;
-  std::int64_t first_accept_ns_ = -1;
-  std::int64_t last_accept_ns_ = -1;
+  // Rate over connected time only: spans between first and last sample of each connection.
+  std::int64_t segment_first_ns_ = 0;
+  std::int64_t last_accept_ns_ = 0;
+  std::uint64_t segment_accepted_ = 0;
+  std::int64_t closed_span_ns_ = 0;
+  std::uint64_t closed_intervals_ = 0;
   std::int64_t last_publish_ns_ = 0;
   std::uint64_t last_sequence_ = 0;        ///< unwrapped, of the last accepted sample
   std::uint64_t last_device_time_us_ = 0;

@@ -31,7 +31,7 @@ struct LinkCounters {
   std::uint64_t disconnects = 0;
   std::uint64_t silence_timeouts = 0;   ///< of the disconnects, those caused by silence
   std::uint64_t failed_opens = 0;
-  double rate_hz = 0.0;                 ///< accepted samples per second of host time
+  double rate_hz = 0.0;                 ///< accepted samples per second while connected (host time)
   double latency_median_us = 0.0;       ///< device->host, above the estimated clock offset
   double latency_p99_us = 0.0;
   double latency_max_us = 0.0;
