@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <numbers>
+#include <string>
 
 #include "rtcore/anatomy/prostate.h"
 
@@ -27,6 +29,32 @@ TEST(CalibrationAdapter, DefaultCalibrationAimsDownTheProstateChannel) {
   }
   const JointCalibration joint = joint_calibration_from(calibration);
   EXPECT_EQ(joint.encoder_counts_per_rev[0], 4096.0);
+}
+
+TEST(CalibrationAdapter, TipRunsFromApexToBladderNeckInsideTheGeneratedLumen) {
+  const ProstateModel prostate = generate_prostate(1296);
+  const GimbalGeometry geometry = gimbal_geometry_from(device::default_calibration());
+  const auto landmark = [&](const std::string& name) {
+    for (const Landmark& l : prostate.landmarks) {
+      if (l.name == name) return l.position;
+    }
+    ADD_FAILURE() << "no landmark " << name;
+    return Vec3(0.0);
+  };
+  const Vec3 apex = landmark("apex");
+  const Vec3 neck = landmark("bladder_neck");
+  DeviceJoints joints;
+  for (int step = 0; step <= 100; ++step) {
+    const double fraction = step / 100.0;
+    const Vec3 target = apex + (neck - apex) * fraction;
+    joints.insertion_m = 0.150 + target.z;  // the sheath reading that should put the tip there
+    const Vec3 tip = sheath_tip_world(joints, geometry);
+    ASSERT_LT(length(tip - target), 1e-12) << "step " << step;
+    // Inside the lumen: no surface vertex closer than the narrowest bulge leaves (about 2.9 mm).
+    double nearest = 1.0;
+    for (const Vec3& p : prostate.surface.positions) nearest = std::min(nearest, length(p - tip));
+    ASSERT_GT(nearest, 0.0025) << "step " << step << " tip z " << tip.z;
+  }
 }
 
 TEST(CalibrationAdapter, RegistrationRotationIsReadRowMajor) {
