@@ -24,7 +24,7 @@ struct DeadlineReport {
   std::uint64_t misses = 0;          ///< ticks that finished after their deadline
   std::uint64_t resynchronizations = 0;
   double max_late_us = 0.0;          ///< the worst miss
-  LatencyHistogram late_us;          ///< lateness of the missed ticks only
+  TimingHistogram late_us;          ///< lateness of the missed ticks only
 };
 
 class FixedStepScheduler {

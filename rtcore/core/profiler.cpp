@@ -40,15 +40,15 @@ const char* stage_name(Stage stage) {
   return "unknown";
 }
 
-LatencyHistogram::LatencyHistogram() : bins_(static_cast<std::size_t>(kBinCount), 0) {}
+TimingHistogram::TimingHistogram() : bins_(static_cast<std::size_t>(kBinCount), 0) {}
 
-void LatencyHistogram::add(double microseconds) {
+void TimingHistogram::add(double microseconds) {
   ++bins_[static_cast<std::size_t>(bin_of(microseconds))];
   ++count_;
   max_us_ = std::max(max_us_, microseconds);
 }
 
-double LatencyHistogram::quantile(double q) const {
+double TimingHistogram::quantile(double q) const {
   if (count_ == 0) return 0.0;
   const auto rank = static_cast<std::uint64_t>(std::ceil(std::clamp(q, 0.0, 1.0) * static_cast<double>(count_)));
   std::uint64_t seen = 0;
@@ -77,7 +77,7 @@ void FrameProfiler::record(Stage stage, std::uint64_t tick, std::int64_t begin_n
 
 StageStatistics FrameProfiler::statistics(Stage stage) const {
   const int s = static_cast<int>(stage);
-  const LatencyHistogram& h = histograms_[s];
+  const TimingHistogram& h = histograms_[s];
   return {h.quantile(0.5), h.quantile(0.95), h.quantile(0.99), h.max(), budgets_us_[s], h.count(), over_budget_[s]};
 }
 

@@ -21,9 +21,9 @@ const char* stage_name(Stage stage);
 
 /// Running distribution of durations in fixed memory: log-spaced bins 1% wide from 10 ns to 100 s,
 /// so percentiles are within 1% and adding a sample never allocates.
-class LatencyHistogram {
+class TimingHistogram {
  public:
-  LatencyHistogram();
+  TimingHistogram();
   void add(double microseconds);
   /// The q-quantile (0..1) in microseconds; 0 when empty.
   double quantile(double q) const;
@@ -76,7 +76,7 @@ class FrameProfiler {
 
  private:
   std::array<double, kStageCount> budgets_us_;
-  std::array<LatencyHistogram, kStageCount> histograms_;
+  std::array<TimingHistogram, kStageCount> histograms_;
   std::array<std::uint64_t, kStageCount> over_budget_{};
   std::vector<StageTiming> trace_;
   std::uint64_t trace_written_ = 0;

@@ -108,6 +108,10 @@ Result<Procedure> parse_procedure(const std::string& text, const std::string& so
     if (!procedure.keyframes.empty() && !(v[0] > procedure.keyframes.back().time_s)) {
       return line_error(source_name, number, "time_s must increase from one keyframe to the next");
     }
+    // Encoders count from where the device powers up, so every procedure starts at the home pose.
+    if (procedure.keyframes.empty() && (v[1] != 0.0 || v[2] != 0.0 || v[3] != 0.0)) {
+      return line_error(source_name, number, "the first keyframe must have yaw, pitch and roll 0 (the device powers up at its home pose)");
+    }
     procedure.keyframes.push_back({v[0], v[1], v[2], v[3], v[4], v[5], v[6] != 0.0, v[7] != 0.0});
   }
   if (procedure.keyframes.empty()) return Error{source_name + ": no keyframes"};

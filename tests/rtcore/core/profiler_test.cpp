@@ -15,11 +15,11 @@
 namespace resecto {
 namespace {
 
-TEST(LatencyHistogram, QuantilesWithinOnePercentOfExact) {
+TEST(TimingHistogram, QuantilesWithinOnePercentOfExact) {
   std::mt19937_64 random(7);
   std::lognormal_distribution<double> durations(4.0, 1.0);  // a long-tailed timing distribution, µs
   std::vector<double> samples(20000);
-  LatencyHistogram histogram;
+  TimingHistogram histogram;
   for (double& s : samples) {
     s = durations(random);
     histogram.add(s);

@@ -48,6 +48,7 @@ TEST(Procedure, ErrorsNameTheLine) {
   EXPECT_NE(error_of("0 0 0 0 300 0 0 0\n").find("mine.txt:1: insertion_mm 300 is outside [0, 230]"), std::string::npos);
   EXPECT_NE(error_of("0 0 0 0 100 0 2 0\n").find("cut must be 0 or 1"), std::string::npos);
   EXPECT_NE(error_of("0 0 zero 0 100 0 0 0\n").find("pitch_deg is not a number: 'zero'"), std::string::npos);
+  EXPECT_NE(error_of("0 5 0 0 100 0 0 0\n").find("mine.txt:1: the first keyframe must have yaw, pitch and roll 0"), std::string::npos);
   EXPECT_NE(error_of("# nothing\n").find("no keyframes"), std::string::npos);
   Result<Procedure> unknown = find_procedure("tour");
   ASSERT_FALSE(unknown);

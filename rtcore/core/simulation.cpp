@@ -1,0 +1,196 @@
+// The core's tick: input, kinematics, collision (refit + query) on collision ticks, physics with
+// penalty response, metrics and the state hash. Everything is sized in create(); step() only reads
+// and writes arrays that already exist.
+#include "rtcore/core/simulation.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "device/link/device_sample.h"
+#include "rtcore/base/units.h"
+#include "rtcore/tissue/state_hash.h"
+#include "rtcore/tissue/tetrahedralize.h"
+
+namespace resecto {
+namespace {
+
+RigidTransform to_transform(const RigidPose& pose) {
+  RigidTransform t;
+  // glm matrices are column-major: rotation[c][r] is row r, column c.
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) t.rotation[r][c] = pose.rotation[c][r];
+  t.translation = pose.translation;
+  return t;
+}
+
+/// Where the tool waits before the device has reported: far outside the body, touching nothing.
+RigidPose withdrawn_pose() {
+  RigidPose pose;
+  pose.translation = Vec3(0.0, 0.0, -1.0);
+  return pose;
+}
+
+/// The middle of the loop's wire front, in the tool frame: the point that cuts first.
+Vec3 loop_front_point(const TriangleMesh& loop) {
+  double front = -1e300;
+  for (const Vec3& p : loop.positions) front = std::max(front, p.z);
+  Vec3 sum(0.0);
+  int count = 0;
+  for (const Vec3& p : loop.positions) {
+    if (p.z > front - 0.0005) {
+      sum += p;
+      ++count;
+    }
+  }
+  return sum / static_cast<double>(std::max(count, 1));
+}
+
+}  // namespace
+
+Status SimulationConfig::validate() const {
+  if (collision_hz < 10 || collision_hz > 1000) return Error{"collision rate " + std::to_string(collision_hz) + " Hz is outside [10, 1000]"};
+  if (physics_per_collision < 1 || physics_per_collision > 64) {
+    return Error{"physics substeps " + std::to_string(physics_per_collision) + " per collision step is outside [1, 64]"};
+  }
+  if (prostate_triangles < 200 || prostate_triangles > 1'000'000) {
+    return Error{"prostate triangles " + std::to_string(prostate_triangles) + " is outside [200, 1000000]"};
+  }
+  return Ok{};
+}
+
+Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& config) {
+  if (Status valid = config.validate(); !valid) return Error{valid.error()};
+  std::unique_ptr<Simulation> sim(new Simulation());
+  sim->config_ = config;
+  sim->prostate_ = generate_prostate(config.prostate_triangles);
+  TetrahedralizeOptions tet;
+  tet.capsule_thickness_m = sim->prostate_.shape.capsule_thickness_m;
+  tet.channel_axis = {{0.0, 0.0, 0.0}, {0.0, 0.0, sim->prostate_.shape.length_m}};
+  tet.max_volume_m3 = config.max_tet_volume_m3;
+  Result<TetMesh> tetra = tetrahedralize(sim->prostate_.surface, tet);
+  if (!tetra) return Error{"building the tissue model: " + tetra.error()};
+  sim->tetrahedra_ = tetra->tetrahedron_count();
+  sim->tissue_ = std::make_unique<MassSpringTissue>(*tetra, config.parameters);
+
+  const ResectoscopeModel tool = generate_resectoscope();
+  sim->sheath_part_ = sim->tissue_->tool().add_part(tool.sheath);
+  sim->loop_part_ = sim->tissue_->tool().add_part(tool.loop);
+  for (const Landmark& l : sim->prostate_.landmarks) {
+    if (l.name == "verumontanum") sim->verumontanum_z_m_ = l.position.z;
+  }
+  sim->loop_front_tool_ = loop_front_point(tool.loop);
+  const RigidTransform away = to_transform(withdrawn_pose());
+  sim->tissue_->tool().reset_pose(sim->sheath_part_, away);
+  sim->tissue_->tool().reset_pose(sim->loop_part_, away);
+  sim->poses_ = {withdrawn_pose(), withdrawn_pose()};
+  sim->metrics_.distal_margin_mm = 1e9;
+  sim->state_hash_ = sim->tissue_->state_hash();
+  return sim;
+}
+
+void Simulation::place_tool(const TickInput& input) {
+  poses_ = input.tool_present ? resecto::tool_poses(input.joints, config_.gimbal) : ToolPoses{withdrawn_pose(), withdrawn_pose()};
+  tissue_->tool().set_pose(sheath_part_, to_transform(poses_.sheath));
+  tissue_->tool().set_pose(loop_part_, to_transform(poses_.loop));
+}
+
+void Simulation::step(const TickInput& input, std::span<const ParameterCommand> commands, FrameProfiler* profiler) {
+  const std::uint64_t tick = tick_;
+  const bool collision_tick = is_collision_tick(tick);
+  {
+    RESECTO_PROFILE_STAGE(profiler, Stage::kInput, tick);
+    // Commands apply in the order they were queued: the console's order, the same on replay.
+    for (const ParameterCommand& command : commands) {
+      if (command.apply_tick <= static_cast<std::int64_t>(tick)) tissue_->apply(command);
+    }
+  }
+  {
+    RESECTO_PROFILE_STAGE(profiler, Stage::kKinematics, tick);
+    place_tool(input);
+  }
+  if (collision_tick) {
+    RESECTO_PROFILE_STAGE(profiler, Stage::kQuery, tick);
+    tissue_->collision_step();
+  }
+  {
+    RESECTO_PROFILE_STAGE(profiler, Stage::kPhysics, tick);
+    reaction_ = tissue_->physics_step(config_.tick_s());
+  }
+  {
+    RESECTO_PROFILE_STAGE(profiler, Stage::kResponse, tick);
+    update_metrics(input, collision_tick);
+    if (collision_tick) {
+      StateHasher hasher;
+      const std::uint64_t tissue_hash = tissue_->state_hash();
+      hasher.add(std::span<const std::uint64_t>(&tissue_hash, 1));
+      hasher.add(std::span<const std::uint64_t>(&tick, 1));
+      hasher.add(std::span<const RigidPose>(&poses_.sheath, 2));
+      state_hash_ = hasher.value();
+    }
+  }
+  ++tick_;
+}
+
+void Simulation::update_metrics(const TickInput& input, bool collision_tick) {
+  const double h = config_.tick_s();
+  const bool contact = tissue_->tool().stats().penetrating > 0;
+  const double force = length(reaction_.force_n);
+  const bool cutting = input.tool_present && (input.pedals & kPedalCut) != 0;
+  metrics_.peak_reaction_force_n = std::max(metrics_.peak_reaction_force_n, force);
+  if (contact) {
+    metrics_.contact_time_s = static_cast<double>(++contact_ticks_) * h;
+    contact_force_sum_n_ += force;
+    metrics_.mean_contact_force_n = contact_force_sum_n_ / static_cast<double>(contact_ticks_);
+  }
+  if (cutting) {
+    metrics_.cut_pedal_time_s += h;
+    if (contact) metrics_.cut_in_contact_time_s += h;
+  }
+  if (input.tool_present) metrics_.max_insertion_mm = std::max(metrics_.max_insertion_mm, units::m_to_mm(input.joints.insertion_m));
+  if (!collision_tick) return;
+  // The costlier measures once per collision step.
+  metrics_.max_tissue_displacement_mm = std::max(metrics_.max_tissue_displacement_mm, units::m_to_mm(tissue_->max_displacement_m()));
+  if (cutting) {
+    const double margin_m = poses_.loop.apply_point(loop_front_tool_).z - verumontanum_z_m_;
+    metrics_.distal_margin_mm = std::min(metrics_.distal_margin_mm, units::m_to_mm(margin_m));
+    if (margin_m < 0.0) ++metrics_.verumontanum_violations;
+  }
+  metrics_.non_finite_steps = static_cast<std::uint64_t>(tissue_->faults().non_finite_steps);
+  metrics_.contact_overflows = static_cast<std::uint64_t>(tissue_->faults().contact_overflows);
+}
+
+void Simulation::fill_snapshot(SimulationSnapshot& snapshot) const {
+  snapshot.tick = tick_;
+  snapshot.state_hash = state_hash_;
+  snapshot.tool = poses_;
+  snapshot.reaction = reaction_;
+  snapshot.penetrating_points = tissue_->tool().stats().penetrating;
+  const std::span<const Vec3> x = tissue_->positions();
+  // The surface's vertices are the tetrahedral mesh's first nodes (TetGen -Y keeps them in order).
+  std::copy_n(x.begin(), std::min(snapshot.surface_positions.size(), x.size()), snapshot.surface_positions.begin());
+  snapshot.metrics = metrics_;
+}
+
+SimulationSnapshot Simulation::make_snapshot() const {
+  SimulationSnapshot snapshot;
+  snapshot.surface_positions.resize(prostate_.surface.vertex_count());
+  fill_snapshot(snapshot);
+  return snapshot;
+}
+
+std::array<double, kStageCount> default_stage_budgets_us(const SimulationConfig& config) {
+  const double tick_us = config.tick_s() * 1e6;
+  std::array<double, kStageCount> budgets{};
+  // Shares of one tick: physics every tick, the collision query every 16th; the rest is small.
+  budgets[static_cast<int>(Stage::kInput)] = 0.05 * tick_us;
+  budgets[static_cast<int>(Stage::kKinematics)] = 0.02 * tick_us;
+  budgets[static_cast<int>(Stage::kPhysics)] = 0.40 * tick_us;
+  budgets[static_cast<int>(Stage::kRefit)] = 0.15 * tick_us;
+  budgets[static_cast<int>(Stage::kQuery)] = 0.35 * tick_us;
+  budgets[static_cast<int>(Stage::kResponse)] = 0.05 * tick_us;
+  budgets[static_cast<int>(Stage::kPublish)] = 0.05 * tick_us;
+  budgets[static_cast<int>(Stage::kTick)] = tick_us;
+  return budgets;
+}
+
+}  // namespace resecto

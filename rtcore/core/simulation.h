@@ -1,0 +1,119 @@
+// Simulation: the deterministic core, state(k+1) = step(state(k), input(k), commands(k)). Ticks are
+// physics steps (960 Hz by default); every `physics_per_collision` ticks a collision step refits the
+// tissue's sphere tree and finds the tool's contact candidates (60 Hz), and the state hash is taken.
+// Wall-clock time never enters: the profiler only watches.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "device/kinematics/tool_kinematics.h"
+#include "rtcore/anatomy/prostate.h"
+#include "rtcore/anatomy/resectoscope.h"
+#include "rtcore/base/result.h"
+#include "rtcore/core/profiler.h"
+#include "rtcore/tissue/mass_spring.h"
+#include "rtcore/tissue/tissue_parameters.h"
+
+namespace resecto {
+
+/// What a simulation is built from; fixed for its lifetime.
+struct SimulationConfig {
+  int prostate_triangles = 8640;
+  int collision_hz = 60;
+  int physics_per_collision = 16;  ///< physics ticks per collision step: 16 gives 960 Hz
+  TissueParameters parameters;     ///< initial values; later changes come as commands
+  GimbalGeometry gimbal;
+  double max_tet_volume_m3 = 0.0;  ///< TetGen -a bound for the tissue model; 0 = unbounded
+
+  double tick_s() const { return 1.0 / (static_cast<double>(collision_hz) * physics_per_collision); }
+  /// The tick rates as a user would write them, or an error naming the bad value.
+  Status validate() const;
+};
+
+/// The input latched for one tick.
+struct TickInput {
+  DeviceJoints joints;
+  std::uint8_t pedals = 0;       ///< kPedalCut | kPedalCoagulate
+  bool tool_present = false;     ///< false until the device has reported (the tool stays withdrawn)
+};
+
+/// A trainee's procedure in numbers, accumulated every tick.
+struct ProcedureMetrics {
+  double contact_time_s = 0.0;             ///< time any tool part pressed into tissue
+  double cut_pedal_time_s = 0.0;
+  double cut_in_contact_time_s = 0.0;      ///< pedal down while the loop pressed tissue
+  double peak_reaction_force_n = 0.0;      ///< largest force of the tissue on the tool
+  double mean_contact_force_n = 0.0;       ///< over the ticks in contact
+  double max_tissue_displacement_mm = 0.0;
+  double max_insertion_mm = 0.0;           ///< deepest the sheath tip went past the pivot
+  double distal_margin_mm = 0.0;           ///< least loop-to-verumontanum distance (along z) while cutting; + is proximal (safe)
+  std::uint64_t verumontanum_violations = 0;  ///< collision steps cutting distal to the verumontanum
+  std::uint64_t non_finite_steps = 0;
+  std::uint64_t contact_overflows = 0;
+};
+
+/// What the core publishes for the console and recorder (taken at collision steps).
+struct SimulationSnapshot {
+  std::uint64_t tick = 0;
+  std::uint64_t state_hash = 0;
+  ToolPoses tool;
+  ToolReaction reaction;
+  std::int32_t penetrating_points = 0;
+  std::vector<Vec3> surface_positions;  ///< the tissue surface's vertices (sized once)
+  ProcedureMetrics metrics;
+};
+
+class Simulation {
+ public:
+  /// Builds the gland, its tetrahedral model, the tissue and the tool. Allocates everything here.
+  static Result<std::unique_ptr<Simulation>> create(const SimulationConfig& config);
+
+  /// Runs tick `tick()`: applies the commands stamped for it, places the tool, steps the tissue, and
+  /// on collision ticks refits, queries and hashes. Allocates nothing, locks nothing, does no I/O.
+  void step(const TickInput& input, std::span<const ParameterCommand> commands, FrameProfiler* profiler = nullptr);
+
+  std::uint64_t tick() const { return tick_; }
+  bool is_collision_tick(std::uint64_t tick) const { return tick % static_cast<std::uint64_t>(config_.physics_per_collision) == 0; }
+  /// The hash taken at the last collision step.
+  std::uint64_t state_hash() const { return state_hash_; }
+  const ProcedureMetrics& metrics() const { return metrics_; }
+  const MassSpringTissue& tissue() const { return *tissue_; }
+  const ProstateModel& prostate() const { return prostate_; }
+  const SimulationConfig& config() const { return config_; }
+  const ToolPoses& tool_poses() const { return poses_; }
+  const ToolReaction& reaction() const { return reaction_; }
+  std::size_t tetrahedron_count() const { return tetrahedra_; }
+
+  /// Copies the publishable state into `snapshot` (whose surface array is sized by make_snapshot()).
+  void fill_snapshot(SimulationSnapshot& snapshot) const;
+  SimulationSnapshot make_snapshot() const;
+
+ private:
+  Simulation() = default;
+  void place_tool(const TickInput& input);
+  void update_metrics(const TickInput& input, bool collision_tick);
+
+  SimulationConfig config_;
+  ProstateModel prostate_;
+  std::unique_ptr<MassSpringTissue> tissue_;
+  int sheath_part_ = 0;
+  int loop_part_ = 0;
+  std::size_t tetrahedra_ = 0;
+  double verumontanum_z_m_ = 0.0;
+  Vec3 loop_front_tool_{0.0};  ///< the loop wire's front, tool frame
+  ToolPoses poses_;
+  ToolReaction reaction_;
+  std::uint64_t tick_ = 0;
+  std::uint64_t state_hash_ = 0;
+  std::uint64_t contact_ticks_ = 0;
+  double contact_force_sum_n_ = 0.0;
+  ProcedureMetrics metrics_;
+};
+
+/// The stages' budgets at a tick rate, microseconds (the tick's time split among its stages).
+std::array<double, kStageCount> default_stage_budgets_us(const SimulationConfig& config);
+
+}  // namespace resecto
