@@ -11,16 +11,18 @@ int64_t lp3500_divide_rounded(int64_t numerator, int64_t denominator) {
 int32_t lp3500_sheath_um(const lp3500_calibration* c, uint32_t code_sum, uint16_t sample_count, uint8_t* clamped) {
   /* |gain| <= 500 000 nm/count, code_sum <= 65535 * 4095: the product stays below 2^47. */
   const int64_t nm = (int64_t)c->sheath_gain_nm_per_count * (int64_t)code_sum;
-  int32_t um = (int32_t)(lp3500_divide_rounded(nm, (int64_t)sample_count * 1000) + c->sheath_offset_um);
+  /* Clamped in 64 bits: an extreme offset cannot wrap before the range check. */
+  const int64_t um = lp3500_divide_rounded(nm, (int64_t)sample_count * 1000) + c->sheath_offset_um;
   *clamped = 0;
   if (um < c->sheath_min_um) {
-    um = c->sheath_min_um;
     *clamped = 1;
-  } else if (um > c->sheath_max_um) {
-    um = c->sheath_max_um;
-    *clamped = 1;
+    return c->sheath_min_um;
   }
-  return um;
+  if (um > c->sheath_max_um) {
+    *clamped = 1;
+    return c->sheath_max_um;
+  }
+  return (int32_t)um;
 }
 
 int32_t lp3500_loop_um(const lp3500_calibration* c, uint32_t hall_sum_total, uint16_t sample_count,
