@@ -97,12 +97,10 @@ void Simulation::place_tool(const TickInput& input) {
 void Simulation::step(const TickInput& input, std::span<const ParameterCommand> commands, FrameProfiler* profiler) {
   const std::uint64_t tick = tick_;
   const bool collision_tick = is_collision_tick(tick);
-  {
-    RESECTO_PROFILE_STAGE(profiler, Stage::kInput, tick);
-    // Commands apply in the order they were queued: the console's order, the same on replay.
-    for (const ParameterCommand& command : commands) {
-      if (command.apply_tick <= static_cast<std::int64_t>(tick)) tissue_->apply(command);
-    }
+  // Commands apply in the order they were queued: the console's order, the same on replay. (The
+  // caller times latching the input and these together as the input stage.)
+  for (const ParameterCommand& command : commands) {
+    if (command.apply_tick <= static_cast<std::int64_t>(tick)) tissue_->apply(command);
   }
   {
     RESECTO_PROFILE_STAGE(profiler, Stage::kKinematics, tick);

@@ -1,0 +1,84 @@
+// `resecto run`: the simulator. `--headless` drives the core through the emulated device with a
+// scripted procedure and writes the JSON report of DESIGN.md's contract.
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "console/commands/command_registry.h"
+#include "console/commands/parameter_options.h"
+#include "console/headless/headless_run.h"
+
+namespace resecto::cli {
+namespace {
+
+struct RunOptions {
+  bool headless = false;
+  std::string procedure = "demo";
+  double seconds = 0.0;
+  bool realtime = false;
+  std::string report;
+  std::string trace;
+  std::vector<std::string> sets;
+  int triangles = 8640;
+  int collision_hz = 60;
+  int substeps = 16;
+  std::uint64_t seed = 1;
+  bool json = false;
+};
+
+void run(const RunOptions& o) {
+  if (!o.headless) {
+    throw std::runtime_error("the operator console is not built yet; run with --headless");
+  }
+  HeadlessOptions options;
+  Result<Procedure> procedure = find_procedure(o.procedure);
+  if (!procedure) throw std::runtime_error(procedure.error());
+  options.procedure = std::move(*procedure);
+  options.seconds = o.seconds;
+  options.realtime = o.realtime;
+  options.trace_path = o.trace;
+  options.seed = o.seed;
+  options.simulation.prostate_triangles = o.triangles;
+  options.simulation.collision_hz = o.collision_hz;
+  options.simulation.physics_per_collision = o.substeps;
+  options.simulation.parameters = parameters_from_assignments(o.sets);
+
+  Result<HeadlessResult> result = run_headless(options);
+  if (!result) throw std::runtime_error(result.error());
+  if (!o.report.empty()) {
+    std::ofstream out(o.report, std::ios::binary);
+    out << result->report.dump(2) << "\n";
+    if (!out.flush()) throw std::runtime_error(o.report + ": cannot write the report");
+  }
+  if (o.json) {
+    std::printf("%s\n", result->report.dump(2).c_str());
+  } else {
+    std::fputs(summarize_report(result->report).c_str(), stdout);
+  }
+}
+
+void register_run(CLI::App& app) {
+  auto o = std::make_shared<RunOptions>();
+  CLI::App* cmd = app.add_subcommand("run", "Run the simulator (headless: a scripted procedure through the emulated device)");
+  cmd->add_flag("--headless", o->headless, "No display: drive the core with a procedure and report");
+  cmd->add_option("--procedure", o->procedure, "Built-in procedure (demo) or a procedure file")->capture_default_str();
+  cmd->add_option("--seconds", o->seconds, "Simulated seconds (default: the procedure's length)")->check(CLI::Range(0.0, 86400.0));
+  cmd->add_flag("--realtime", o->realtime, "Real time: the device link on its own thread, ticks at their deadlines");
+  cmd->add_option("--report", o->report, "Write the JSON report here");
+  cmd->add_option("--trace", o->trace, "Write a Chrome trace-event JSON (opens in Perfetto)");
+  add_parameter_option(*cmd, o->sets);
+  cmd->add_option("--triangles", o->triangles, "Prostate surface triangles")->check(CLI::Range(200, 1000000))->capture_default_str();
+  cmd->add_option("--collision-hz", o->collision_hz, "Collision steps per second")->check(CLI::Range(10, 1000))->capture_default_str();
+  cmd->add_option("--substeps", o->substeps, "Physics steps per collision step")->check(CLI::Range(1, 64))->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Seed of the emulated sensors' noise")->capture_default_str();
+  cmd->add_flag("--json", o->json, "Print the JSON report instead of the summary");
+  cmd->callback([o] { run(*o); });
+}
+
+const RegisterCommand kRegister{"run", &register_run};
+
+}  // namespace
+}  // namespace resecto::cli

@@ -1,0 +1,272 @@
+// The headless run: device -> core -> snapshots, batch or real time, and its report.
+#include "console/headless/headless_run.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <thread>
+
+#include "console/headless/lockstep_device.h"
+#include "device/calibration/calibration.h"
+#include "device/link/calibration_adapter.h"
+#include "device/link/device_link.h"
+#include "device/link/tool_input.h"
+#include "device/transport/emulator_transport.h"
+#include "device/transport/host_clock.h"
+#include "rtcore/concurrency/spsc_ring.h"
+#include "rtcore/concurrency/triple_buffer.h"
+#include "rtcore/core/fixed_step_scheduler.h"
+#include "rtcore/tissue/state_hash.h"
+
+namespace resecto {
+namespace {
+
+using nlohmann::ordered_json;
+
+/// Takes the core's snapshots on its own thread, as the console will; optionally slow on purpose.
+class SnapshotConsumer {
+ public:
+  SnapshotConsumer(TripleBuffer<SimulationSnapshot>& snapshots, double delay_ms)
+      : snapshots_(snapshots), delay_ms_(delay_ms), thread_([this] { run(); }) {}
+  ~SnapshotConsumer() { stop(); }
+  void stop() {
+    running_.store(false, std::memory_order_release);
+    if (thread_.joinable()) thread_.join();
+  }
+  std::uint64_t received() const { return received_.load(std::memory_order_acquire); }
+  std::uint64_t last_tick() const { return last_tick_.load(std::memory_order_acquire); }
+
+ private:
+  void run() {
+    while (running_.load(std::memory_order_acquire)) {
+      if (snapshots_.update()) {
+        received_.fetch_add(1, std::memory_order_acq_rel);
+        last_tick_.store(snapshots_.read_slot().tick, std::memory_order_release);
+        if (delay_ms_ > 0) std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(delay_ms_));
+      } else {
+        std::this_thread::sleep_for(std::chrono::microseconds(500));
+      }
+    }
+  }
+
+  TripleBuffer<SimulationSnapshot>& snapshots_;
+  double delay_ms_;
+  std::atomic<bool> running_{true};
+  std::atomic<std::uint64_t> received_{0};
+  std::atomic<std::uint64_t> last_tick_{0};
+  std::thread thread_;
+};
+
+/// The real-time device: the emulated board behind the host link's own thread and transport.
+struct LiveDevice {
+  LiveDevice(const Procedure& procedure, const device::Calibration& calibration, std::uint64_t seed)
+      : emulator([&] {
+          firmware::EmulatorOptions options;
+          options.seed = seed;
+          return options;
+        }()),
+        transport(emulator, clock),
+        link(transport, clock, [&] {
+          LinkConfig config;
+          config.calibration = joint_calibration_from(calibration);
+          return config;
+        }()) {
+    emulator.set_motion(motion_script_for(procedure));  // before the link thread first opens the board
+  }
+  firmware::Emulator emulator;
+  SteadyHostClock clock;
+  EmulatorTransport transport;
+  DeviceLink link;
+};
+
+ordered_json stage_json(const StageStatistics& s) {
+  return {{"median_us", s.median_us}, {"p95_us", s.p95_us}, {"p99_us", s.p99_us}, {"max_us", s.max_us},
+          {"budget_us", s.budget_us}, {"samples", s.samples}, {"over_budget", s.over_budget}};
+}
+
+ordered_json metrics_json(const ProcedureMetrics& m) {
+  return {{"contact_time_s", m.contact_time_s},
+          {"cut_pedal_time_s", m.cut_pedal_time_s},
+          {"cut_in_contact_time_s", m.cut_in_contact_time_s},
+          {"peak_reaction_force_n", m.peak_reaction_force_n},
+          {"mean_contact_force_n", m.mean_contact_force_n},
+          {"max_tissue_displacement_mm", m.max_tissue_displacement_mm},
+          {"max_insertion_mm", m.max_insertion_mm},
+          {"distal_margin_mm", m.distal_margin_mm > 1e8 ? ordered_json(nullptr) : ordered_json(m.distal_margin_mm)},
+          {"verumontanum_violations", m.verumontanum_violations},
+          {"non_finite_steps", m.non_finite_steps},
+          {"contact_overflows", m.contact_overflows}};
+}
+
+}  // namespace
+
+std::string hex_hash(std::uint64_t hash) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
+  return text;
+}
+
+Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
+  Result<std::unique_ptr<Simulation>> created = Simulation::create(options.simulation);
+  if (!created) return Error{created.error()};
+  Simulation& sim = **created;
+  const SimulationConfig& config = sim.config();
+  const double seconds = options.seconds > 0.0 ? options.seconds : options.procedure.duration_s();
+  const double tick_s = config.tick_s();
+  const auto ticks = static_cast<std::uint64_t>(std::llround(seconds / tick_s));
+  const auto period_ns = static_cast<std::int64_t>(std::llround(tick_s * 1e9));
+
+  FrameProfiler profiler(default_stage_budgets_us(config), std::min<std::uint64_t>(ticks * 6 + 64, 1u << 22));
+  SchedulerConfig schedule;
+  schedule.period_ns = period_ns;
+  schedule.realtime = options.realtime;
+  FixedStepScheduler scheduler(schedule);
+
+  const device::Calibration calibration = device::default_calibration();
+  SpscRing<DeviceSample> samples(4096);
+  ToolInput tool_input;
+  std::unique_ptr<LockstepDevice> lockstep;
+  std::unique_ptr<LiveDevice> live;
+  if (options.realtime) {
+    live = std::make_unique<LiveDevice>(options.procedure, calibration, options.seed);
+    live->link.start();
+  } else {
+    lockstep = std::make_unique<LockstepDevice>(options.procedure, calibration, options.seed);
+  }
+
+  TripleBuffer<SimulationSnapshot> snapshots(sim.make_snapshot());
+  SnapshotConsumer consumer(snapshots, options.consumer_delay_ms);
+
+  HeadlessResult result;
+  result.collision_hashes.reserve(ticks / static_cast<std::uint64_t>(config.physics_per_collision) + 2);
+  TimingHistogram input_to_snapshot_us;
+  std::int64_t newest_sample_host_ns = 0;   // host receipt of the newest sample latched
+  std::int64_t published_sample_host_ns = 0;
+
+  const auto wall_start = std::chrono::steady_clock::now();
+  scheduler.run(0, ticks, [&](std::uint64_t tick) {
+    const std::int64_t tick_begin_ns = FrameProfiler::now_ns();
+    TickInput input;
+    {
+      RESECTO_PROFILE_STAGE(&profiler, Stage::kInput, tick);
+      if (lockstep) {
+        lockstep->advance_to(static_cast<std::uint64_t>(tick) * static_cast<std::uint64_t>(period_ns) / 1000, samples);
+      } else {
+        // Relay the link's ring into the core's, noting when the newest sample reached the host.
+        DeviceSample sample;
+        while (live->link.samples().try_pop(sample)) {
+          if (sample.event == LinkEvent::kSample) newest_sample_host_ns = std::max(newest_sample_host_ns, sample.host_time_ns);
+          samples.try_push(sample);
+        }
+      }
+      tool_input.latch(samples, tick_s);
+      input.joints = tool_input.joints();
+      input.pedals = tool_input.pedals();
+      input.tool_present = tool_input.state() != ToolInputState::kNoDevice;
+    }
+    sim.step(input, {}, &profiler);
+    if (sim.is_collision_tick(tick)) {
+      result.collision_hashes.push_back(sim.state_hash());
+      RESECTO_PROFILE_STAGE(&profiler, Stage::kPublish, tick);
+      sim.fill_snapshot(snapshots.write_slot());
+      snapshots.publish();
+      if (live && newest_sample_host_ns > published_sample_host_ns) {
+        input_to_snapshot_us.add(static_cast<double>(FrameProfiler::now_ns() - newest_sample_host_ns) * 1e-3);
+        published_sample_host_ns = newest_sample_host_ns;
+      }
+    }
+    profiler.record(Stage::kTick, tick, tick_begin_ns, FrameProfiler::now_ns());
+    return true;
+  });
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  consumer.stop();
+  if (live) live->link.stop();
+
+  result.ticks = sim.tick();
+  result.final_hash = sim.state_hash();
+  StateHasher chain;
+  chain.add(std::span<const std::uint64_t>(result.collision_hashes));
+
+  ordered_json& r = result.report;
+  r["ticks"] = result.ticks;
+  r["state_hash"] = hex_hash(result.final_hash);
+  r["hash_chain"] = hex_hash(chain.value());
+  r["collision_steps"] = result.collision_hashes.size();
+  r["mode"] = options.realtime ? "realtime" : "batch";
+  r["procedure"] = options.procedure.name;
+  r["simulated_s"] = static_cast<double>(result.ticks) * tick_s;
+  r["wall_s"] = wall_s;
+  r["rates_hz"] = {{"physics", 1.0 / tick_s}, {"collision", config.collision_hz}};
+  r["model"] = {{"surface_triangles", sim.prostate().surface.triangle_count()},
+                {"tetrahedra", sim.tetrahedron_count()},
+                {"nodes", sim.tissue().node_count()}};
+  ordered_json stages = ordered_json::object();
+  for (Stage stage : {Stage::kInput, Stage::kKinematics, Stage::kPhysics, Stage::kQuery, Stage::kResponse, Stage::kPublish, Stage::kTick}) {
+    stages[stage_name(stage)] = stage_json(profiler.statistics(stage));
+  }
+  r["stages"] = stages;
+  const DeadlineReport& deadlines = scheduler.report();
+  r["deadline_misses"] = deadlines.misses;
+  r["deadlines"] = {{"ticks", deadlines.ticks},
+                    {"misses", deadlines.misses},
+                    {"miss_fraction", deadlines.ticks ? static_cast<double>(deadlines.misses) / static_cast<double>(deadlines.ticks) : 0.0},
+                    {"max_late_us", deadlines.max_late_us},
+                    {"p99_late_us", deadlines.late_us.quantile(0.99)},
+                    {"resynchronizations", deadlines.resynchronizations}};
+  if (lockstep) {
+    const LockstepCounters& c = lockstep->counters();
+    r["device"] = {{"transport", "emulator (lockstep)"}, {"reports", c.reports}, {"accepted", c.accepted}, {"lost", c.lost},
+                   {"duplicates", c.duplicates}, {"rejected", c.rejected},
+                   {"rate_hz", r["simulated_s"].get<double>() > 0 ? static_cast<double>(c.accepted) / r["simulated_s"].get<double>() : 0.0}};
+  } else {
+    const LinkCounters c = live->link.counters();
+    r["device"] = {{"transport", "emulator (link thread)"}, {"reports", c.reports}, {"accepted", c.accepted}, {"lost", c.lost},
+                   {"duplicates", c.duplicates}, {"rejected", c.rejected}, {"rate_hz", c.rate_hz},
+                   {"latency_us", {{"median", c.latency_median_us}, {"p99", c.latency_p99_us}}}};
+    r["input_to_snapshot_us"] = {{"median", input_to_snapshot_us.quantile(0.5)}, {"p99", input_to_snapshot_us.quantile(0.99)},
+                                 {"max", input_to_snapshot_us.max()}};
+  }
+  r["snapshots"] = {{"published", result.collision_hashes.size()}, {"received", consumer.received()}};
+  r["metrics"] = metrics_json(sim.metrics());
+  if (profiler.trace_dropped() > 0) r["trace_dropped_events"] = profiler.trace_dropped();
+
+  if (!options.trace_path.empty()) {
+    if (Status written = profiler.write_chrome_trace(options.trace_path); !written) return Error{written.error()};
+  }
+  return result;
+}
+
+std::string summarize_report(const ordered_json& r) {
+  char text[2048];
+  const auto& m = r.at("metrics");
+  const auto& physics = r.at("stages").at("physics");
+  const auto& query = r.at("stages").at("query");
+  const auto& tick = r.at("stages").at("tick");
+  std::snprintf(text, sizeof text,
+                "%s run of '%s': %llu ticks (%.2f s simulated in %.2f s), final state hash %s\n"
+                "  model      %llu surface triangles, %llu tetrahedra\n"
+                "  physics    median %.0f us, p99 %.0f us (budget %.0f us)\n"
+                "  collision  median %.0f us, p99 %.0f us (budget %.0f us)\n"
+                "  tick       median %.0f us, p99 %.0f us, max %.0f us; deadline misses %llu\n"
+                "  device     %llu reports, %llu lost, %.0f Hz\n"
+                "  procedure  contact %.2f s, peak force %.2f N, cut pedal %.2f s (%.2f s in contact), tissue moved up to %.2f mm\n",
+                r.at("mode").get<std::string>().c_str(), r.at("procedure").get<std::string>().c_str(),
+                static_cast<unsigned long long>(r.at("ticks").get<std::uint64_t>()), r.at("simulated_s").get<double>(),
+                r.at("wall_s").get<double>(), r.at("state_hash").get<std::string>().c_str(),
+                static_cast<unsigned long long>(r.at("model").at("surface_triangles").get<std::uint64_t>()),
+                static_cast<unsigned long long>(r.at("model").at("tetrahedra").get<std::uint64_t>()), physics.at("median_us").get<double>(),
+                physics.at("p99_us").get<double>(), physics.at("budget_us").get<double>(), query.at("median_us").get<double>(),
+                query.at("p99_us").get<double>(), query.at("budget_us").get<double>(), tick.at("median_us").get<double>(),
+                tick.at("p99_us").get<double>(), tick.at("max_us").get<double>(),
+                static_cast<unsigned long long>(r.at("deadline_misses").get<std::uint64_t>()),
+                static_cast<unsigned long long>(r.at("device").at("reports").get<std::uint64_t>()),
+                static_cast<unsigned long long>(r.at("device").at("lost").get<std::uint64_t>()), r.at("device").at("rate_hz").get<double>(),
+                m.at("contact_time_s").get<double>(), m.at("peak_reaction_force_n").get<double>(), m.at("cut_pedal_time_s").get<double>(),
+                m.at("cut_in_contact_time_s").get<double>(), m.at("max_tissue_displacement_mm").get<double>());
+  return text;
+}
+
+}  // namespace resecto

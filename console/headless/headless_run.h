@@ -1,0 +1,46 @@
+// The headless runner behind `resecto run --headless`: the emulated device drives the core through a
+// procedure, in batch mode (deterministic, as fast as possible, the emulator in lockstep) or real
+// time (the device link on its own thread, absolute tick deadlines), while a consumer thread takes the
+// core's snapshots through the triple buffer. Ends with the report DESIGN.md's contract describes.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "rtcore/base/result.h"
+#include "rtcore/core/simulation.h"
+#include "rtcore/scenes/procedure.h"
+
+namespace resecto {
+
+struct HeadlessOptions {
+  Procedure procedure;
+  double seconds = 0.0;          ///< 0: the procedure's length
+  bool realtime = false;
+  SimulationConfig simulation;
+  std::uint64_t seed = 1;        ///< the emulator's sensor noise
+  std::string trace_path;        ///< empty: no trace
+  double consumer_delay_ms = 0;  ///< makes the snapshot consumer slow on purpose (tests)
+};
+
+/// Everything a run produced.
+struct HeadlessResult {
+  std::uint64_t ticks = 0;
+  std::uint64_t final_hash = 0;
+  std::vector<std::uint64_t> collision_hashes;  ///< the state hash at every collision step
+  nlohmann::ordered_json report;
+};
+
+/// Runs the procedure; an error only for a setup failure (a bad model or an unwritable trace).
+Result<HeadlessResult> run_headless(const HeadlessOptions& options);
+
+/// A few lines a person reads at the end of a run.
+std::string summarize_report(const nlohmann::ordered_json& report);
+
+/// 16 lower-case hex digits.
+std::string hex_hash(std::uint64_t hash);
+
+}  // namespace resecto
