@@ -1,6 +1,7 @@
 // `resecto device list` and `resecto device monitor`: the HID devices that match, and the live link
 // (from the LP3500 or the in-process emulator, optionally through injected faults) with its
 // statistics; `--json` ends with one summary object. `device calibrate` lives in its own file.
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -206,6 +207,23 @@ void run_monitor(const MonitorOptions& o) {
   faults.seed = o.seed;
   FaultInjectingTransport faulty(*transport, clock, faults);
 
+  // The board's identity, read once before the link thread takes the transport over.
+  nlohmann::json identity = nullptr;
+  if (Status opened = faulty.open(); opened) {
+    std::array<std::uint8_t, LP3500_IDENTITY_REPORT_SIZE> bytes{};
+    auto got = faulty.get_feature_report(LP3500_REPORT_ID_IDENTITY, bytes);
+    lp3500_identity id{};
+    if (got && lp3500_unpack_identity(bytes.data(), *got, &id) == LP3500_OK) {
+      identity = {{"name", std::string(id.name)},
+                  {"firmware", std::to_string(id.firmware_major) + "." + std::to_string(id.firmware_minor) + "." +
+                                   std::to_string(id.firmware_patch)},
+                  {"serial_number", id.serial_number},
+                  {"report_rate_hz", id.report_rate_hz},
+                  {"calibration_written", id.calibration_written != 0}};
+    }
+    faulty.close();
+  }
+
   std::optional<RawReportWriter> recorder;
   if (!o.record.empty()) {
     auto created = RawReportWriter::create(o.record);
@@ -226,7 +244,10 @@ void run_monitor(const MonitorOptions& o) {
   std::int64_t last_tick_ns = start_ns;
   std::int64_t next_print_ns = start_ns + 250 * kNanosecondsPerMillisecond;
   link.start();
-  if (!o.json) std::printf("monitoring %s for %.1f s\n", faulty.describe().c_str(), o.seconds);
+  if (!o.json) {
+    std::printf("monitoring %s for %.1f s\n", faulty.describe().c_str(), o.seconds);
+    if (!identity.is_null()) std::printf("board: %s\n", identity.dump().c_str());
+  }
   for (;;) {
     const std::int64_t now_ns = clock.now_ns();
     if (now_ns >= end_ns) break;
@@ -255,7 +276,8 @@ void run_monitor(const MonitorOptions& o) {
   const LinkCounters c = link.counters();
   const double seconds = static_cast<double>(clock.now_ns() - start_ns) * 1e-9;
   if (c.connects == 0) fail("the device never connected: " + link.last_error());
-  const nlohmann::json summary = summary_json(o, c, faulty.injected(), faulty.describe(), seconds);
+  nlohmann::json summary = summary_json(o, c, faulty.injected(), faulty.describe(), seconds);
+  summary["identity"] = identity;
   if (o.json) {
     std::printf("%s\n", summary.dump(2).c_str());
   } else {

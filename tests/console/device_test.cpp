@@ -51,6 +51,9 @@ TEST(DeviceCommand, MonitorOnTheEmulatorEndsWithAJsonSummary) {
   EXPECT_EQ(j["rejected"].get<int>(), 0);
   EXPECT_GT(j["rate_hz"].get<double>(), 500.0);
   EXPECT_LE(j["latency_us"]["median"].get<double>(), j["latency_us"]["p99"].get<double>());
+  // The identity feature report was read through the same transport.
+  ASSERT_TRUE(j["identity"].is_object()) << j.dump();
+  EXPECT_EQ(j["identity"]["report_rate_hz"].get<int>(), 1000);
 }
 
 TEST(DeviceCommand, MonitorCountsTheFaultsItInjects) {
