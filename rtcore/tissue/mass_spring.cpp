@@ -1,0 +1,271 @@
+// The mass-spring tissue: material from the live parameters, forces, the three integrators, faults.
+// Loops over springs run in spring index order and loops over nodes in node index order, so every
+// sum is formed in the same order on every run (determinism).
+#include "rtcore/tissue/mass_spring.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rtcore/tissue/state_hash.h"
+
+namespace resecto {
+
+MassSpringTissue::MassSpringTissue(const TetMesh& mesh, const TissueParameters& parameters, const TissueConfig& config)
+    : parameters_(parameters),
+      config_(config),
+      network_(build_spring_network(mesh)),
+      tetrahedra_(mesh.tetrahedra),
+      tool_(config.contact_margin_m, config.contact_capacity) {
+  const std::size_t n = mesh.node_count();
+  const std::size_t s = network_.spring_count();
+  x_ = mesh.positions;
+  rest_ = mesh.positions;
+  v_.assign(n, Vec3(0.0));
+  force_.assign(n, Vec3(0.0));
+  mass_.assign(n, 0.0);
+  stiffness_bound_.assign(n, 0.0);
+  damping_bound_.assign(n, 0.0);
+  spring_k_.assign(s, 0.0);
+  spring_c_.assign(s, 0.0);
+  anchor_k_.assign(network_.anchor_nodes.size(), 0.0);
+  if (config_.integrator == TissueIntegrator::kImplicitEuler) {
+    spring_direction_.assign(s, Vec3(0.0));
+    spring_transverse_k_.assign(s, 0.0);
+    for (auto* vec : {&cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_dv_}) vec->assign(n, Vec3(0.0));
+  }
+  surface_ = boundary_surface(mesh);
+  surface_tree_.build(surface_);
+  update_material();
+}
+
+void MassSpringTissue::update_material() {
+  const double modulus = parameters_.si(TissueParameter::kStiffness);
+  const double viscosity = parameters_.si(TissueParameter::kSpringDamping);
+  const double density = parameters_.si(TissueParameter::kDensity);
+  const double anchor = parameters_.si(TissueParameter::kAnchorStiffness);
+  for (std::size_t i = 0; i < spring_k_.size(); ++i) {
+    spring_k_[i] = edge_spring_constant(modulus, network_.volume_share_m3[i], network_.rest_length_m[i]);
+    spring_c_[i] = edge_spring_constant(viscosity, network_.volume_share_m3[i], network_.rest_length_m[i]);
+  }
+  for (std::size_t i = 0; i < mass_.size(); ++i) mass_[i] = density * network_.node_volume_m3[i];
+  for (std::size_t a = 0; a < anchor_k_.size(); ++a) anchor_k_[a] = anchor * network_.anchor_area_m2[a];
+}
+
+void MassSpringTissue::apply(const ParameterCommand& command) {
+  parameters_.values[static_cast<std::size_t>(command.id)] = command.value;
+  update_material();
+}
+
+void MassSpringTissue::set_parameters(const TissueParameters& parameters) {
+  parameters_ = parameters;
+  update_material();
+}
+
+void MassSpringTissue::collision_step() {
+  // The surface shares the tetrahedral mesh's node indices; its positions are the nodes'.
+  std::copy(x_.begin(), x_.end(), surface_.positions.begin());
+  surface_tree_.refit(surface_);
+  tool_.update_candidates(surface_tree_, surface_);
+  if (tool_.stats().overflowed) ++faults_.contact_overflows;
+}
+
+void MassSpringTissue::accumulate_forces(double h_s) {
+  const double viscous_rate = parameters_.si(TissueParameter::kViscousDamping);
+  const std::size_t n = x_.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    force_[i] = -viscous_rate * mass_[i] * v_[i];
+    stiffness_bound_[i] = 0.0;
+    damping_bound_[i] = viscous_rate * mass_[i];
+  }
+  const std::uint32_t* pairs = network_.spring_nodes.data();
+  const double* rest = network_.rest_length_m.data();
+  const bool linearise = config_.integrator == TissueIntegrator::kImplicitEuler;
+  for (std::size_t s = 0; s < spring_k_.size(); ++s) {
+    const std::uint32_t i = pairs[2 * s], j = pairs[2 * s + 1];
+    const Vec3 d = x_[j] - x_[i];
+    const double length = glm::length(d);
+    const Vec3 u = length > 0.0 ? d / length : Vec3(0.0);
+    const double stretch = length - rest[s];
+    const double k = spring_k_[s], c = spring_c_[s];
+    const Vec3 f = (k * stretch + c * glm::dot(v_[j] - v_[i], u)) * u;
+    force_[i] += f;
+    force_[j] -= f;
+    // The spring's Hessian blocks have norm k * max(1, |1 - L0/L|); each row holds two of them.
+    const double geometric = length > 0.0 ? std::abs(stretch) / length : 1.0;
+    const double row_k = 2.0 * k * std::max(1.0, geometric);
+    stiffness_bound_[i] += row_k;
+    stiffness_bound_[j] += row_k;
+    damping_bound_[i] += 2.0 * c;
+    damping_bound_[j] += 2.0 * c;
+    if (linearise) {
+      spring_direction_[s] = u;
+      spring_transverse_k_[s] = length > 0.0 ? k * std::max(0.0, stretch / length) : 0.0;  // tension only: keeps K >= 0
+    }
+  }
+  for (std::size_t a = 0; a < anchor_k_.size(); ++a) {
+    const std::uint32_t i = network_.anchor_nodes[a];
+    force_[i] -= anchor_k_[a] * (x_[i] - rest_[i]);
+    stiffness_bound_[i] += anchor_k_[a];
+  }
+  reaction_ = tool_.add_forces(x_, v_, surface_.triangles, parameters_.si(TissueParameter::kPenaltyStiffness),
+                               parameters_.si(TissueParameter::kPenaltyDamping), h_s, force_, stiffness_bound_, damping_bound_);
+}
+
+void MassSpringTissue::step_bounded_symplectic(double h_s) {
+  accumulate_forces(h_s);
+  // Gershgorin: every eigenvalue of D^-1 K is below max R_K / D and of D^-1 C below max R_C / D, so
+  // with D = m + h^2 R_K / 2 + h R_C the step has h^2 lambda < 2 and h mu < 1, inside symplectic
+  // Euler's region (h^2 lambda + 2 h mu < 4) for any stiffness, damping or resolution.
+  const std::size_t n = x_.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = mass_[i] + 0.5 * h_s * h_s * stiffness_bound_[i] + h_s * damping_bound_[i];
+    v_[i] += (h_s / d) * force_[i];
+    x_[i] += h_s * v_[i];
+  }
+  last_substeps_ = 1;
+}
+
+void MassSpringTissue::step_substepped_symplectic(double h_s) {
+  // Sub-steps from the same bound with D = m: h_sub^2 R_K / m < 2 and h_sub R_C / m < 1 at every node,
+  // measured at the start of the step (with 10% headroom for the stiffening within it).
+  accumulate_forces(h_s);
+  double rate = 0.0;
+  for (std::size_t i = 0; i < x_.size(); ++i) {
+    rate = std::max(rate, std::max(std::sqrt(stiffness_bound_[i] / (2.0 * mass_[i])), damping_bound_[i] / mass_[i]));
+  }
+  int substeps = std::max(1, static_cast<int>(std::ceil(1.1 * h_s * rate)));
+  if (substeps > config_.max_substeps) {
+    substeps = config_.max_substeps;
+    ++faults_.substep_cap_hits;
+  }
+  const double h = h_s / substeps;
+  ToolReaction total;
+  for (int step = 0; step < substeps; ++step) {
+    if (step > 0) accumulate_forces(h_s);
+    total.force_n += reaction_.force_n;
+    total.torque_nm += reaction_.torque_nm;
+    for (std::size_t i = 0; i < x_.size(); ++i) {
+      v_[i] += (h / mass_[i]) * force_[i];
+      x_[i] += h * v_[i];
+    }
+  }
+  reaction_.force_n = total.force_n / static_cast<double>(substeps);
+  reaction_.torque_nm = total.torque_nm / static_cast<double>(substeps);
+  last_substeps_ = substeps;
+}
+
+void MassSpringTissue::apply_system(double mass_coefficient, double damping_coefficient, double stiffness_coefficient,
+                                    std::span<const Vec3> p, std::span<Vec3> out) const {
+  // out = (a M + b C + c K) p with the springs' linearisation from accumulate_forces; anchors enter
+  // K, contacts only the preconditioner (they stay explicit).
+  const double viscous_rate = parameters_.si(TissueParameter::kViscousDamping);
+  for (std::size_t i = 0; i < p.size(); ++i) out[i] = mass_[i] * (mass_coefficient + damping_coefficient * viscous_rate) * p[i];
+  for (std::size_t a = 0; a < anchor_k_.size(); ++a) {
+    const std::uint32_t i = network_.anchor_nodes[a];
+    out[i] += stiffness_coefficient * anchor_k_[a] * p[i];
+  }
+  const std::uint32_t* pairs = network_.spring_nodes.data();
+  for (std::size_t s = 0; s < spring_k_.size(); ++s) {
+    const std::uint32_t i = pairs[2 * s], j = pairs[2 * s + 1];
+    const Vec3& u = spring_direction_[s];
+    const Vec3 dp = p[j] - p[i];
+    const double along = glm::dot(u, dp);
+    const Vec3 value = (stiffness_coefficient * spring_k_[s] + damping_coefficient * spring_c_[s]) * along * u +
+                       (stiffness_coefficient * spring_transverse_k_[s]) * (dp - along * u);
+    out[i] -= value;
+    out[j] += value;
+  }
+}
+
+void MassSpringTissue::step_implicit_euler(double h_s) {
+  accumulate_forces(h_s);
+  const std::size_t n = x_.size();
+  // Right-hand side h (f - h K v) with K = -df/dx (Baraff-Witkin).
+  apply_system(0.0, 0.0, 1.0, v_, cg_q_);
+  for (std::size_t i = 0; i < n; ++i) cg_r_[i] = h_s * (force_[i] - h_s * cg_q_[i]);
+  // Jacobi-preconditioned CG from dv = 0, bounded.
+  double rr0 = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    cg_dv_[i] = Vec3(0.0);
+    const double diagonal = mass_[i] + 0.5 * h_s * h_s * stiffness_bound_[i] + h_s * damping_bound_[i];
+    cg_z_[i] = cg_r_[i] / diagonal;
+    cg_p_[i] = cg_z_[i];
+    rr0 += glm::dot(cg_r_[i], cg_z_[i]);
+  }
+  double rz = rr0;
+  int iteration = 0;
+  for (; iteration < config_.max_cg_iterations && rz > config_.cg_tolerance * config_.cg_tolerance * rr0 && rz > 0.0; ++iteration) {
+    apply_system(1.0, h_s, h_s * h_s, cg_p_, cg_q_);
+    double pq = 0.0;
+    for (std::size_t i = 0; i < n; ++i) pq += glm::dot(cg_p_[i], cg_q_[i]);
+    if (!(pq > 0.0)) break;
+    const double alpha = rz / pq;
+    double rz_next = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      cg_dv_[i] += alpha * cg_p_[i];
+      cg_r_[i] -= alpha * cg_q_[i];
+      const double diagonal = mass_[i] + 0.5 * h_s * h_s * stiffness_bound_[i] + h_s * damping_bound_[i];
+      cg_z_[i] = cg_r_[i] / diagonal;
+      rz_next += glm::dot(cg_r_[i], cg_z_[i]);
+    }
+    const double beta = rz_next / rz;
+    rz = rz_next;
+    for (std::size_t i = 0; i < n; ++i) cg_p_[i] = cg_z_[i] + beta * cg_p_[i];
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    v_[i] += cg_dv_[i];
+    x_[i] += h_s * v_[i];
+  }
+  last_cg_iterations_ = iteration;
+  last_substeps_ = 1;
+}
+
+ToolReaction MassSpringTissue::physics_step(double h_s) {
+  switch (config_.integrator) {
+    case TissueIntegrator::kBoundedSymplectic: step_bounded_symplectic(h_s); break;
+    case TissueIntegrator::kSubsteppedSymplectic: step_substepped_symplectic(h_s); break;
+    case TissueIntegrator::kImplicitEuler: step_implicit_euler(h_s); break;
+  }
+  check_finite();
+  return reaction_;
+}
+
+void MassSpringTissue::check_finite() {
+  for (std::size_t i = 0; i < x_.size(); ++i) {
+    const double sum = x_[i].x + x_[i].y + x_[i].z + v_[i].x + v_[i].y + v_[i].z;
+    if (!std::isfinite(sum)) {
+      if (faults_.first_non_finite_node < 0) faults_.first_non_finite_node = static_cast<std::int64_t>(i);
+      ++faults_.non_finite_steps;
+      return;
+    }
+  }
+}
+
+std::uint64_t MassSpringTissue::state_hash() const {
+  StateHasher hasher;
+  hasher.add(std::span<const Vec3>(x_));
+  hasher.add(std::span<const Vec3>(v_));
+  hasher.add(std::span<const std::uint32_t>(network_.spring_nodes));
+  hasher.add(std::span<const Triangle>(surface_.triangles));
+  return hasher.value();
+}
+
+double MassSpringTissue::total_mass_kg() const {
+  double total = 0.0;
+  for (double m : mass_) total += m;
+  return total;
+}
+
+double MassSpringTissue::kinetic_energy_j() const {
+  double energy = 0.0;
+  for (std::size_t i = 0; i < v_.size(); ++i) energy += 0.5 * mass_[i] * glm::dot(v_[i], v_[i]);
+  return energy;
+}
+
+double MassSpringTissue::max_displacement_m() const {
+  double largest2 = 0.0;
+  for (std::size_t i = 0; i < x_.size(); ++i) largest2 = std::max(largest2, glm::dot(x_[i] - rest_[i], x_[i] - rest_[i]));
+  return std::sqrt(largest2);
+}
+
+}  // namespace resecto

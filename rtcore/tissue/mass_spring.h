@@ -1,0 +1,126 @@
+// MassSpringTissue: the deformable gland (paper sections 3.3-3.4). Nodes of the tetrahedral mesh with
+// lumped masses, a spring and damper per tetrahedron edge, anchor springs on the capsule, penalty
+// contact with the tool; hot state in flat arrays sized once, so a physics step allocates nothing.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "rtcore/collision/sphere_tree.h"
+#include "rtcore/tissue/springs.h"
+#include "rtcore/tissue/tet_mesh.h"
+#include "rtcore/tissue/tissue_parameters.h"
+#include "rtcore/tissue/tool_contact.h"
+
+namespace resecto {
+
+/// How a physics step advances the nodes (README: the measured comparison behind the default).
+enum class TissueIntegrator : std::uint8_t {
+  /// Symplectic Euler whose per-node mass is raised by a Gershgorin bound of the step's stiffness
+  /// and damping (D = m + h^2 R_K / 2 + h R_C): stable for every stiffness, one force pass a step,
+  /// statics exact; fast modes are slowed instead of exploding. The default.
+  kBoundedSymplectic,
+  /// Plain symplectic Euler split into as many sub-steps as the same bound demands: exact dynamics,
+  /// cost that grows with sqrt(stiffness) and with resolution.
+  kSubsteppedSymplectic,
+  /// Linearised implicit Euler (Baraff-Witkin) with a Jacobi-preconditioned conjugate-gradient solve
+  /// bounded to `max_cg_iterations`.
+  kImplicitEuler,
+};
+
+/// Fixed choices of a tissue instance (not live parameters).
+struct TissueConfig {
+  TissueIntegrator integrator = TissueIntegrator::kBoundedSymplectic;
+  int max_cg_iterations = 20;
+  double cg_tolerance = 1e-4;          ///< relative residual at which CG stops
+  int max_substeps = 4096;             ///< cap of kSubsteppedSymplectic; hitting it is flagged
+  double contact_margin_m = 0.0015;
+  ToolContactCapacity contact_capacity;
+};
+
+/// Faults of the last step, counted rather than thrown (STYLE.md "Errors").
+struct TissueFaults {
+  std::int64_t non_finite_steps = 0;  ///< steps after which a position or velocity was NaN/inf
+  std::int64_t first_non_finite_node = -1;
+  std::int64_t substep_cap_hits = 0;
+  std::int64_t contact_overflows = 0;
+};
+
+class MassSpringTissue {
+ public:
+  /// Builds the model from a tetrahedral mesh (metres). Allocates every array here.
+  MassSpringTissue(const TetMesh& mesh, const TissueParameters& parameters = {}, const TissueConfig& config = {});
+
+  /// Applies a parameter command; call only between steps (the tick boundary). Allocates nothing.
+  void apply(const ParameterCommand& command);
+  /// Replaces every parameter at once (same rule).
+  void set_parameters(const TissueParameters& parameters);
+  const TissueParameters& parameters() const { return parameters_; }
+
+  /// The tool's rigid parts and their poses; set the poses before each physics step.
+  ToolContacts& tool() { return tool_; }
+  const ToolContacts& tool() const { return tool_; }
+
+  /// The 60 Hz collision step: copies the node positions into the surface, refits its sphere tree,
+  /// and lets the tool find its candidate pairs.
+  void collision_step();
+  /// One physics step of h_s seconds (default 1/960 s). Returns the reaction on the tool.
+  ToolReaction physics_step(double h_s);
+
+  /// 64-bit hash of positions, velocities and topology, bytes in index order.
+  std::uint64_t state_hash() const;
+
+  std::size_t node_count() const { return x_.size(); }
+  std::span<const Vec3> positions() const { return x_; }
+  std::span<const Vec3> velocities() const { return v_; }
+  std::span<const Vec3> rest_positions() const { return rest_; }
+  const TriangleMesh& surface() const { return surface_; }
+  const SphereTree& surface_tree() const { return surface_tree_; }
+  const SpringNetwork& network() const { return network_; }
+  double total_mass_kg() const;
+  double kinetic_energy_j() const;
+  /// Largest distance of a node from its rest position.
+  double max_displacement_m() const;
+  const TissueFaults& faults() const { return faults_; }
+  /// Sub-steps the last physics step took (1 except for kSubsteppedSymplectic) and CG iterations.
+  int last_substeps() const { return last_substeps_; }
+  int last_cg_iterations() const { return last_cg_iterations_; }
+
+ private:
+  void update_material();
+  void accumulate_forces(double h_s);
+  void step_bounded_symplectic(double h_s);
+  void step_substepped_symplectic(double h_s);
+  void step_implicit_euler(double h_s);
+  void apply_system(double mass_coefficient, double damping_coefficient, double stiffness_coefficient,
+                    std::span<const Vec3> p, std::span<Vec3> out) const;
+  void check_finite();
+
+  TissueParameters parameters_;
+  TissueConfig config_;
+  SpringNetwork network_;
+  std::vector<Tetrahedron> tetrahedra_;
+
+  // Hot, per node.
+  std::vector<Vec3> x_, v_, rest_, force_;
+  std::vector<double> mass_, stiffness_bound_, damping_bound_;
+  // Hot, per spring (node pairs live in network_.spring_nodes).
+  std::vector<double> spring_k_, spring_c_;
+  // Per anchor.
+  std::vector<double> anchor_k_;
+  // Implicit Euler only: per-spring linearisation and CG vectors.
+  std::vector<Vec3> spring_direction_;
+  std::vector<double> spring_transverse_k_;
+  std::vector<Vec3> cg_r_, cg_z_, cg_p_, cg_q_, cg_dv_;
+
+  TriangleMesh surface_;
+  SphereTree surface_tree_;
+  ToolContacts tool_;
+  ToolReaction reaction_;
+  TissueFaults faults_;
+  int last_substeps_ = 1;
+  int last_cg_iterations_ = 0;
+};
+
+}  // namespace resecto

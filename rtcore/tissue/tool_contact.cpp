@@ -1,0 +1,289 @@
+// Tool contact: candidate search (60 Hz) and penalty forces (every substep). Two kinds of point
+// penetrate: tissue nodes inside a tool part, and tool vertices inside the tissue (the 0.35 mm loop
+// wire is thinner than the tissue's triangles, so it would slip between nodes otherwise).
+#include "rtcore/tissue/tool_contact.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rtcore/geometry/closest_point.h"
+
+namespace resecto {
+namespace {
+
+Vec3 rotate(const RigidTransform& pose, const Vec3& p) {
+  const auto& r = pose.rotation;
+  return {r[0][0] * p.x + r[0][1] * p.y + r[0][2] * p.z, r[1][0] * p.x + r[1][1] * p.y + r[1][2] * p.z,
+          r[2][0] * p.x + r[2][1] * p.y + r[2][2] * p.z};
+}
+
+/// World point into the tool frame (the pose's rotation is orthonormal).
+Vec3 to_tool_frame(const RigidTransform& pose, const Vec3& world) {
+  const auto& r = pose.rotation;
+  const Vec3 d = world - pose.translation;
+  return {r[0][0] * d.x + r[1][0] * d.y + r[2][0] * d.z, r[0][1] * d.x + r[1][1] * d.y + r[2][1] * d.z,
+          r[0][2] * d.x + r[1][2] * d.y + r[2][2] * d.z};
+}
+
+/// Barycentric weights of q, a point of triangle (a, b, c); equal thirds for a degenerate triangle.
+Vec3 barycentric(const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 v0 = b - a, v1 = c - a, v2 = q - a;
+  const double d00 = glm::dot(v0, v0), d01 = glm::dot(v0, v1), d11 = glm::dot(v1, v1);
+  const double d20 = glm::dot(v2, v0), d21 = glm::dot(v2, v1);
+  const double denominator = d00 * d11 - d01 * d01;
+  if (!(denominator > 1e-30)) return Vec3(1.0 / 3.0);
+  const double v = std::clamp((d11 * d20 - d01 * d21) / denominator, 0.0, 1.0);
+  const double w = std::clamp((d00 * d21 - d01 * d20) / denominator, 0.0, 1.0 - v);
+  return {1.0 - v - w, v, w};
+}
+
+bool sphere_near(const Sphere& s, const Vec3& p, double radius) {
+  const double reach = s.radius + radius;
+  const Vec3 d = p - s.center;
+  return glm::dot(d, d) <= reach * reach;
+}
+
+/// The closest candidate is the one the point is nearest; among equally near ones (a point facing
+/// an edge or vertex) the one whose plane it is furthest from decides the side, which is the
+/// pseudo-normal's answer for convex corners.
+struct Closest {
+  double distance2 = 1e300;
+  double plane_distance = 0.0;  // |signed distance to the plane| of the chosen triangle
+  double side = 1.0;            // < 0: the point is behind the chosen triangle
+  Vec3 point{0.0};
+  std::uint32_t triangle = 0;
+  void offer(const Vec3& p, const Vec3& q, const Vec3& unit_normal, std::uint32_t t) {
+    const double d2 = glm::dot(p - q, p - q);
+    const double plane = glm::dot(p - q, unit_normal);
+    constexpr double kTie = 1e-18;  // m^2: closest points this close are the same feature
+    if (d2 < distance2 - kTie || (d2 <= distance2 + kTie && std::abs(plane) > plane_distance)) {
+      distance2 = d2;
+      plane_distance = std::abs(plane);
+      side = plane;
+      point = q;
+      triangle = t;
+    }
+  }
+};
+
+}  // namespace
+
+ToolContacts::ToolContacts(double margin_m, const ToolContactCapacity& capacity) : margin_m_(margin_m), capacity_(capacity) {
+  node_candidates_.resize(static_cast<std::size_t>(capacity.max_tissue_nodes));
+  vertex_candidates_.resize(static_cast<std::size_t>(capacity.max_tool_vertices));
+  pair_triangles_.resize(static_cast<std::size_t>(capacity.max_pair_entries));
+  stack_.reserve(256);
+}
+
+int ToolContacts::add_part(const TriangleMesh& mesh) {
+  Part part;
+  part.mesh = mesh;
+  part.inflated = mesh;
+  std::vector<Vec3> vertex_normals(mesh.vertex_count(), Vec3(0.0));
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const Vec3 n2 = triangle_normal_x2(mesh, t);
+    const double length = glm::length(n2);
+    part.face_normals.push_back(length > 0.0 ? n2 / length : Vec3(0.0));
+    for (std::uint32_t v : mesh.triangles[t]) vertex_normals[v] += n2;
+  }
+  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+    const double length = glm::length(vertex_normals[v]);
+    if (length > 0.0) part.inflated.positions[v] += margin_m_ * vertex_normals[v] / length;
+  }
+  part.tree.build(part.inflated);
+  parts_.push_back(std::move(part));
+  std::size_t max_triangles = 0;
+  for (const Part& p : parts_) max_triangles = std::max(max_triangles, p.mesh.triangle_count());
+  triangle_stamp_.assign(max_triangles, 0);
+  std::size_t vertices = 0;
+  for (const Part& p : parts_) vertices += p.mesh.vertex_count();
+  tool_vertex_stamp_.assign(vertices, 0);
+  stamp_ = 0;
+  return static_cast<int>(parts_.size()) - 1;
+}
+
+void ToolContacts::set_pose(int part, const RigidTransform& pose) {
+  Part& p = parts_[static_cast<std::size_t>(part)];
+  p.previous_pose = p.pose;
+  p.pose = pose;
+}
+
+void ToolContacts::reset_pose(int part, const RigidTransform& pose) {
+  Part& p = parts_[static_cast<std::size_t>(part)];
+  p.previous_pose = pose;
+  p.pose = pose;
+}
+
+bool ToolContacts::push_pair(std::uint32_t triangle) {
+  if (pair_count_ >= pair_triangles_.size()) {
+    stats_.overflowed = true;
+    return false;
+  }
+  pair_triangles_[pair_count_++] = triangle;
+  return true;
+}
+
+void ToolContacts::gather_triangles(const SphereTree& tree, const Vec3& p, double radius, std::vector<std::uint32_t>& seen) {
+  // Depth-first, left child first: the pair order is a function of the tree alone.
+  if (tree.empty()) return;
+  ++stamp_;
+  stack_.clear();
+  stack_.push_back(tree.root());
+  const auto& spheres = tree.spheres();
+  const auto& links = tree.links();
+  while (!stack_.empty()) {
+    const std::int32_t node = stack_.back();
+    stack_.pop_back();
+    if (!sphere_near(spheres[static_cast<std::size_t>(node)], p, radius)) continue;
+    if (tree.is_leaf(node)) {
+      const std::uint32_t t = tree.pieces()[static_cast<std::size_t>(node)].triangle;
+      if (seen[t] != stamp_) {
+        seen[t] = stamp_;
+        push_pair(t);
+      }
+    } else if (stack_.size() + 2 <= stack_.capacity()) {
+      stack_.push_back(links[static_cast<std::size_t>(node)].right);
+      stack_.push_back(links[static_cast<std::size_t>(node)].left);
+    } else {
+      stats_.overflowed = true;
+    }
+  }
+}
+
+void ToolContacts::update_candidates(const SphereTree& tissue_tree, const TriangleMesh& surface) {
+  // Sized once for this tissue; a tissue whose size changes (resection) grows them at that step.
+  if (node_stamp_.size() < surface.vertex_count()) node_stamp_.assign(surface.vertex_count(), 0);
+  if (tissue_triangle_stamp_.size() < surface.triangle_count()) tissue_triangle_stamp_.assign(surface.triangle_count(), 0);
+  if (stamp_ > 0xfff00000u) {  // keep the stamps from wrapping
+    std::fill(node_stamp_.begin(), node_stamp_.end(), 0u);
+    std::fill(tissue_triangle_stamp_.begin(), tissue_triangle_stamp_.end(), 0u);
+    std::fill(triangle_stamp_.begin(), triangle_stamp_.end(), 0u);
+    std::fill(tool_vertex_stamp_.begin(), tool_vertex_stamp_.end(), 0u);
+    stamp_ = 0;
+  }
+  node_count_ = vertex_count_ = pair_count_ = 0;
+  stats_ = {};
+  const double search_radius = margin_m_;
+  std::uint32_t vertex_offset = 0;
+  // Parts in index order, leaves in the collider's order, triangles' corners in order: deterministic.
+  for (std::size_t pi = 0; pi < parts_.size(); vertex_offset += static_cast<std::uint32_t>(parts_[pi].mesh.vertex_count()), ++pi) {
+    Part& part = parts_[pi];
+    if (!part.enabled) continue;
+    if (!part.collider.collide(tissue_tree, surface, part.tree, part.inflated, part.pose)) stats_.overflowed = true;
+    stats_.tissue_leaves += static_cast<std::int32_t>(part.collider.tissue_leaves().size());
+    stats_.tool_leaves += static_cast<std::int32_t>(part.collider.tool_leaves().size());
+
+    // Tissue nodes of the colliding tissue leaves, each once per part, against nearby tool triangles.
+    const std::uint32_t node_mark = ++stamp_;
+    for (std::int32_t leaf : part.collider.tissue_leaves()) {
+      const Triangle& tri = surface.triangles[tissue_tree.pieces()[static_cast<std::size_t>(leaf)].triangle];
+      for (std::uint32_t n : tri) {
+        if (node_stamp_[n] == node_mark) continue;
+        node_stamp_[n] = node_mark;
+        if (node_count_ >= node_candidates_.size()) {
+          stats_.overflowed = true;
+          continue;
+        }
+        const auto first = static_cast<std::uint32_t>(pair_count_);
+        gather_triangles(part.tree, to_tool_frame(part.pose, surface.positions[n]), search_radius, triangle_stamp_);
+        if (pair_count_ > first) {
+          node_candidates_[node_count_++] = {n, static_cast<std::uint16_t>(pi), first, static_cast<std::uint32_t>(pair_count_ - first)};
+        }
+      }
+    }
+    // Tool vertices of the colliding tool leaves against nearby tissue triangles.
+    const std::uint32_t vertex_mark = ++stamp_;
+    for (std::int32_t leaf : part.collider.tool_leaves()) {
+      const Triangle& tri = part.mesh.triangles[part.tree.pieces()[static_cast<std::size_t>(leaf)].triangle];
+      for (std::uint32_t v : tri) {
+        if (tool_vertex_stamp_[vertex_offset + v] == vertex_mark) continue;
+        tool_vertex_stamp_[vertex_offset + v] = vertex_mark;
+        if (vertex_count_ >= vertex_candidates_.size()) {
+          stats_.overflowed = true;
+          continue;
+        }
+        const auto first = static_cast<std::uint32_t>(pair_count_);
+        gather_triangles(tissue_tree, transform_point(part.pose, part.mesh.positions[v]), search_radius, tissue_triangle_stamp_);
+        if (pair_count_ > first) {
+          vertex_candidates_[vertex_count_++] = {v, static_cast<std::uint16_t>(pi), first, static_cast<std::uint32_t>(pair_count_ - first)};
+        }
+      }
+    }
+  }
+  stats_.tissue_nodes = static_cast<std::int32_t>(node_count_);
+  stats_.tool_vertices = static_cast<std::int32_t>(vertex_count_);
+  stats_.pair_entries = static_cast<std::int32_t>(pair_count_);
+}
+
+ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const Vec3> v, const std::vector<Triangle>& surface_triangles,
+                                      double k, double c, double h_s, std::span<Vec3> force, std::span<double> stiffness_bound,
+                                      std::span<double> damping_bound) {
+  ToolReaction reaction;
+  std::int32_t penetrating = 0;
+  const double inverse_h = 1.0 / h_s;
+  // Candidates in the order update_candidates stored them: the force sums are the same every run.
+  for (std::size_t i = 0; i < node_count_; ++i) {
+    const PointCandidates& pc = node_candidates_[i];
+    const Part& part = parts_[pc.part];
+    const Vec3 p = to_tool_frame(part.pose, x[pc.point]);
+    Closest best;
+    for (std::uint32_t e = pc.first; e < pc.first + pc.count; ++e) {
+      const Triangle& t = part.mesh.triangles[pair_triangles_[e]];
+      const Vec3 q = closest_point_on_triangle(p, part.mesh.positions[t[0]], part.mesh.positions[t[1]], part.mesh.positions[t[2]]);
+      best.offer(p, q, part.face_normals[pair_triangles_[e]], pair_triangles_[e]);
+    }
+    if (!(best.side < 0.0)) continue;
+    const double depth = std::sqrt(best.distance2);
+    // Out of the tool: from the node toward its closest surface point (the distance gradient).
+    const Vec3 out_tool = depth > 1e-12 ? (best.point - p) / depth : part.face_normals[best.triangle];
+    const Vec3 out = rotate(part.pose, out_tool);
+    const Vec3 surface_world = transform_point(part.pose, best.point);
+    const Vec3 surface_velocity = (surface_world - transform_point(part.previous_pose, best.point)) * inverse_h;
+    const double separating_speed = glm::dot(v[pc.point] - surface_velocity, out);
+    const double magnitude = std::max(0.0, k * depth - c * separating_speed);
+    const Vec3 f = magnitude * out;
+    force[pc.point] += f;
+    stiffness_bound[pc.point] += k;
+    damping_bound[pc.point] += c;
+    reaction.force_n -= f;
+    reaction.torque_nm += glm::cross(surface_world - part.pose.translation, -f);
+    ++penetrating;
+  }
+  for (std::size_t i = 0; i < vertex_count_; ++i) {
+    const PointCandidates& pc = vertex_candidates_[i];
+    const Part& part = parts_[pc.part];
+    const Vec3 w = transform_point(part.pose, part.mesh.positions[pc.point]);
+    Closest best;
+    for (std::uint32_t e = pc.first; e < pc.first + pc.count; ++e) {
+      const Triangle& t = surface_triangles[pair_triangles_[e]];
+      const Vec3 q = closest_point_on_triangle(w, x[t[0]], x[t[1]], x[t[2]]);
+      const Vec3 n2 = glm::cross(x[t[1]] - x[t[0]], x[t[2]] - x[t[0]]);
+      const double length = glm::length(n2);
+      best.offer(w, q, length > 0.0 ? n2 / length : Vec3(0.0), pair_triangles_[e]);
+    }
+    if (!(best.side < 0.0)) continue;
+    const Triangle& t = surface_triangles[best.triangle];
+    const double depth = std::sqrt(best.distance2);
+    if (!(depth > 1e-12)) continue;
+    // Into the tissue: the surface point is pushed toward the tool vertex below it.
+    const Vec3 in = (w - best.point) / depth;
+    const Vec3 weights = barycentric(best.point, x[t[0]], x[t[1]], x[t[2]]);
+    const Vec3 tissue_velocity = weights[0] * v[t[0]] + weights[1] * v[t[1]] + weights[2] * v[t[2]];
+    const Vec3 tool_velocity = (w - transform_point(part.previous_pose, part.mesh.positions[pc.point])) * inverse_h;
+    const double approach_speed = glm::dot(tool_velocity - tissue_velocity, in);
+    const double magnitude = std::max(0.0, k * depth + c * approach_speed);
+    const Vec3 f = magnitude * in;
+    for (int corner = 0; corner < 3; ++corner) {
+      force[t[corner]] += weights[corner] * f;
+      stiffness_bound[t[corner]] += weights[corner] * k;
+      damping_bound[t[corner]] += weights[corner] * c;
+    }
+    reaction.force_n -= f;
+    reaction.torque_nm += glm::cross(w - part.pose.translation, -f);
+    ++penetrating;
+  }
+  stats_.penetrating = penetrating;
+  return reaction;
+}
+
+}  // namespace resecto

@@ -1,0 +1,107 @@
+// Penalty contact between the tissue and the kinematic tool parts (sheath, loop): candidate pairs
+// found at the 60 Hz collision step from the sphere trees' colliding leaf lists, penalty forces with
+// damping evaluated on those pairs at every physics substep, and the reaction on the tool.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "rtcore/collision/collide.h"
+#include "rtcore/collision/sphere_tree.h"
+#include "rtcore/mesh/triangle_mesh.h"
+
+namespace resecto {
+
+/// Total force and torque the tissue applies to the tool in one substep (torque about the origin of
+/// each part's tool frame, i.e. the sheath tip; all parts share that frame).
+struct ToolReaction {
+  Vec3 force_n{0.0};
+  Vec3 torque_nm{0.0};
+};
+
+/// Capacities fixed at start; exceeding one sets `overflowed` and drops pairs instead of allocating.
+struct ToolContactCapacity {
+  std::int32_t max_tissue_nodes = 8192;    ///< tissue nodes near a tool part
+  std::int32_t max_tool_vertices = 4096;   ///< tool vertices near the tissue
+  std::int32_t max_pair_entries = 262144;  ///< candidate (point, triangle) pairs in all
+};
+
+/// What one collision step found, for the profiler and the tests.
+struct ToolContactStats {
+  std::int32_t tissue_leaves = 0;  ///< L1 entries over all parts
+  std::int32_t tool_leaves = 0;    ///< L2 entries over all parts
+  std::int32_t tissue_nodes = 0;   ///< candidate tissue nodes
+  std::int32_t tool_vertices = 0;  ///< candidate tool vertices
+  std::int32_t pair_entries = 0;
+  std::int32_t penetrating = 0;    ///< points that pushed in the last substep
+  bool overflowed = false;
+};
+
+/// The tool side of contact: the rigid parts, their (margin-inflated) sphere trees, their poses.
+class ToolContacts {
+ public:
+  /// `margin_m`: how far outside the tool a point may be and still become a candidate; it must
+  /// exceed what tool and tissue move in one collision step.
+  explicit ToolContacts(double margin_m = 0.0015, const ToolContactCapacity& capacity = {});
+
+  /// Adds a rigid part given in the tool frame; returns its index. Call before the first step.
+  int add_part(const TriangleMesh& mesh_in_tool_frame);
+  int part_count() const { return static_cast<int>(parts_.size()); }
+  /// Sets where a part is for the coming physics step; the previous pose gives the tool's velocity.
+  void set_pose(int part, const RigidTransform& pose);
+  /// Places a part without motion (both poses), e.g. at start.
+  void reset_pose(int part, const RigidTransform& pose);
+  /// Takes a part out of (or back into) contact, e.g. the loop when it is not modelled.
+  void set_enabled(int part, bool enabled) { parts_[static_cast<std::size_t>(part)].enabled = enabled; }
+  const RigidTransform& pose(int part) const { return parts_[static_cast<std::size_t>(part)].pose; }
+
+  /// The 60 Hz collision step: queries each part's tree against the tissue surface tree (already
+  /// refitted to `surface`'s positions) and rebuilds the candidate pairs. Allocates nothing once the
+  /// capacities are reserved.
+  void update_candidates(const SphereTree& tissue_tree, const TriangleMesh& surface);
+
+  /// One substep's penalty forces on the candidate pairs at positions x, velocities v: adds to
+  /// `force`, and to the per-node bounds of the contact stiffness and damping the integrator needs.
+  /// Returns the reaction on the tool.
+  ToolReaction add_forces(std::span<const Vec3> x, std::span<const Vec3> v, const std::vector<Triangle>& surface_triangles,
+                          double stiffness_n_m, double damping_ns_m, double h_s, std::span<Vec3> force,
+                          std::span<double> stiffness_bound, std::span<double> damping_bound);
+
+  const ToolContactStats& stats() const { return stats_; }
+
+ private:
+  struct Part {
+    TriangleMesh mesh;          // tool frame
+    TriangleMesh inflated;      // every vertex pushed out by the margin along its normal
+    std::vector<Vec3> face_normals;  // unit, tool frame
+    SphereTree tree;            // over `inflated`, so the query's contact is the margin's
+    Collider collider;
+    RigidTransform pose, previous_pose;
+    bool enabled = true;
+  };
+  /// A point with its candidate triangles: entries [first, first + count) of pair_triangles_.
+  struct PointCandidates {
+    std::uint32_t point;  // tissue node, or tool vertex
+    std::uint16_t part;
+    std::uint32_t first;
+    std::uint32_t count;
+  };
+  /// Appends the triangles of `tree` with a leaf sphere within `radius` of `point`, each once.
+  void gather_triangles(const SphereTree& tree, const Vec3& point, double radius, std::vector<std::uint32_t>& seen);
+  bool push_pair(std::uint32_t triangle);
+
+  double margin_m_;
+  ToolContactCapacity capacity_;
+  std::vector<Part> parts_;
+  std::vector<PointCandidates> node_candidates_;    // tissue node against tool triangles
+  std::vector<PointCandidates> vertex_candidates_;  // tool vertex against tissue triangles
+  std::vector<std::uint32_t> pair_triangles_;
+  std::size_t node_count_ = 0, vertex_count_ = 0, pair_count_ = 0;
+  std::vector<std::uint32_t> node_stamp_, tool_vertex_stamp_, triangle_stamp_, tissue_triangle_stamp_;
+  std::uint32_t stamp_ = 0;
+  std::vector<std::int32_t> stack_;
+  ToolContactStats stats_;
+};
+
+}  // namespace resecto
