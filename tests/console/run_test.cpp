@@ -1,0 +1,90 @@
+// `resecto run --headless` end to end: the report's contract, the trace Perfetto opens, the same hash
+// twice, and clear errors for bad arguments.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <regex>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/console/run_resecto.h"
+
+namespace resecto::testing {
+namespace {
+
+const char* kShortRun = "run --headless --triangles 1296 --seconds 2.5";
+
+TEST(RunCommand, ReportFollowsTheContractAndTheTraceMatchesIt) {
+  const auto dir = scratch_directory("run_report");
+  const CommandOutput run =
+      run_resecto(std::string(kShortRun) + " --report " + (dir / "r.json").string() + " --trace " + (dir / "t.json").string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("final state hash"), std::string::npos) << run.out;
+  const auto report = nlohmann::json::parse(read_text(dir / "r.json"));
+  EXPECT_EQ(report.at("ticks").get<int>(), 2400);
+  EXPECT_TRUE(std::regex_match(report.at("state_hash").get<std::string>(), std::regex("[0-9a-f]{16}")));
+  EXPECT_EQ(report.at("deadline_misses").get<int>(), 0);  // batch mode has no deadlines
+  for (const char* key : {"reports", "lost", "rate_hz"}) EXPECT_TRUE(report.at("device").contains(key)) << key;
+  EXPECT_NEAR(report.at("device").at("rate_hz").get<double>(), 1000.0, 5.0);
+  EXPECT_EQ(report.at("device").at("lost").get<int>(), 0);
+  EXPECT_TRUE(report.at("metrics").is_object());
+
+  // Every stage's statistics are present, ordered, and agree with the trace's complete events.
+  const auto trace = nlohmann::json::parse(read_text(dir / "t.json"));
+  std::map<std::string, std::vector<double>> durations;
+  for (const auto& event : trace.at("traceEvents")) {
+    if (event.at("ph") == "X") durations[event.at("name").get<std::string>()].push_back(event.at("dur").get<double>());
+  }
+  for (const auto& [name, stage] : report.at("stages").items()) {
+    SCOPED_TRACE(name);
+    const double median = stage.at("median_us"), p95 = stage.at("p95_us"), p99 = stage.at("p99_us"), max = stage.at("max_us");
+    EXPECT_GT(stage.at("budget_us").get<double>(), 0.0);
+    EXPECT_LE(median, p95);
+    EXPECT_LE(p95, p99);
+    EXPECT_LE(p99, max);
+    auto& d = durations[name];
+    ASSERT_EQ(d.size(), stage.at("samples").get<std::size_t>());
+    std::sort(d.begin(), d.end());
+    EXPECT_NEAR(d.back(), max, 1e-3 * max + 1e-3);
+    const double trace_median = d[(d.size() + 1) / 2 - 1];
+    EXPECT_NEAR(median, trace_median, 0.011 * trace_median + 0.01);  // the histogram's 1% bins
+  }
+  for (const char* stage : {"input", "kinematics", "physics", "query", "publish", "tick"}) EXPECT_TRUE(durations.count(stage)) << stage;
+}
+
+TEST(RunCommand, TwoRunsWithTheSameArgumentsPrintTheSameHash) {
+  const auto dir = scratch_directory("run_twice");
+  std::string hashes[2], chains[2];
+  for (int i = 0; i < 2; ++i) {
+    const auto path = dir / ("r" + std::to_string(i) + ".json");
+    ASSERT_EQ(run_resecto(std::string(kShortRun) + " --report " + path.string()).exit_code, 0);
+    const auto report = nlohmann::json::parse(read_text(path));
+    hashes[i] = report.at("state_hash");
+    chains[i] = report.at("hash_chain");  // covers the hash of every collision step
+  }
+  EXPECT_EQ(hashes[0], hashes[1]);
+  EXPECT_EQ(chains[0], chains[1]);
+  // A different tissue gives a different trajectory.
+  const auto stiff = dir / "stiff.json";
+  ASSERT_EQ(run_resecto(std::string(kShortRun) + " --set stiffness=60 --report " + stiff.string()).exit_code, 0);
+  EXPECT_NE(nlohmann::json::parse(read_text(stiff)).at("hash_chain").get<std::string>(), chains[0]);
+}
+
+TEST(RunCommand, BadArgumentsFailWithOneLine) {
+  const auto dir = scratch_directory("run_errors");
+  std::ofstream(dir / "bad.txt") << "0 0 0 0 100 0 0 0\n1 0 0 0 100 0 0\n";
+  for (const std::string& args : {std::string("run --headless --procedure tour"), std::string("run --headless --procedure ") + (dir / "bad.txt").string(),
+                                  std::string("run --headless --set nonsense=1"), std::string("run --headless --set stiffness=-5"),
+                                  std::string("run")}) {
+    SCOPED_TRACE(args);
+    const CommandOutput run = run_resecto(args);
+    EXPECT_NE(run.exit_code, 0);
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+  }
+  EXPECT_NE(run_resecto(std::string("run --headless --procedure ") + (dir / "bad.txt").string()).err.find("bad.txt:2"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace resecto::testing

@@ -1,0 +1,113 @@
+// The core as a deterministic state machine: equal inputs give equal hashes at every collision step,
+// commands take effect at their tick, and the steady-state tick neither allocates nor locks.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <mutex>
+#include <vector>
+
+#include "rtcore/core/simulation.h"
+#include "tests/support/realtime_probe.h"
+
+namespace resecto {
+namespace {
+
+SimulationConfig small_config() {
+  SimulationConfig config;
+  config.prostate_triangles = 1296;
+  return config;
+}
+
+/// A scripted hand: insert through the apex, roll, swing into a lobe and back.
+TickInput input_at(std::uint64_t tick, double tick_s) {
+  const double t = static_cast<double>(tick) * tick_s;
+  TickInput input;
+  input.tool_present = true;
+  input.joints.insertion_m = 0.130 + 0.04 * std::min(t / 1.0, 1.0);
+  input.joints.roll_rad = 1.2 * std::sin(t);
+  input.joints.yaw_rad = t > 1.0 ? 0.01 * std::sin(3.0 * t) : 0.0;
+  input.joints.loop_travel_m = 0.006 * (1.0 - std::cos(t));
+  input.pedals = t > 1.5 ? 1 : 0;
+  return input;
+}
+
+std::vector<std::uint64_t> run_hashes(const SimulationConfig& config, std::uint64_t ticks, const std::vector<ParameterCommand>& commands = {}) {
+  auto sim = Simulation::create(config);
+  EXPECT_TRUE(sim) << (sim ? "" : sim.error());
+  std::vector<std::uint64_t> hashes;
+  for (std::uint64_t tick = 0; tick < ticks; ++tick) {
+    std::vector<ParameterCommand> due;
+    for (const ParameterCommand& c : commands) {
+      if (c.apply_tick == static_cast<std::int64_t>(tick)) due.push_back(c);
+    }
+    (*sim)->step(input_at(tick, config.tick_s()), due);
+    if ((*sim)->is_collision_tick(tick)) hashes.push_back((*sim)->state_hash());
+  }
+  return hashes;
+}
+
+TEST(Simulation, SameInputsGiveTheSameHashAtEveryCollisionStep) {
+  const SimulationConfig config = small_config();
+  const auto first = run_hashes(config, 2 * 960);
+  const auto second = run_hashes(config, 2 * 960);
+  ASSERT_EQ(first.size(), 120u);
+  EXPECT_EQ(first, second);
+  // The tool moved the tissue: the hashes are not all the same state.
+  EXPECT_NE(first.front(), first.back());
+}
+
+TEST(Simulation, ACommandChangesTheStateFromItsTickOn) {
+  const SimulationConfig config = small_config();
+  ParameterCommand stiffer;
+  stiffer.apply_tick = 960;  // the 60th collision step
+  stiffer.id = TissueParameter::kStiffness;
+  stiffer.value = 2.0 * TissueParameters().get(TissueParameter::kStiffness);
+  const auto plain = run_hashes(config, 1200);
+  const auto changed = run_hashes(config, 1200, {stiffer});
+  ASSERT_EQ(plain.size(), changed.size());
+  // Collision step 60 is tick 960 itself, hashed after the command applied: the first to differ.
+  for (std::size_t i = 0; i < 60; ++i) EXPECT_EQ(plain[i], changed[i]) << "collision step " << i;
+  EXPECT_NE(plain.back(), changed.back());
+}
+
+TEST(Simulation, SteadyStateTickAllocatesNothingAndTakesNoLock) {
+  auto sim = Simulation::create(small_config());
+  ASSERT_TRUE(sim) << sim.error();
+  const double h = (*sim)->config().tick_s();
+  FrameProfiler profiler(default_stage_budgets_us((*sim)->config()), 1 << 14);
+  // Warm up: the first contacts size the buffers that later ticks reuse.
+  std::uint64_t tick = 0;
+  for (; tick < 960; ++tick) (*sim)->step(input_at(tick, h), {}, &profiler);
+  long allocations = 0, locks = 0;
+  {
+    testing::RealtimeProbe probe;
+    for (; tick < 1920; ++tick) (*sim)->step(input_at(tick, h), {}, &profiler);
+    allocations = probe.allocations();
+    locks = probe.locks();
+  }
+  EXPECT_EQ(allocations, 0);
+  EXPECT_EQ(locks, 0);
+  EXPECT_GT((*sim)->metrics().contact_time_s, 0.0);  // the ticks counted did real contact work
+}
+
+TEST(RealtimeProbe, SeesAnAllocationAndALock) {
+  // The probe itself must be able to fail: a heap allocation and a mutex are counted.
+  std::mutex mutex;
+  testing::RealtimeProbe probe;
+  auto* value = new int(7);
+  { std::lock_guard<std::mutex> lock(mutex); }
+  delete value;
+  EXPECT_GE(probe.allocations(), 1);
+  EXPECT_GE(probe.locks(), 1);
+}
+
+TEST(Simulation, RejectsImpossibleRates) {
+  SimulationConfig config = small_config();
+  config.physics_per_collision = 0;
+  auto sim = Simulation::create(config);
+  ASSERT_FALSE(sim);
+  EXPECT_NE(sim.error().find("physics substeps 0"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace resecto

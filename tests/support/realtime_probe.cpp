@@ -1,0 +1,51 @@
+// The counting operator new and pthread_mutex_lock behind RealtimeProbe. Kept in their own
+// translation unit so the compiler never sees a malloc'd pointer reach the matching delete inline.
+#include "tests/support/realtime_probe.h"
+
+#include <dlfcn.h>
+#include <pthread.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+namespace {
+
+std::atomic<int> g_open_probes{0};
+std::atomic<long> g_allocations{0};
+std::atomic<long> g_locks{0};
+
+void* counted_allocation(std::size_t size) {
+  if (g_open_probes.load(std::memory_order_relaxed) > 0) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+
+}  // namespace
+
+void* operator new(std::size_t size) { return counted_allocation(size); }
+void* operator new[](std::size_t size) { return counted_allocation(size); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+extern "C" int pthread_mutex_lock(pthread_mutex_t* mutex) {
+  using Lock = int (*)(pthread_mutex_t*);
+  static const Lock real = reinterpret_cast<Lock>(dlsym(RTLD_NEXT, "pthread_mutex_lock"));
+  if (g_open_probes.load(std::memory_order_relaxed) > 0) g_locks.fetch_add(1, std::memory_order_relaxed);
+  return real(mutex);
+}
+
+namespace resecto::testing {
+
+RealtimeProbe::RealtimeProbe() {
+  g_allocations.store(0);
+  g_locks.store(0);
+  g_open_probes.fetch_add(1);
+}
+RealtimeProbe::~RealtimeProbe() { g_open_probes.fetch_sub(1); }
+long RealtimeProbe::allocations() const { return g_allocations.load(); }
+long RealtimeProbe::locks() const { return g_locks.load(); }
+
+}  // namespace resecto::testing

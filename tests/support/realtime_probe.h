@@ -1,0 +1,19 @@
+// RealtimeProbe: counts heap allocations and mutex locks made by any thread while a probe is open,
+// so a test can prove a steady-state step allocates nothing and takes no lock. Linking test_support
+// replaces the global operator new and interposes pthread_mutex_lock in that test binary.
+#pragma once
+
+namespace resecto::testing {
+
+class RealtimeProbe {
+ public:
+  RealtimeProbe();   ///< starts counting
+  ~RealtimeProbe();  ///< stops counting
+  RealtimeProbe(const RealtimeProbe&) = delete;
+  RealtimeProbe& operator=(const RealtimeProbe&) = delete;
+
+  long allocations() const;
+  long locks() const;
+};
+
+}  // namespace resecto::testing
