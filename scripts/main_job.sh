@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
-# The main job of the README's first command: generate the procedural models, validate them, build the
-# volumetric tissue model, and print their statistics. Later the simulator itself runs here.
+# The main job of the README's first command: generate and validate the procedural models, then run
+# the built-in demo procedure headless through the emulated device and print a summary of its report.
+# (The operator console is not built yet; once it is, this opens it where there is a display.)
 set -euo pipefail
 bin="$1"
 out="${RESECTO_OUT:-out}"
 mkdir -p "$out"
-"$bin" mesh prostate --triangles 8640 -o "$out/prostate.off"
+"$bin" mesh prostate --triangles 8640 -o "$out/prostate.off" | head -3
+"$bin" mesh resectoscope -o "$out/resectoscope.off" | head -1
+"$bin" mesh tetra "$out/prostate.off" -o "$out/prostate.vtk" | head -2
 echo
-"$bin" mesh resectoscope -o "$out/resectoscope.off"
+"$bin" run --headless --procedure demo --report "$out/demo-report.json" --trace "$out/demo-trace.json"
 echo
-"$bin" mesh tetra "$out/prostate.off" -o "$out/prostate.vtk"
-echo
-echo "models written to $out/ (open the .off and .vtk files in ParaView, MeshLab or 3D Slicer)"
+echo "models, report and trace are in $out/ (open demo-trace.json in https://ui.perfetto.dev)"
