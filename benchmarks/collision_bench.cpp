@@ -36,6 +36,13 @@ struct Clock {
   }
 };
 
+// --slice-aspect X: the leaves' slab aspect for both trees (tuning; SphereTree::kSliceAspect if 0).
+double g_slice_aspect = 0.0;
+
+void configure(SphereTree& tree) {
+  if (g_slice_aspect > 0.0) tree.set_slice_aspect(g_slice_aspect);
+}
+
 double elapsed_us(double start_us) { return Clock::now() - start_us; }
 
 double median(std::vector<double> values) {
@@ -159,6 +166,7 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
   TriangleMesh& tissue = gland.surface;
   row.triangles = static_cast<int>(tissue.triangle_count());
   SphereTree tissue_tree;
+  configure(tissue_tree);
   tissue_tree.build(tissue);
   Collider collider;
   collider.reserve(1 << 16, 1 << 19);
@@ -276,6 +284,7 @@ int run_table(int repetitions, int only_size) {
   sizes.emplace_back(138240, 0.0);
   const TriangleMesh tool = combined_resectoscope_mesh(generate_resectoscope());
   SphereTree tool_tree;
+  configure(tool_tree);
   tool_tree.build(tool);
   const auto poses = benchmark_poses();
   std::printf("collision benchmark: resectoscope %zu triangles (%d leaf spheres), %zu poses pressing into the wall, "
@@ -333,6 +342,7 @@ int main(int argc, char** argv) {
       benchmark::RunSpecifiedBenchmarks();
       return 0;
     }
+    if (std::strcmp(argv[i], "--slice-aspect") == 0 && i + 1 < argc) g_slice_aspect = std::atof(argv[++i]);
     if (std::strcmp(argv[i], "--size") == 0 && i + 1 < argc) only_size = std::atoi(argv[++i]);
     if (std::strcmp(argv[i], "--repetitions") == 0 && i + 1 < argc) repetitions = std::max(1, std::atoi(argv[++i]));
   }

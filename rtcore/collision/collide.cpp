@@ -27,6 +27,24 @@ double stretch_bound(const RigidTransform& pose) {
   return std::sqrt(worst_row) * (1.0 + 1e-12);
 }
 
+// The descent's one sphere test (tissue sphere, tool sphere in the world): every caller rounds alike.
+bool spheres_meet(const Sphere& tissue, const Sphere& tool, double slack) {
+  const double reach = tissue.radius + tool.radius + slack;
+  return length_squared(tissue.center - tool.center) <= reach * reach;
+}
+
+// True when `leaf` is the first leaf of its triangle (chain order) whose sphere meets `other`.
+// The descent reaches every leaf pair whose spheres meet (ancestors cover their leaves with room to
+// spare), so the triangle pair is tested exactly once, at that first leaf, with no table.
+template <bool kTissueSide>
+bool first_meeting_leaf(const SphereTree& tree, const Sphere* spheres, std::uint32_t triangle, std::int32_t leaf,
+                        const Sphere& other, double slack) {
+  for (std::int32_t n = tree.first_leaf_of_triangle(triangle); n != leaf; n = tree.next_leaf_of_triangle(n)) {
+    if (kTissueSide ? spheres_meet(spheres[n], other, slack) : spheres_meet(other, spheres[n], slack)) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 void Collider::reserve(std::int32_t max_pairs, std::int32_t max_tested_pairs) {
@@ -39,7 +57,7 @@ void Collider::reserve(std::int32_t max_pairs, std::int32_t max_tested_pairs) {
 
 void Collider::next_stamp() {
   if (++stamp_ == 0) {  // wrapped: forget every old mark once
-    for (auto* marks : {&tool_center_stamp_, &tool_vertex_stamp_, &l1_stamp_, &l2_stamp_, &tested_stamp_}) {
+    for (auto* marks : {&l1_stamp_, &l2_stamp_, &tested_stamp_}) {
       std::fill(marks->begin(), marks->end(), 0u);
     }
     stamp_ = 1;
@@ -50,32 +68,15 @@ void Collider::prepare(const SphereTree& tissue_tree, const SphereTree& tool_tre
   // resize() allocates only when a tree has grown past every size seen before.
   const auto tissue_nodes = static_cast<std::size_t>(tissue_tree.node_capacity());
   const auto tool_nodes = static_cast<std::size_t>(tool_tree.node_capacity());
-  tool_centers_.resize(tool_nodes);
-  tool_center_stamp_.resize(tool_nodes, 0);
+  tool_spheres_.resize(tool_nodes);
   tool_vertices_.resize(tool.vertex_count());
-  tool_vertex_stamp_.resize(tool.vertex_count(), 0);
+  tool_boxes_.resize(tool.triangle_count());
   l1_stamp_.resize(tissue_nodes, 0);
   l1_.resize(tissue_nodes);
   l2_stamp_.resize(tool_nodes, 0);
   l2_.resize(tool_nodes);
   const std::int32_t heights = tissue_tree.links()[tissue_tree.root()].height + tool_tree.links()[tool_tree.root()].height;
   stack_.resize(static_cast<std::size_t>(heights) + 2);
-}
-
-const Vec3& Collider::tool_center(const SphereTree& tool_tree, std::int32_t node) {
-  if (tool_center_stamp_[node] != stamp_) {
-    tool_center_stamp_[node] = stamp_;
-    tool_centers_[node] = transform_point(pose_, tool_tree.spheres()[node].center);
-  }
-  return tool_centers_[node];
-}
-
-const Vec3& Collider::tool_vertex(const TriangleMesh& tool, std::uint32_t v) {
-  if (tool_vertex_stamp_[v] != stamp_) {
-    tool_vertex_stamp_[v] = stamp_;
-    tool_vertices_[v] = transform_point(pose_, tool.positions[v]);
-  }
-  return tool_vertices_[v];
 }
 
 bool Collider::first_test_of(std::uint32_t tissue_triangle, std::uint32_t tool_triangle) {
@@ -96,15 +97,24 @@ bool Collider::first_test_of(std::uint32_t tissue_triangle, std::uint32_t tool_t
   return true;
 }
 
-void Collider::test_triangles(const TriangleMesh& tissue, const TriangleMesh& tool, std::uint32_t a, std::uint32_t b) {
-  if (!first_test_of(a, b)) return;  // another leaf pair of these two triangles got here first
-  ++stats_.triangle_tests;
+void Collider::test_triangles(const TriangleMesh& tissue, std::uint32_t a, std::uint32_t b, bool may_repeat) {
+  // Only a triangle covered by several leaves can reach the same pair twice.
+  if (may_repeat && !first_test_of(a, b)) return;
   const Triangle& ta = tissue.triangles[a];
-  const Triangle& tb = tool.triangles[b];
-  if (!triangles_intersect(tissue.positions[ta[0]], tissue.positions[ta[1]], tissue.positions[ta[2]],
-                           tool_vertex(tool, tb[0]), tool_vertex(tool, tb[1]), tool_vertex(tool, tb[2]))) {
+  const Vec3& p0 = tissue.positions[ta[0]];
+  const Vec3& p1 = tissue.positions[ta[1]];
+  const Vec3& p2 = tissue.positions[ta[2]];
+  // Closed boxes that do not meet hold closed triangles that do not meet: exact on coordinates,
+  // the same prefilter brute force uses.
+  const Aabb& box = tool_boxes_[b];
+  if (std::max({p0.x, p1.x, p2.x}) < box.min.x || box.max.x < std::min({p0.x, p1.x, p2.x}) ||
+      std::max({p0.y, p1.y, p2.y}) < box.min.y || box.max.y < std::min({p0.y, p1.y, p2.y}) ||
+      std::max({p0.z, p1.z, p2.z}) < box.min.z || box.max.z < std::min({p0.z, p1.z, p2.z})) {
     return;
   }
+  ++stats_.triangle_tests;
+  const Triangle& tb = tool_mesh_->triangles[b];
+  if (!triangles_intersect(p0, p1, p2, tool_vertices_[tb[0]], tool_vertices_[tb[1]], tool_vertices_[tb[2]])) return;
   if (pair_count_ == pairs_.size()) {
     overflowed_ = true;
     return;
@@ -125,16 +135,32 @@ bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue
   next_stamp();
   pose_ = tool_pose;
   radius_scale_ = stretch_bound(tool_pose);
+  tool_mesh_ = &tool;
+  // Place the tool once: its tree and mesh are small next to the work of the descent.
+  const std::vector<Sphere>& tool_rest = tool_tree.spheres();
+  for (std::size_t n = 0; n < tool_rest.size(); ++n) {
+    tool_spheres_[n] = {transform_point(pose_, tool_rest[n].center), tool_rest[n].radius * radius_scale_};
+  }
+  for (std::size_t v = 0; v < tool_vertices_.size(); ++v) tool_vertices_[v] = transform_point(pose_, tool.positions[v]);
+  for (std::size_t u = 0; u < tool_boxes_.size(); ++u) {
+    const Triangle& t = tool.triangles[u];
+    const Vec3& a = tool_vertices_[t[0]];
+    const Vec3& b = tool_vertices_[t[1]];
+    const Vec3& c = tool_vertices_[t[2]];
+    tool_boxes_[u] = {glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
+  }
   // Rounding of transformed centres and of distances is far below this slack; it only ever lets
   // a few more sphere pairs through to the exact test.
-  const Sphere& tool_root = tool_tree.spheres()[tool_tree.root()];
+  const Sphere& tool_root = tool_rest[tool_tree.root()];
   const double slack = 1e-12 * (max_abs(tool_pose.translation) + max_abs(tool_root.center) + tool_root.radius +
                                 max_abs(tissue_tree.spheres()[tissue_tree.root()].center));
 
-  const std::vector<Sphere>& tissue_spheres = tissue_tree.spheres();
-  const std::vector<SphereTreeLinks>& tissue_links = tissue_tree.links();
-  const std::vector<Sphere>& tool_spheres = tool_tree.spheres();
-  const std::vector<SphereTreeLinks>& tool_links = tool_tree.links();
+  const Sphere* tissue_spheres = tissue_tree.spheres().data();
+  const SphereTreeLinks* tissue_links = tissue_tree.links().data();
+  const LeafPiece* tissue_pieces = tissue_tree.pieces().data();
+  const Sphere* tool_spheres = tool_spheres_.data();
+  const SphereTreeLinks* tool_links = tool_tree.links().data();
+  const LeafPiece* tool_pieces = tool_tree.pieces().data();
 
   // Depth-first with an explicit stack; children are pushed farther first so the closer one is
   // walked first (Figure 11). The walk order depends only on the trees and the pose: deterministic.
@@ -143,11 +169,9 @@ bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue
   while (top > 0) {
     const NodePair pair = stack_[--top];
     const Sphere& s1 = tissue_spheres[pair.tissue];
-    const Vec3& c2 = tool_center(tool_tree, pair.tool);
-    const double r2 = tool_spheres[pair.tool].radius * radius_scale_;
+    const Sphere& s2 = tool_spheres[pair.tool];
     ++stats_.sphere_tests;
-    const double reach = s1.radius + r2 + slack;
-    if (length_squared(s1.center - c2) > reach * reach) continue;
+    if (!spheres_meet(s1, s2, slack)) continue;
 
     const bool leaf1 = tissue_links[pair.tissue].left == SphereTree::kNoNode;
     const bool leaf2 = tool_links[pair.tool].left == SphereTree::kNoNode;
@@ -161,14 +185,31 @@ bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue
         l2_stamp_[pair.tool] = stamp_;
         l2_[l2_count_++] = pair.tool;
       }
-      test_triangles(tissue, tool, tissue_tree.pieces()[pair.tissue].triangle, tool_tree.pieces()[pair.tool].triangle);
+      const LeafPiece& a = tissue_pieces[pair.tissue];
+      const LeafPiece& b = tool_pieces[pair.tool];
+      // A triangle pair can meet through several leaf pairs only when a triangle has several
+      // leaves; with one side sliced it is tested at that side's first meeting leaf, and only
+      // when both are sliced does the table of tested pairs decide.
+      if (a.slices > 1 && b.slices > 1) {
+        test_triangles(tissue, a.triangle, b.triangle, true);
+      } else if (b.slices > 1) {
+        if (first_meeting_leaf<false>(tool_tree, tool_spheres, b.triangle, pair.tool, s1, slack)) {
+          test_triangles(tissue, a.triangle, b.triangle, false);
+        }
+      } else if (a.slices > 1) {
+        if (first_meeting_leaf<true>(tissue_tree, tissue_spheres, a.triangle, pair.tissue, s2, slack)) {
+          test_triangles(tissue, a.triangle, b.triangle, false);
+        }
+      } else {
+        test_triangles(tissue, a.triangle, b.triangle, false);
+      }
       continue;
     }
     // Steps 11-17: open the non-leaf sphere, or the larger when neither is a leaf.
-    if (!leaf1 && (leaf2 || s1.radius >= r2)) {
+    if (!leaf1 && (leaf2 || s1.radius >= s2.radius)) {
       std::int32_t near = tissue_links[pair.tissue].left;
       std::int32_t far = tissue_links[pair.tissue].right;
-      if (length_squared(tissue_spheres[far].center - c2) < length_squared(tissue_spheres[near].center - c2)) {
+      if (length_squared(tissue_spheres[far].center - s2.center) < length_squared(tissue_spheres[near].center - s2.center)) {
         std::swap(near, far);
       }
       stack_[top++] = {far, pair.tool};
@@ -176,8 +217,7 @@ bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue
     } else {
       std::int32_t near = tool_links[pair.tool].left;
       std::int32_t far = tool_links[pair.tool].right;
-      if (length_squared(tool_center(tool_tree, far) - s1.center) <
-          length_squared(tool_center(tool_tree, near) - s1.center)) {
+      if (length_squared(tool_spheres[far].center - s1.center) < length_squared(tool_spheres[near].center - s1.center)) {
         std::swap(near, far);
       }
       stack_[top++] = {pair.tissue, far};

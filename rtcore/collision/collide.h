@@ -69,20 +69,20 @@ class Collider {
     std::int32_t tool;
   };
   void prepare(const SphereTree& tissue_tree, const SphereTree& tool_tree, const TriangleMesh& tool);
-  const Vec3& tool_center(const SphereTree& tool_tree, std::int32_t node);
-  const Vec3& tool_vertex(const TriangleMesh& tool, std::uint32_t v);
   bool first_test_of(std::uint32_t tissue_triangle, std::uint32_t tool_triangle);
-  void test_triangles(const TriangleMesh& tissue, const TriangleMesh& tool, std::uint32_t a, std::uint32_t b);
+  void test_triangles(const TriangleMesh& tissue, std::uint32_t a, std::uint32_t b, bool may_repeat);
   void next_stamp();
 
   RigidTransform pose_;
   double radius_scale_ = 1.0;  // bounds how much the pose's matrix can stretch a tool sphere
   std::uint32_t stamp_ = 0;    // per-query mark: an entry is set for this query when it equals stamp_
 
-  std::vector<Vec3> tool_centers_;  // tool node centres in the world, filled on first use
-  std::vector<std::uint32_t> tool_center_stamp_;
-  std::vector<Vec3> tool_vertices_;  // tool vertices in the world, filled on first use
-  std::vector<std::uint32_t> tool_vertex_stamp_;
+  // The tool placed in the world once per query (its tree is small): node spheres, vertices, and
+  // each triangle's box for the exact prefilter ahead of the triangle test.
+  std::vector<Sphere> tool_spheres_;
+  std::vector<Vec3> tool_vertices_;
+  std::vector<Aabb> tool_boxes_;
+  const TriangleMesh* tool_mesh_ = nullptr;
   std::vector<std::uint32_t> l1_stamp_;
   std::vector<std::uint32_t> l2_stamp_;
   std::vector<std::int32_t> l1_;

@@ -49,9 +49,41 @@ Sphere sphere_around(const std::array<Vec3, N>& points) {
   return inflated(best.center, best.radius);
 }
 
+// A tight sphere around a triangle, O(1): the sphere on its longest edge when that holds the third
+// corner (an obtuse or right triangle: then it is the smallest), else the circumsphere. The radius
+// is measured from the rounded centre to every corner, so rounding can only loosen, never uncover.
+Sphere triangle_sphere(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double ab = length_squared(b - a);
+  const double bc = length_squared(c - b);
+  const double ca = length_squared(a - c);
+  Vec3 center;
+  // The longest edge's midpoint, and the corner opposite it.
+  const Vec3* far = &c;
+  center = 0.5 * (a + b);
+  double half2 = 0.25 * ab;
+  if (bc >= ab && bc >= ca) {
+    center = 0.5 * (b + c), half2 = 0.25 * bc, far = &a;
+  } else if (ca >= ab && ca >= bc) {
+    center = 0.5 * (c + a), half2 = 0.25 * ca, far = &b;
+  }
+  if (length_squared(*far - center) > half2) {
+    const Vec3 u = b - a;
+    const Vec3 v = c - a;
+    const Vec3 w = cross(u, v);
+    const double w2 = length_squared(w);
+    if (w2 > 0.0) center = a + (cross(w, u) * length_squared(v) + cross(v, w) * length_squared(u)) / (2.0 * w2);
+  }
+  const double r2 = std::max({length_squared(a - center), length_squared(b - center), length_squared(c - center)});
+  return inflated(center, std::sqrt(r2));
+}
+
 }  // namespace
 
 int SphereTree::slice_count(const TriangleMesh& mesh, std::uint32_t t, std::uint8_t& apex) {
+  return slice_count(mesh, t, apex, kSliceAspect);
+}
+
+int SphereTree::slice_count(const TriangleMesh& mesh, std::uint32_t t, std::uint8_t& apex, double aspect) {
   const Triangle& tri = mesh.triangles[t];
   const std::array<Vec3, 3> v{mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]]};
   // The edge opposite vertex i runs from v[i+1] to v[i+2]; slabs are cut parallel to the shortest.
@@ -66,7 +98,7 @@ int SphereTree::slice_count(const TriangleMesh& mesh, std::uint32_t t, std::uint
   const Vec3 base = v[(apex + 2) % 3] - v[(apex + 1) % 3];
   if (!(shortest > 0.0)) return 1;
   const double height = length(cross(base, v[apex] - v[(apex + 1) % 3])) / shortest;
-  const double slices = std::ceil(height / (kSliceAspect * shortest));
+  const double slices = std::ceil(height / (aspect * shortest));
   return static_cast<int>(std::clamp(slices, 1.0, static_cast<double>(kMaxSlices)));
 }
 
@@ -75,7 +107,7 @@ Sphere SphereTree::piece_sphere(const TriangleMesh& mesh, const LeafPiece& piece
   const Vec3& b = mesh.positions[tri[piece.apex]];
   const Vec3& x = mesh.positions[tri[(piece.apex + 1) % 3]];
   const Vec3& y = mesh.positions[tri[(piece.apex + 2) % 3]];
-  if (piece.slices == 1) return sphere_around(std::array<Vec3, 3>{b, x, y});
+  if (piece.slices == 1) return triangle_sphere(b, x, y);
   // The slab between the lines at t0 and t1 (t: the weight of the apex) is the hull of these four.
   const double t0 = static_cast<double>(piece.slice) / piece.slices;
   const double t1 = static_cast<double>(piece.slice + 1) / piece.slices;
@@ -115,7 +147,7 @@ void SphereTree::add_triangle_leaves(const TriangleMesh& mesh, std::uint32_t t, 
   if (first_leaf_.size() <= t) first_leaf_.resize(t + 1, kNoNode);
   assert(first_leaf_[t] == kNoNode && "triangle already in the tree");
   std::uint8_t apex = 0;
-  const int slices = slice_count(mesh, t, apex);
+  const int slices = slice_count(mesh, t, apex, slice_aspect_);
   for (int s = slices - 1; s >= 0; --s) {  // pushed front-first so the chain runs slice 0, 1, ...
     const std::int32_t leaf = allocate_node();
     pieces_[leaf] = {t, static_cast<std::uint16_t>(s), static_cast<std::uint16_t>(slices), apex};
@@ -260,7 +292,8 @@ void SphereTree::refit_upward(std::int32_t node) {
 }
 
 void SphereTree::update_refit_order() {
-  refit_order_.clear();
+  refit_leaves_.clear();
+  refit_internal_.clear();
   if (root_ == kNoNode) return;
   // Pre-order with the right child visited first, reversed: every child precedes its parent.
   stack_.clear();
@@ -268,26 +301,28 @@ void SphereTree::update_refit_order() {
   while (!stack_.empty()) {
     const std::int32_t node = stack_.back();
     stack_.pop_back();
-    refit_order_.push_back(node);
-    if (!is_leaf(node)) {
+    if (is_leaf(node)) {
+      refit_leaves_.push_back(node);
+    } else {
+      refit_internal_.push_back(node);
       stack_.push_back(links_[node].left);
       stack_.push_back(links_[node].right);
     }
   }
-  std::reverse(refit_order_.begin(), refit_order_.end());
+  std::reverse(refit_internal_.begin(), refit_internal_.end());
+  // Leaves in node order: the sweep over them reads the node arrays front to back.
+  std::sort(refit_leaves_.begin(), refit_leaves_.end());
   order_dirty_ = false;
 }
 
 void SphereTree::refit(const TriangleMesh& mesh) {
   if (order_dirty_) update_refit_order();
-  // Children before parents (the order above), so each merge reads refitted children.
-  for (const std::int32_t node : refit_order_) {
-    if (is_leaf(node)) {
-      spheres_[node] = piece_sphere(mesh, pieces_[node]);
-    } else {
-      const SphereTreeLinks& l = links_[node];
-      spheres_[node] = merge(spheres_[l.left], spheres_[l.right]);
-    }
+  // Leaves from their triangles' corners, then one bottom-up pass of O(1) merges: each internal
+  // sphere is the smallest holding its two children's, so every leaf below stays covered.
+  for (const std::int32_t leaf : refit_leaves_) spheres_[leaf] = piece_sphere(mesh, pieces_[leaf]);
+  for (const std::int32_t node : refit_internal_) {
+    const SphereTreeLinks& l = links_[node];
+    spheres_[node] = merge(spheres_[l.left], spheres_[l.right]);
   }
 }
 

@@ -50,9 +50,14 @@ class SphereTree {
  public:
   static constexpr std::int32_t kNoNode = -1;
   /// A triangle whose slab across its shortest edge is longer than this many times that edge is
-  /// split into more leaves (at most kMaxSlices).
-  static constexpr double kSliceAspect = 1.0;
+  /// split into more leaves (at most kMaxSlices). Compact triangles keep one tight leaf each; only
+  /// genuinely long thin ones (the sheath's side strips) are cut, into slabs this elongated.
+  static constexpr double kSliceAspect = 3.0;
   static constexpr int kMaxSlices = 256;
+
+  /// The slab aspect used by later builds and insertions (kSliceAspect unless changed; >= 1).
+  void set_slice_aspect(double aspect) { slice_aspect_ = aspect < 1.0 ? 1.0 : aspect; }
+  double slice_aspect() const { return slice_aspect_; }
 
   /// Builds top-down over every triangle of `mesh`, splitting at the middle of the principal
   /// component of the leaf centres (median split when one side would be empty).
@@ -102,6 +107,8 @@ class SphereTree {
   static Sphere piece_sphere(const TriangleMesh& mesh, const LeafPiece& piece);
   /// The pieces a triangle is covered by.
   static int slice_count(const TriangleMesh& mesh, std::uint32_t t, std::uint8_t& apex);
+  /// The same for slabs of a given aspect (kSliceAspect above).
+  static int slice_count(const TriangleMesh& mesh, std::uint32_t t, std::uint8_t& apex, double aspect);
 
  private:
   std::int32_t allocate_node();
@@ -120,13 +127,15 @@ class SphereTree {
   std::vector<LeafPiece> pieces_;       // per node (leaves only)
   std::vector<std::int32_t> next_leaf_;   // per node: next leaf of the same triangle
   std::vector<std::int32_t> first_leaf_;  // per triangle
-  std::vector<std::int32_t> refit_order_;  // children before parents; rebuilt when topology changes
+  std::vector<std::int32_t> refit_leaves_;    // every live leaf, in node order
+  std::vector<std::int32_t> refit_internal_;  // internal nodes, children before parents
   std::vector<std::int32_t> stack_;        // scratch for update_refit_order
   std::int32_t root_ = kNoNode;
   std::int32_t free_list_ = kNoNode;
   std::int32_t leaf_count_ = 0;
   std::int32_t live_nodes_ = 0;
   bool order_dirty_ = true;
+  double slice_aspect_ = kSliceAspect;
   double built_mean_internal_radius_ = 0.0;
 };
 

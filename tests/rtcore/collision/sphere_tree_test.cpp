@@ -45,8 +45,9 @@ TEST(SphereTree, LeavesCoverEveryTriangleAndThinStripsGetSeveral) {
     }
     most_leaves = std::max(most_leaves, leaves);
   }
-  // A 120 mm x 1.4 mm side strip: dozens of leaves, each far smaller than the strip.
-  EXPECT_GE(most_leaves, 40);
+  // A 120 mm side strip: a row of slabs (SphereTree::kSliceAspect times as long as wide), each far
+  // smaller than the strip; compact triangles (the caps, the loop) keep one leaf.
+  EXPECT_GE(most_leaves, 10);
   double largest_leaf = 0.0;
   for (std::int32_t n = 0; n < tree.node_capacity(); ++n) {
     if (tree.is_leaf(n)) largest_leaf = std::max(largest_leaf, tree.spheres()[n].radius);
