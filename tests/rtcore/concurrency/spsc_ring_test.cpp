@@ -74,7 +74,7 @@ struct StressItem {
 };
 
 TEST(SpscRing, TwoThreadStressLosesAndReordersNothing) {
-  constexpr std::uint64_t kItems = 4'000'000;
+  constexpr std::uint64_t kItems = 2'000'000;
   SpscRing<StressItem> ring(256);  // small, so both the full and the empty paths run often
   std::uint64_t producer_full_retries = 0;
 
