@@ -37,10 +37,13 @@ struct Clock {
 };
 
 // --slice-aspect X: the leaves' slab aspect for both trees (tuning; SphereTree::kSliceAspect if 0).
+// --tool-slice-aspect X: the same for the tool's tree alone.
 double g_slice_aspect = 0.0;
+double g_tool_slice_aspect = 0.0;
 
-void configure(SphereTree& tree) {
+void configure(SphereTree& tree, bool tool = false) {
   if (g_slice_aspect > 0.0) tree.set_slice_aspect(g_slice_aspect);
+  if (tool && g_tool_slice_aspect > 0.0) tree.set_slice_aspect(g_tool_slice_aspect);
 }
 
 double elapsed_us(double start_us) { return Clock::now() - start_us; }
@@ -156,6 +159,8 @@ struct Row {
   double remove_us = 0;
   double sphere_tests = 0;
   double triangle_tests = 0;
+  double leaf_pairs = 0;
+  int tissue_leaves = 0;
 };
 
 Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, const SphereTree& tool_tree,
@@ -169,12 +174,12 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
   configure(tissue_tree);
   tissue_tree.build(tissue);
   Collider collider;
-  collider.reserve(1 << 16, 1 << 19);
+  collider.reserve(1 << 16, 1 << 16);
 
   // Our query: every pose, `repetitions` times; the median over all.
   std::vector<double> ours;
   std::vector<std::vector<TrianglePair>> ours_found(poses.size());
-  double sphere_tests = 0, triangle_tests = 0;
+  double sphere_tests = 0, triangle_tests = 0, leaf_pairs = 0;
   for (int r = 0; r < repetitions; ++r) {
     for (std::size_t p = 0; p < poses.size(); ++p) {
       const auto start = Clock::now();
@@ -184,12 +189,15 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
         ours_found[p].assign(collider.pairs().begin(), collider.pairs().end());
         sphere_tests += static_cast<double>(collider.stats().sphere_tests);
         triangle_tests += static_cast<double>(collider.stats().triangle_tests);
+        leaf_pairs += static_cast<double>(collider.stats().leaf_pairs);
       }
     }
   }
   row.ours_us = median(ours);
   row.sphere_tests = sphere_tests / static_cast<double>(poses.size());
   row.triangle_tests = triangle_tests / static_cast<double>(poses.size());
+  row.leaf_pairs = leaf_pairs / static_cast<double>(poses.size());
+  row.tissue_leaves = tissue_tree.leaf_count();
   for (const auto& f : ours_found) row.ours_pairs += f.size();
 
   // FCL OBBRSS, all contacts.
@@ -284,28 +292,28 @@ int run_table(int repetitions, int only_size) {
   sizes.emplace_back(138240, 0.0);
   const TriangleMesh tool = combined_resectoscope_mesh(generate_resectoscope());
   SphereTree tool_tree;
-  configure(tool_tree);
+  configure(tool_tree, true);
   tool_tree.build(tool);
   const auto poses = benchmark_poses();
   std::printf("collision benchmark: resectoscope %zu triangles (%d leaf spheres), %zu poses pressing into the wall, "
               "median of %d repetitions of every pose\n",
               tool.triangle_count(), tool_tree.leaf_count(), poses.size(), repetitions);
-  std::printf("%8s %8s | %9s %9s | %9s %7s | %9s %7s | %7s %7s %6s %6s %5s | %8s %8s %6s | %6s %6s | %8s %7s\n", "tissue",
+  std::printf("%8s %8s | %9s %9s | %9s %7s | %9s %7s | %7s %7s %6s %6s %5s | %8s %8s %6s | %6s %6s | %8s %7s %7s %6s\n", "tissue",
               "paper", "ours", "ours", "FCL", "FCL/", "brute", "brute/", "pairs", "pairs", "FCL", "FCL", "brute", "refit",
-              "FCL", "FCL/", "insert", "remove", "sphere", "tri");
-  std::printf("%8s %8s | %9s %9s | %9s %7s | %9s %7s | %7s %7s %6s %6s %5s | %8s %8s %6s | %6s %6s | %8s %7s\n", "tris",
+              "FCL", "FCL/", "insert", "remove", "sphere", "leaf", "tri", "tissue");
+  std::printf("%8s %8s | %9s %9s | %9s %7s | %9s %7s | %7s %7s %6s %6s %5s | %8s %8s %6s | %6s %6s | %8s %7s %7s %6s\n", "tris",
               "Hz", "us", "Hz", "OBBRSS us", "ours", "us", "ours", "ours", "FCL", "miss", "extra", "diff", "ours us",
-              "AABB us", "ours", "us", "us", "tests", "tests");
+              "AABB us", "ours", "us", "us", "tests", "pairs", "tests", "leaves");
   for (const auto& [triangles, paper_hz] : sizes) {
     if (only_size > 0 && triangles != only_size) continue;
     const Row row = measure(triangles, paper_hz, tool, tool_tree, poses, triangles > 40000 ? 3 : repetitions, true);
     char paper[16];
     if (paper_hz > 0) std::snprintf(paper, sizeof paper, "%.2f", paper_hz); else std::snprintf(paper, sizeof paper, "-");
-    std::printf("%8d %8s | %9.1f %9.0f | %9.1f %7.1f | %9.1f %7.1f | %7zu %7zu %6zu %6zu %5zu | %8.1f %8.1f %6.1f | %6.2f %6.2f | %8.0f %7.0f\n",
+    std::printf("%8d %8s | %9.1f %9.0f | %9.1f %7.1f | %9.1f %7.1f | %7zu %7zu %6zu %6zu %5zu | %8.1f %8.1f %6.1f | %6.2f %6.2f | %8.0f %7.0f %7.0f %6d\n",
                 row.triangles, paper, row.ours_us, 1e6 / row.ours_us, row.fcl_us, row.fcl_us / row.ours_us, row.brute_us,
                 row.brute_us / row.ours_us, row.ours_pairs, row.fcl_pairs, row.fcl_missing, row.fcl_extra, row.brute_mismatch,
                 row.refit_us, row.fcl_refit_us, row.fcl_refit_us / row.refit_us, row.insert_us, row.remove_us, row.sphere_tests,
-                row.triangle_tests);
+                row.leaf_pairs, row.triangle_tests, row.tissue_leaves);
     std::fflush(stdout);
   }
   std::printf("pairs: summed over the poses; FCL miss/extra: pairs we found that FCL did not / the reverse; brute diff: "
@@ -342,6 +350,7 @@ int main(int argc, char** argv) {
       benchmark::RunSpecifiedBenchmarks();
       return 0;
     }
+    if (std::strcmp(argv[i], "--tool-slice-aspect") == 0 && i + 1 < argc) g_tool_slice_aspect = std::atof(argv[++i]);
     if (std::strcmp(argv[i], "--slice-aspect") == 0 && i + 1 < argc) g_slice_aspect = std::atof(argv[++i]);
     if (std::strcmp(argv[i], "--size") == 0 && i + 1 < argc) only_size = std::atoi(argv[++i]);
     if (std::strcmp(argv[i], "--repetitions") == 0 && i + 1 < argc) repetitions = std::max(1, std::atoi(argv[++i]));

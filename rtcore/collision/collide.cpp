@@ -27,10 +27,14 @@ double stretch_bound(const RigidTransform& pose) {
   return std::sqrt(worst_row) * (1.0 + 1e-12);
 }
 
-// The descent's one sphere test (tissue sphere, tool sphere in the world): every caller rounds alike.
-bool spheres_meet(const Sphere& tissue, const Sphere& tool, double slack) {
-  const double reach = tissue.radius + tool.radius + slack;
-  return length_squared(tissue.center - tool.center) <= reach * reach;
+// The descent's one sphere test, on the squared distance between the centres of a tissue sphere
+// and a tool sphere in the world (tissue minus tool): every caller rounds alike.
+inline bool within_reach(double distance2, double tissue_radius, double tool_radius, double slack) {
+  const double reach = tissue_radius + tool_radius + slack;
+  return distance2 <= reach * reach;
+}
+inline bool spheres_meet(const Sphere& tissue, const Sphere& tool, double slack) {
+  return within_reach(length_squared(tissue.center - tool.center), tissue.radius, tool.radius, slack);
 }
 
 // True when `leaf` is the first leaf of its triangle (chain order) whose sphere meets `other`.
@@ -45,21 +49,21 @@ bool first_meeting_leaf(const SphereTree& tree, const Sphere* spheres, std::uint
   return true;
 }
 
+constexpr bool kTableForSlices = false;
+
 }  // namespace
 
 void Collider::reserve(std::int32_t max_pairs, std::int32_t max_tested_pairs) {
   pairs_.resize(static_cast<std::size_t>(std::max(max_pairs, 1)));
   std::size_t table = 64;
   while (table < 2 * static_cast<std::size_t>(std::max(max_tested_pairs, 1))) table *= 2;
-  tested_keys_.assign(table, 0);
-  tested_stamp_.assign(table, 0);
+  tested_.assign(table, TestedSlot{});
 }
 
 void Collider::next_stamp() {
   if (++stamp_ == 0) {  // wrapped: forget every old mark once
-    for (auto* marks : {&l1_stamp_, &l2_stamp_, &tested_stamp_}) {
-      std::fill(marks->begin(), marks->end(), 0u);
-    }
+    for (auto* marks : {&l1_stamp_, &l2_stamp_}) std::fill(marks->begin(), marks->end(), 0u);
+    std::fill(tested_.begin(), tested_.end(), TestedSlot{});
     stamp_ = 1;
   }
 }
@@ -76,23 +80,24 @@ void Collider::prepare(const SphereTree& tissue_tree, const SphereTree& tool_tre
   l2_stamp_.resize(tool_nodes, 0);
   l2_.resize(tool_nodes);
   const std::int32_t heights = tissue_tree.links()[tissue_tree.root()].height + tool_tree.links()[tool_tree.root()].height;
-  stack_.resize(static_cast<std::size_t>(heights) + 2);
+  // Depth-first: at most one pending sibling per level, plus the two slots a node's children are
+  // written to before it is known which are kept.
+  stack_.resize(static_cast<std::size_t>(heights) + 4);
 }
 
 bool Collider::first_test_of(std::uint32_t tissue_triangle, std::uint32_t tool_triangle) {
   const std::uint64_t key = (static_cast<std::uint64_t>(tissue_triangle) << 32) | tool_triangle;
-  const std::size_t mask = tested_keys_.size() - 1;
-  if (2 * (tested_count_ + 1) > tested_keys_.size()) {
+  const std::size_t mask = tested_.size() - 1;
+  if (2 * (tested_count_ + 1) > tested_.size()) {
     overflowed_ = true;  // table too full to probe: test again rather than risk a lost pair
     return true;
   }
   std::size_t slot = static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask;
-  while (tested_stamp_[slot] == stamp_) {
-    if (tested_keys_[slot] == key) return false;
+  while (tested_[slot].stamp == stamp_) {
+    if (tested_[slot].key == key) return false;
     slot = (slot + 1) & mask;
   }
-  tested_stamp_[slot] = stamp_;
-  tested_keys_[slot] = key;
+  tested_[slot] = {key, stamp_};
   ++tested_count_;
   return true;
 }
@@ -162,20 +167,29 @@ bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue
   const SphereTreeLinks* tool_links = tool_tree.links().data();
   const LeafPiece* tool_pieces = tool_tree.pieces().data();
 
-  // Depth-first with an explicit stack; children are pushed farther first so the closer one is
-  // walked first (Figure 11). The walk order depends only on the trees and the pose: deterministic.
+  // Depth-first with an explicit stack of pairs whose spheres are known to meet: a node opened
+  // has both children tested at once, and those that meet are pushed farther first, so the
+  // closer is walked first (Figure 11); the distance that orders them is the one that tests them.
+  // The walk order depends only on the trees and the pose: deterministic.
+  std::int64_t sphere_tests = 1;
+  std::int64_t leaf_pairs = 0;
+  if (!spheres_meet(tissue_spheres[tissue_tree.root()], tool_spheres[tool_tree.root()], slack)) {
+    stats_.sphere_tests = sphere_tests;
+    return true;
+  }
+  NodePair* const stack = stack_.data();
   std::size_t top = 0;
-  stack_[top++] = {tissue_tree.root(), tool_tree.root()};
+  stack[top++] = {tissue_tree.root(), tool_tree.root()};
   while (top > 0) {
-    const NodePair pair = stack_[--top];
+    const NodePair pair = stack[--top];
     const Sphere& s1 = tissue_spheres[pair.tissue];
     const Sphere& s2 = tool_spheres[pair.tool];
-    ++stats_.sphere_tests;
-    if (!spheres_meet(s1, s2, slack)) continue;
-
-    const bool leaf1 = tissue_links[pair.tissue].left == SphereTree::kNoNode;
-    const bool leaf2 = tool_links[pair.tool].left == SphereTree::kNoNode;
+    const SphereTreeLinks& links1 = tissue_links[pair.tissue];
+    const SphereTreeLinks& links2 = tool_links[pair.tool];
+    const bool leaf1 = links1.left == SphereTree::kNoNode;
+    const bool leaf2 = links2.left == SphereTree::kNoNode;
     if (leaf1 && leaf2) {
+      ++leaf_pairs;
       // Steps 4-9: both leaves. Each goes into its list once (the flags make that O(1)).
       if (l1_stamp_[pair.tissue] != stamp_) {
         l1_stamp_[pair.tissue] = stamp_;
@@ -190,7 +204,7 @@ bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue
       // A triangle pair can meet through several leaf pairs only when a triangle has several
       // leaves; with one side sliced it is tested at that side's first meeting leaf, and only
       // when both are sliced does the table of tested pairs decide.
-      if (a.slices > 1 && b.slices > 1) {
+      if (kTableForSlices ? (a.slices > 1 || b.slices > 1) : (a.slices > 1 && b.slices > 1)) {
         test_triangles(tissue, a.triangle, b.triangle, true);
       } else if (b.slices > 1) {
         if (first_meeting_leaf<false>(tool_tree, tool_spheres, b.triangle, pair.tool, s1, slack)) {
@@ -205,25 +219,41 @@ bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue
       }
       continue;
     }
+    sphere_tests += 2;
     // Steps 11-17: open the non-leaf sphere, or the larger when neither is a leaf.
     if (!leaf1 && (leaf2 || s1.radius >= s2.radius)) {
-      std::int32_t near = tissue_links[pair.tissue].left;
-      std::int32_t far = tissue_links[pair.tissue].right;
-      if (length_squared(tissue_spheres[far].center - s2.center) < length_squared(tissue_spheres[near].center - s2.center)) {
-        std::swap(near, far);
-      }
-      stack_[top++] = {far, pair.tool};
-      stack_[top++] = {near, pair.tool};
+      const std::int32_t near = links1.left;
+      const std::int32_t far = links1.right;
+      const double d_near = length_squared(tissue_spheres[near].center - s2.center);
+      const double d_far = length_squared(tissue_spheres[far].center - s2.center);
+      const bool swap = d_far < d_near;
+      const std::int32_t first = swap ? far : near;
+      const std::int32_t second = swap ? near : far;
+      const bool meets_near = within_reach(swap ? d_far : d_near, tissue_spheres[first].radius, s2.radius, slack);
+      const bool meets_far = within_reach(swap ? d_near : d_far, tissue_spheres[second].radius, s2.radius, slack);
+      // Written always, kept only when they meet: no branch on an unpredictable outcome.
+      stack[top] = {second, pair.tool};
+      top += meets_far;
+      stack[top] = {first, pair.tool};
+      top += meets_near;
     } else {
-      std::int32_t near = tool_links[pair.tool].left;
-      std::int32_t far = tool_links[pair.tool].right;
-      if (length_squared(tool_spheres[far].center - s1.center) < length_squared(tool_spheres[near].center - s1.center)) {
-        std::swap(near, far);
-      }
-      stack_[top++] = {pair.tissue, far};
-      stack_[top++] = {pair.tissue, near};
+      const std::int32_t near = links2.left;
+      const std::int32_t far = links2.right;
+      const double d_near = length_squared(s1.center - tool_spheres[near].center);
+      const double d_far = length_squared(s1.center - tool_spheres[far].center);
+      const bool swap = d_far < d_near;
+      const std::int32_t first = swap ? far : near;
+      const std::int32_t second = swap ? near : far;
+      const bool meets_near = within_reach(swap ? d_far : d_near, s1.radius, tool_spheres[first].radius, slack);
+      const bool meets_far = within_reach(swap ? d_near : d_far, s1.radius, tool_spheres[second].radius, slack);
+      stack[top] = {pair.tissue, second};
+      top += meets_far;
+      stack[top] = {pair.tissue, first};
+      top += meets_near;
     }
   }
+  stats_.sphere_tests = sphere_tests;
+  stats_.leaf_pairs = leaf_pairs;
   // Sorted on the unique (tissue, tool) key: the same output whatever the walk order.
   std::sort(pairs_.begin(), pairs_.begin() + static_cast<std::ptrdiff_t>(pair_count_));
   return !overflowed_;

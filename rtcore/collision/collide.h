@@ -36,7 +36,8 @@ struct TrianglePair {
 /// Work counters of the last query.
 struct CollisionStats {
   std::int64_t sphere_tests = 0;
-  std::int64_t triangle_tests = 0;
+  std::int64_t leaf_pairs = 0;      ///< leaf pairs whose spheres met
+  std::int64_t triangle_tests = 0;  ///< exact triangle tests (after the box prefilter)
 };
 
 /// Runs the dual descent. Holds every buffer a query needs; after reserve() (or the first queries
@@ -90,8 +91,11 @@ class Collider {
   std::size_t l1_count_ = 0;
   std::size_t l2_count_ = 0;
 
-  std::vector<std::uint64_t> tested_keys_;  // open addressing: triangle pairs tested this query
-  std::vector<std::uint32_t> tested_stamp_;
+  struct TestedSlot {
+    std::uint64_t key = 0;    // (tissue triangle << 32) | tool triangle
+    std::uint32_t stamp = 0;  // the query that filled the slot
+  };
+  std::vector<TestedSlot> tested_;  // open addressing: triangle pairs tested this query
   std::size_t tested_count_ = 0;
   std::vector<TrianglePair> pairs_;
   std::size_t pair_count_ = 0;

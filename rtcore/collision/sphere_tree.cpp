@@ -12,13 +12,13 @@ namespace {
 
 // Rounding in a sphere's centre and radius is a few ulps; growing every radius by far more than
 // that (relative, plus a floor tied to the coordinates' magnitude) makes the cover conservative.
-Sphere inflated(const Vec3& center, double radius) {
+inline Sphere inflated(const Vec3& center, double radius) {
   const double magnitude = std::max({std::abs(center.x), std::abs(center.y), std::abs(center.z), radius});
   return {center, radius * (1.0 + 1e-12) + magnitude * 1e-15};
 }
 
 // The smallest sphere holding both spheres.
-Sphere merge(const Sphere& a, const Sphere& b) {
+inline Sphere merge(const Sphere& a, const Sphere& b) {
   const Vec3 offset = b.center - a.center;
   const double distance = length(offset);
   if (distance + b.radius <= a.radius) return a;
@@ -47,6 +47,15 @@ Sphere sphere_around(const std::array<Vec3, N>& points) {
     if (r < best.radius) best = {c, r};
   }
   return inflated(best.center, best.radius);
+}
+
+// The refit's leaf sphere for a whole triangle: centred on the centroid, radius to the farthest
+// corner. One square root and no division or branch: a shade looser than triangle_sphere (equal
+// for an equilateral triangle), and cheap enough for the per-tick refit of every leaf.
+inline Sphere centroid_sphere(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 center = (a + b + c) * (1.0 / 3.0);
+  const double r2 = std::max({length_squared(a - center), length_squared(b - center), length_squared(c - center)});
+  return inflated(center, std::sqrt(r2));
 }
 
 // A tight sphere around a triangle, O(1): the sphere on its longest edge when that holds the third
@@ -189,6 +198,7 @@ void SphereTree::build_over(const TriangleMesh& mesh, const std::vector<std::uin
   std::vector<std::int32_t> leaves(static_cast<std::size_t>(leaf_count_));
   for (std::int32_t i = 0; i < leaf_count_; ++i) leaves[i] = i;  // leaves were allocated first
   if (!leaves.empty()) root_ = build_range(leaves.data(), leaves.data() + leaves.size(), kNoNode);
+  renumber_depth_first();
   order_dirty_ = true;
   built_mean_internal_radius_ = quality().mean_internal_radius;
 }
@@ -259,6 +269,47 @@ std::int32_t SphereTree::build_range(std::int32_t* first, std::int32_t* last, st
   return node;
 }
 
+// Lays the nodes out in depth-first order, a left child right after its parent: the descent and
+// the refit then walk the arrays mostly forward instead of jumping between leaves and internals.
+void SphereTree::renumber_depth_first() {
+  if (root_ == kNoNode) return;
+  const std::size_t count = links_.size();
+  std::vector<std::int32_t> old_of;  // new index -> old index
+  old_of.reserve(count);
+  stack_.clear();
+  stack_.push_back(root_);
+  while (!stack_.empty()) {
+    const std::int32_t node = stack_.back();
+    stack_.pop_back();
+    old_of.push_back(node);
+    if (!is_leaf(node)) {
+      stack_.push_back(links_[node].right);
+      stack_.push_back(links_[node].left);
+    }
+  }
+  std::vector<std::int32_t> new_of(count, kNoNode);
+  for (std::size_t i = 0; i < old_of.size(); ++i) new_of[static_cast<std::size_t>(old_of[i])] = static_cast<std::int32_t>(i);
+  const auto remap = [&](std::int32_t n) { return n == kNoNode ? kNoNode : new_of[static_cast<std::size_t>(n)]; };
+  std::vector<Sphere> spheres(old_of.size());
+  std::vector<SphereTreeLinks> links(old_of.size());
+  std::vector<LeafPiece> pieces(old_of.size());
+  std::vector<std::int32_t> next_leaf(old_of.size());
+  for (std::size_t i = 0; i < old_of.size(); ++i) {
+    const auto o = static_cast<std::size_t>(old_of[i]);
+    spheres[i] = spheres_[o];
+    pieces[i] = pieces_[o];
+    next_leaf[i] = remap(next_leaf_[o]);
+    const SphereTreeLinks& l = links_[o];
+    links[i] = {remap(l.parent), remap(l.left), remap(l.right), l.height};
+  }
+  for (std::int32_t& leaf : first_leaf_) leaf = remap(leaf);
+  spheres_ = std::move(spheres);
+  links_ = std::move(links);
+  pieces_ = std::move(pieces);
+  next_leaf_ = std::move(next_leaf);
+  root_ = 0;
+}
+
 // The paper's rule: a node's sphere covers every leaf sphere below it directly, which is tighter
 // than covering the two child spheres; the smaller of the two covers is kept.
 void SphereTree::cover_leaves(std::int32_t node, const std::int32_t* first, const std::int32_t* last) {
@@ -295,23 +346,24 @@ void SphereTree::update_refit_order() {
   refit_leaves_.clear();
   refit_internal_.clear();
   if (root_ == kNoNode) return;
-  // Pre-order with the right child visited first, reversed: every child precedes its parent.
-  stack_.clear();
-  stack_.push_back(root_);
-  while (!stack_.empty()) {
-    const std::int32_t node = stack_.back();
-    stack_.pop_back();
-    if (is_leaf(node)) {
-      refit_leaves_.push_back(node);
-    } else {
-      refit_internal_.push_back(node);
-      stack_.push_back(links_[node].left);
-      stack_.push_back(links_[node].right);
-    }
+  // Leaves in node order; internal nodes by height (a child is always lower than its parent), so
+  // the merges of one height are independent of each other and overlap in the pipeline.
+  std::int32_t tallest = 0;
+  for (std::int32_t n = 0; n < node_capacity(); ++n) {
+    const std::int32_t h = links_[n].height;
+    if (h == 0) refit_leaves_.push_back(n);
+    tallest = std::max(tallest, h);
   }
-  std::reverse(refit_internal_.begin(), refit_internal_.end());
-  // Leaves in node order: the sweep over them reads the node arrays front to back.
-  std::sort(refit_leaves_.begin(), refit_leaves_.end());
+  stack_.assign(static_cast<std::size_t>(tallest) + 2, 0);  // counting sort on the height
+  for (std::int32_t n = 0; n < node_capacity(); ++n) {
+    if (links_[n].height > 0) ++stack_[static_cast<std::size_t>(links_[n].height) + 1];
+  }
+  for (std::size_t h = 1; h < stack_.size(); ++h) stack_[h] += stack_[h - 1];
+  refit_internal_.resize(static_cast<std::size_t>(stack_.back()));
+  for (std::int32_t n = 0; n < node_capacity(); ++n) {
+    const std::int32_t h = links_[n].height;
+    if (h > 0) refit_internal_[static_cast<std::size_t>(stack_[static_cast<std::size_t>(h)]++)] = n;
+  }
   order_dirty_ = false;
 }
 
@@ -319,7 +371,15 @@ void SphereTree::refit(const TriangleMesh& mesh) {
   if (order_dirty_) update_refit_order();
   // Leaves from their triangles' corners, then one bottom-up pass of O(1) merges: each internal
   // sphere is the smallest holding its two children's, so every leaf below stays covered.
-  for (const std::int32_t leaf : refit_leaves_) spheres_[leaf] = piece_sphere(mesh, pieces_[leaf]);
+  for (const std::int32_t leaf : refit_leaves_) {
+    const LeafPiece& piece = pieces_[leaf];
+    if (piece.slices == 1) {
+      const Triangle& tri = mesh.triangles[piece.triangle];
+      spheres_[leaf] = centroid_sphere(mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]]);
+    } else {
+      spheres_[leaf] = piece_sphere(mesh, piece);
+    }
+  }
   for (const std::int32_t node : refit_internal_) {
     const SphereTreeLinks& l = links_[node];
     spheres_[node] = merge(spheres_[l.left], spheres_[l.right]);

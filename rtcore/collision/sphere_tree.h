@@ -55,8 +55,8 @@ class SphereTree {
   static constexpr double kSliceAspect = 3.0;
   static constexpr int kMaxSlices = 256;
 
-  /// The slab aspect used by later builds and insertions (kSliceAspect unless changed; >= 1).
-  void set_slice_aspect(double aspect) { slice_aspect_ = aspect < 1.0 ? 1.0 : aspect; }
+  /// The slab aspect used by later builds and insertions (kSliceAspect unless changed; >= 0.25).
+  void set_slice_aspect(double aspect) { slice_aspect_ = aspect < 0.25 ? 0.25 : aspect; }
   double slice_aspect() const { return slice_aspect_; }
 
   /// Builds top-down over every triangle of `mesh`, splitting at the middle of the principal
@@ -121,6 +121,7 @@ class SphereTree {
   void build_over(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles);
   void add_triangle_leaves(const TriangleMesh& mesh, std::uint32_t t, bool insert);
   void update_refit_order();
+  void renumber_depth_first();
 
   std::vector<Sphere> spheres_;         // hot: per node
   std::vector<SphereTreeLinks> links_;  // per node
