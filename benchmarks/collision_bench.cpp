@@ -161,6 +161,11 @@ struct Row {
   double triangle_tests = 0;
   double leaf_pairs = 0;
   int tissue_leaves = 0;
+  bool deformed_checked = false;       // the after-deformation comparison ran for this size
+  std::size_t deformed_pairs = 0;      // brute-force pairs on the deformed surface, summed over poses
+  std::size_t deformed_ours_missing = 0;
+  std::size_t deformed_fcl_missing = 0;  // FCL OBBRSS after its bottom-up refit
+  std::size_t deformed_fcl_extra = 0;
 };
 
 Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, const SphereTree& tool_tree,
@@ -253,13 +258,36 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
   row.refit_us = median(refit);
   row.fcl_refit_us = median(fcl_refit);
   // After the refit, still exact: the deformed surface against the poses, vs brute force.
+  // The same poses through FCL's OBBRSS tree built on the rest surface and refitted bottom-up to
+  // the deformed one (its update path), against brute force on the deformed surface.
   if (with_brute && target_triangles <= 8640) {
+    TriangleMesh rest_mesh = tissue;
+    rest_mesh.positions = rest;
+    auto fcl_refitted = fcl_model<fcl::OBBRSSd>(rest_mesh);
+    fcl_refitted->beginUpdateModel();
+    fcl_refitted->updateSubModel(moved);
+    fcl_refitted->endUpdateModel(true, true);
+    fcl::CollisionObjectd fcl_deformed(fcl_refitted);
+    fcl::CollisionObjectd fcl_tool_obj(fcl_model<fcl::OBBRSSd>(tool));
+    row.deformed_checked = true;
     for (const RigidTransform& pose : poses) {
       collider.collide(tissue_tree, tissue, tool_tree, tool, pose);
       const auto expected = collide_brute_force(tissue, tool, pose);
+      row.deformed_pairs += expected.size();
       if (!std::equal(collider.pairs().begin(), collider.pairs().end(), expected.begin(), expected.end())) {
         ++row.brute_mismatch;
       }
+      std::vector<TrianglePair> diff;
+      std::set_difference(expected.begin(), expected.end(), collider.pairs().begin(), collider.pairs().end(),
+                          std::back_inserter(diff));
+      row.deformed_ours_missing += diff.size();
+      const auto fcl_found = fcl_pairs<fcl::OBBRSSd>(fcl_deformed, fcl_tool_obj, pose, nullptr);
+      diff.clear();
+      std::set_difference(expected.begin(), expected.end(), fcl_found.begin(), fcl_found.end(), std::back_inserter(diff));
+      row.deformed_fcl_missing += diff.size();
+      diff.clear();
+      std::set_difference(fcl_found.begin(), fcl_found.end(), expected.begin(), expected.end(), std::back_inserter(diff));
+      row.deformed_fcl_extra += diff.size();
     }
   }
 
@@ -304,9 +332,11 @@ int run_table(int repetitions, int only_size) {
   std::printf("%8s %8s | %9s %9s | %9s %7s | %9s %7s | %7s %7s %6s %6s %5s | %8s %8s %6s | %6s %6s | %8s %7s %7s %6s\n", "tris",
               "Hz", "us", "Hz", "OBBRSS us", "ours", "us", "ours", "ours", "FCL", "miss", "extra", "diff", "ours us",
               "AABB us", "ours", "us", "us", "tests", "pairs", "tests", "leaves");
+  std::vector<Row> rows;
   for (const auto& [triangles, paper_hz] : sizes) {
     if (only_size > 0 && triangles != only_size) continue;
-    const Row row = measure(triangles, paper_hz, tool, tool_tree, poses, triangles > 40000 ? 3 : repetitions, true);
+    rows.push_back(measure(triangles, paper_hz, tool, tool_tree, poses, triangles > 40000 ? 3 : repetitions, true));
+    const Row& row = rows.back();
     char paper[16];
     if (paper_hz > 0) std::snprintf(paper, sizeof paper, "%.2f", paper_hz); else std::snprintf(paper, sizeof paper, "-");
     std::printf("%8d %8s | %9.1f %9.0f | %9.1f %7.1f | %9.1f %7.1f | %7zu %7zu %6zu %6zu %5zu | %8.1f %8.1f %6.1f | %6.2f %6.2f | %8.0f %7.0f %7.0f %6d\n",
@@ -318,6 +348,14 @@ int run_table(int repetitions, int only_size) {
   }
   std::printf("pairs: summed over the poses; FCL miss/extra: pairs we found that FCL did not / the reverse; brute diff: "
               "poses where our pairs differ from brute force (before and after the deformation refit; must be 0).\n");
+  std::printf("\nafter a smooth deformation of up to 1.5 mm and a refit (ours: SphereTree::refit; FCL: OBBRSS built at rest, "
+              "endUpdateModel(refit, bottom-up)), pairs vs brute force on the deformed surface, summed over the poses:\n");
+  std::printf("%8s | %8s | %12s | %12s %10s\n", "tissue", "brute", "ours missing", "FCL missing", "FCL extra");
+  for (const Row& row : rows) {
+    if (!row.deformed_checked) continue;
+    std::printf("%8d | %8zu | %12zu | %12zu %10zu\n", row.triangles, row.deformed_pairs, row.deformed_ours_missing,
+                row.deformed_fcl_missing, row.deformed_fcl_extra);
+  }
   return 0;
 }
 

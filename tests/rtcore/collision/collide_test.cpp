@@ -46,8 +46,11 @@ struct ProstateScene {
   TriangleMesh tool;
   SphereTree tissue_tree;
   SphereTree tool_tree;
-  explicit ProstateScene(int triangles) : prostate(generate_prostate(triangles)) {
+  explicit ProstateScene(int triangles, double slice_aspect = SphereTree::kSliceAspect)
+      : prostate(generate_prostate(triangles)) {
     tool = combined_resectoscope_mesh(generate_resectoscope());
+    tissue_tree.set_slice_aspect(slice_aspect);
+    tool_tree.set_slice_aspect(slice_aspect);
     tissue_tree.build(prostate.surface);
     tool_tree.build(tool);
   }
@@ -72,6 +75,21 @@ TEST(Collide, EqualsBruteForceOnTheGlandOverThousandsOfPoses) {
   // The poses must actually press the tool into the wall most of the time.
   EXPECT_GT(poses_with_pairs, poses / 2);
   EXPECT_GT(total_pairs, 10 * poses);
+}
+
+// Slabs as wide as long cut most tissue triangles too: a triangle pair then meets through several
+// leaf pairs on one side or both, and must still come out once (first meeting slab, or the table).
+TEST(Collide, EqualsBruteForceWhenBothTreesAreSlicedFinely) {
+  ProstateScene scene(1296, 1.0);
+  ASSERT_GT(scene.tissue_tree.leaf_count(), static_cast<std::int32_t>(scene.prostate.surface.triangle_count()));
+  Collider collider;
+  std::mt19937_64 rng(17);
+  for (int i = 0; i < 300; ++i) {
+    const RigidTransform pose = random_channel_pose(rng);
+    ASSERT_TRUE(collider.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
+    ASSERT_EQ(pairs_of(collider), collide_brute_force(scene.prostate.surface, scene.tool, pose)) << "pose " << i;
+    if (i % 20 == 0) expect_leaf_lists(collider, scene.tissue_tree, scene.tool_tree);
+  }
 }
 
 TEST(Collide, EqualsBruteForceOnALargerGlandWithTheLoopPressedIn) {

@@ -67,6 +67,14 @@ TEST(SphereTree, BuildIsBalancedAndDeterministic) {
   EXPECT_EQ(q.leaves, a.leaf_count());
   EXPECT_LE(q.height, 1.5 * std::log2(q.leaves) + 2) << "leaves " << q.leaves;
   EXPECT_FALSE(a.should_rebuild());
+  // Compact triangles keep one leaf each; the layout is depth-first (a left child follows its parent).
+  EXPECT_LT(a.leaf_count(), static_cast<std::int32_t>(gland.surface.triangle_count() * 5 / 4));
+  EXPECT_EQ(a.root(), 0);
+  for (std::int32_t n = 0; n < a.node_capacity(); ++n) {
+    if (!a.is_leaf(n)) {
+      ASSERT_EQ(a.links()[n].left, n + 1) << "node " << n;
+    }
+  }
   ASSERT_EQ(a.node_capacity(), b.node_capacity());
   for (std::int32_t n = 0; n < a.node_capacity(); ++n) {
     ASSERT_EQ(a.spheres()[n].center, b.spheres()[n].center);
