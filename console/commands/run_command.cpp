@@ -26,6 +26,7 @@ struct RunOptions {
   int collision_hz = 60;
   int substeps = 16;
   std::uint64_t seed = 1;
+  std::string calibration;
   bool json = false;
 };
 
@@ -45,6 +46,11 @@ void run(const RunOptions& o) {
   options.simulation.collision_hz = o.collision_hz;
   options.simulation.physics_per_collision = o.substeps;
   options.simulation.parameters = parameters_from_assignments(o.sets);
+  if (!o.calibration.empty()) {
+    Result<device::Calibration> calibration = device::read_calibration(o.calibration);
+    if (!calibration) throw std::runtime_error(calibration.error());
+    options.calibration = *calibration;
+  }
 
   Result<HeadlessResult> result = run_headless(options);
   if (!result) throw std::runtime_error(result.error());
@@ -73,6 +79,7 @@ void register_run(CLI::App& app) {
   cmd->add_option("--triangles", o->triangles, "Prostate surface triangles")->check(CLI::Range(200, 1000000))->capture_default_str();
   cmd->add_option("--collision-hz", o->collision_hz, "Collision steps per second")->check(CLI::Range(10, 1000))->capture_default_str();
   cmd->add_option("--substeps", o->substeps, "Physics steps per collision step")->check(CLI::Range(1, 64))->capture_default_str();
+  cmd->add_option("--calibration", o->calibration, "Device calibration file (default: the reference device's)");
   cmd->add_option("--seed", o->seed, "Seed of the emulated sensors' noise")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print the JSON report instead of the summary");
   cmd->callback([o] { run(*o); });

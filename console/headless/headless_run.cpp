@@ -110,7 +110,9 @@ std::string hex_hash(std::uint64_t hash) {
 }
 
 Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
-  Result<std::unique_ptr<Simulation>> created = Simulation::create(options.simulation);
+  SimulationConfig simulation = options.simulation;
+  simulation.gimbal = gimbal_geometry_from(options.calibration);
+  Result<std::unique_ptr<Simulation>> created = Simulation::create(simulation);
   if (!created) return Error{created.error()};
   Simulation& sim = **created;
   const SimulationConfig& config = sim.config();
@@ -125,7 +127,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   schedule.realtime = options.realtime;
   FixedStepScheduler scheduler(schedule);
 
-  const device::Calibration calibration = device::default_calibration();
+  const device::Calibration& calibration = options.calibration;
   SpscRing<DeviceSample> samples(4096);
   ToolInput tool_input;
   std::unique_ptr<LockstepDevice> lockstep;

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "device/calibration/calibration.h"
 #include "rtcore/base/result.h"
 #include "rtcore/core/simulation.h"
 #include "rtcore/scenes/procedure.h"
@@ -24,6 +25,9 @@ struct HeadlessOptions {
   std::uint64_t seed = 1;        ///< the emulator's sensor noise
   std::string trace_path;        ///< empty: no trace
   double consumer_delay_ms = 0;  ///< makes the snapshot consumer slow on purpose (tests)
+  /// The device's calibration: sensor conversion and the registration that places the gimbal in the
+  /// world (it replaces `simulation.gimbal`).
+  device::Calibration calibration = device::default_calibration();
 };
 
 /// Everything a run produced.
