@@ -10,6 +10,7 @@
 
 #include "console/commands/command_registry.h"
 #include "console/commands/parameter_options.h"
+#include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/base/units.h"
 #include "rtcore/tissue/indentation.h"
 
@@ -27,7 +28,7 @@ void run_indent(const IndentOptions& o) {
   IndentationOptions options;
   options.parameters = parameters_from_assignments(o.assignments);
   options.depth_m = units::mm_to_m(o.depth_mm);
-  Result<ProstateTissueModel> model = build_prostate_tissue_model(o.triangles);
+  Result<ProstateTissueModel> model = build_prostate_tissue_model(generate_prostate(o.triangles), generate_resectoscope().loop);
   if (!model) throw std::runtime_error(model.error());
   const IndentationResult r = run_indentation(*model, options);
   const double median_us = quantile(r.physics_step_us, 0.5), p99_us = quantile(r.physics_step_us, 0.99);

@@ -5,19 +5,19 @@
 #include <chrono>
 #include <cmath>
 
-#include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/tissue/tetrahedralize.h"
 
 namespace resecto {
 
-Result<ProstateTissueModel> build_prostate_tissue_model(int target_triangles) {
+Result<ProstateTissueModel> build_prostate_tissue_model(ProstateModel anatomy, TriangleMesh loop) {
   ProstateTissueModel model;
-  model.anatomy = generate_prostate(target_triangles);
+  model.anatomy = std::move(anatomy);
+  model.loop = std::move(loop);
   TetrahedralizeOptions options;
   options.capsule_thickness_m = model.anatomy.shape.capsule_thickness_m;
   options.channel_axis = {{0.0, 0.0, 0.0}, {0.0, 0.0, model.anatomy.shape.length_m}};
   Result<TetMesh> mesh = tetrahedralize(model.anatomy.surface, options);
-  if (!mesh) return Error{"prostate of " + std::to_string(target_triangles) + " triangles: " + mesh.error()};
+  if (!mesh) return Error{"prostate of " + std::to_string(model.anatomy.surface.triangle_count()) + " triangles: " + mesh.error()};
   model.mesh = std::move(*mesh);
   return model;
 }
@@ -50,7 +50,7 @@ double quantile(std::vector<double> samples, double q) {
 IndentationResult run_indentation(const ProstateTissueModel& model, const IndentationOptions& options) {
   using Clock = std::chrono::steady_clock;
   MassSpringTissue tissue(model.mesh, options.parameters, options.config);
-  const TriangleMesh loop = generate_resectoscope().loop;
+  const TriangleMesh& loop = model.loop;
   const int loop_part = tissue.tool().add_part(loop);
 
   IndentationResult result;

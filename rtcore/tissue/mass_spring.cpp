@@ -84,14 +84,15 @@ void MassSpringTissue::accumulate_forces(double h_s) {
     const std::uint32_t i = pairs[2 * s], j = pairs[2 * s + 1];
     const Vec3 d = x_[j] - x_[i];
     const double length = glm::length(d);
-    const Vec3 u = length > 0.0 ? d / length : Vec3(0.0);
+    const double inverse_length = length > 0.0 ? 1.0 / length : 0.0;
+    const Vec3 u = d * inverse_length;
     const double stretch = length - rest[s];
     const double k = spring_k_[s], c = spring_c_[s];
     const Vec3 f = (k * stretch + c * glm::dot(v_[j] - v_[i], u)) * u;
     force_[i] += f;
     force_[j] -= f;
     // The spring's Hessian blocks have norm k * max(1, |1 - L0/L|); each row holds two of them.
-    const double geometric = length > 0.0 ? std::abs(stretch) / length : 1.0;
+    const double geometric = length > 0.0 ? std::abs(stretch) * inverse_length : 1.0;
     const double row_k = 2.0 * k * std::max(1.0, geometric);
     stiffness_bound_[i] += row_k;
     stiffness_bound_[j] += row_k;
@@ -99,7 +100,7 @@ void MassSpringTissue::accumulate_forces(double h_s) {
     damping_bound_[j] += 2.0 * c;
     if (linearise) {
       spring_direction_[s] = u;
-      spring_transverse_k_[s] = length > 0.0 ? k * std::max(0.0, stretch / length) : 0.0;  // tension only: keeps K >= 0
+      spring_transverse_k_[s] = k * std::max(0.0, stretch * inverse_length);  // tension only: keeps K >= 0
     }
   }
   for (std::size_t a = 0; a < anchor_k_.size(); ++a) {

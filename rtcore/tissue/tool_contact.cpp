@@ -150,6 +150,18 @@ void ToolContacts::gather_triangles(const SphereTree& tree, const Vec3& p, doubl
   }
 }
 
+void ToolContacts::keep_within_margin(std::uint32_t first, const Vec3& p, const std::vector<Vec3>& positions,
+                                      const std::vector<Triangle>& triangles) {
+  // The sphere descent over-approximates; the substeps only need triangles really within the margin.
+  std::size_t kept = first;
+  for (std::size_t e = first; e < pair_count_; ++e) {
+    const Triangle& t = triangles[pair_triangles_[e]];
+    const Vec3 q = closest_point_on_triangle(p, positions[t[0]], positions[t[1]], positions[t[2]]);
+    if (glm::dot(p - q, p - q) <= margin_m_ * margin_m_) pair_triangles_[kept++] = pair_triangles_[e];
+  }
+  pair_count_ = kept;
+}
+
 void ToolContacts::update_candidates(const SphereTree& tissue_tree, const TriangleMesh& surface) {
   // Sized once for this tissue; a tissue whose size changes (resection) grows them at that step.
   if (node_stamp_.size() < surface.vertex_count()) node_stamp_.assign(surface.vertex_count(), 0);
@@ -185,7 +197,9 @@ void ToolContacts::update_candidates(const SphereTree& tissue_tree, const Triang
           continue;
         }
         const auto first = static_cast<std::uint32_t>(pair_count_);
-        gather_triangles(part.tree, to_tool_frame(part.pose, surface.positions[n]), search_radius, triangle_stamp_);
+        const Vec3 p = to_tool_frame(part.pose, surface.positions[n]);
+        gather_triangles(part.tree, p, search_radius, triangle_stamp_);
+        keep_within_margin(first, p, part.mesh.positions, part.mesh.triangles);
         if (pair_count_ > first) {
           node_candidates_[node_count_++] = {n, static_cast<std::uint16_t>(pi), first, static_cast<std::uint32_t>(pair_count_ - first)};
         }
@@ -203,7 +217,9 @@ void ToolContacts::update_candidates(const SphereTree& tissue_tree, const Triang
           continue;
         }
         const auto first = static_cast<std::uint32_t>(pair_count_);
-        gather_triangles(tissue_tree, transform_point(part.pose, part.mesh.positions[v]), search_radius, tissue_triangle_stamp_);
+        const Vec3 w = transform_point(part.pose, part.mesh.positions[v]);
+        gather_triangles(tissue_tree, w, search_radius, tissue_triangle_stamp_);
+        keep_within_margin(first, w, surface.positions, surface.triangles);
         if (pair_count_ > first) {
           vertex_candidates_[vertex_count_++] = {v, static_cast<std::uint16_t>(pi), first, static_cast<std::uint32_t>(pair_count_ - first)};
         }
@@ -233,10 +249,13 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
       best.offer(p, q, part.face_normals[pair_triangles_[e]], pair_triangles_[e]);
     }
     if (!(best.side < 0.0)) continue;
-    const double depth = std::sqrt(best.distance2);
-    // Out of the tool: from the node toward its closest surface point (the distance gradient).
-    const Vec3 out_tool = depth > 1e-12 ? (best.point - p) / depth : part.face_normals[best.triangle];
-    const Vec3 out = rotate(part.pose, out_tool);
+    // Along the closest face's normal, by the distance behind its plane: the signed distance's
+    // gradient there. (The closest-point direction would turn fast near the wire's centre line, a
+    // transverse stiffness no step bound sees.)
+    // Capped at the margin: a deeper "penetration" is a crushed or inverted face, not a contact to
+    // push ever harder on (that feedback is what blew up the stiffest corner of the sweep).
+    const double depth = std::min(-best.side, margin_m_);
+    const Vec3 out = rotate(part.pose, part.face_normals[best.triangle]);
     const Vec3 surface_world = transform_point(part.pose, best.point);
     const Vec3 surface_velocity = (surface_world - transform_point(part.previous_pose, best.point)) * inverse_h;
     const double separating_speed = glm::dot(v[pc.point] - surface_velocity, out);
@@ -263,10 +282,10 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
     }
     if (!(best.side < 0.0)) continue;
     const Triangle& t = surface_triangles[best.triangle];
-    const double depth = std::sqrt(best.distance2);
-    if (!(depth > 1e-12)) continue;
-    // Into the tissue: the surface point is pushed toward the tool vertex below it.
-    const Vec3 in = (w - best.point) / depth;
+    const double depth = std::min(-best.side, margin_m_);
+    // Into the tissue along the closest face's inward normal (the signed distance's gradient).
+    const Vec3 n2 = glm::cross(x[t[1]] - x[t[0]], x[t[2]] - x[t[0]]);
+    const Vec3 in = -n2 / glm::length(n2);
     const Vec3 weights = barycentric(best.point, x[t[0]], x[t[1]], x[t[2]]);
     const Vec3 tissue_velocity = weights[0] * v[t[0]] + weights[1] * v[t[1]] + weights[2] * v[t[2]];
     const Vec3 tool_velocity = (w - transform_point(part.previous_pose, part.mesh.positions[pc.point])) * inverse_h;

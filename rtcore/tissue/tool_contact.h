@@ -90,6 +90,9 @@ class ToolContacts {
   /// Appends the triangles of `tree` with a leaf sphere within `radius` of `point`, each once.
   void gather_triangles(const SphereTree& tree, const Vec3& point, double radius, std::vector<std::uint32_t>& seen);
   bool push_pair(std::uint32_t triangle);
+  /// Drops the pairs from `first` on whose triangle is further than the margin from `p`.
+  void keep_within_margin(std::uint32_t first, const Vec3& p, const std::vector<Vec3>& positions,
+                          const std::vector<Triangle>& triangles);
 
   double margin_m_;
   ToolContactCapacity capacity_;
