@@ -56,6 +56,18 @@ struct ProstateScene {
   }
 };
 
+// `poses` random channel poses: pairs equal brute force; the leaf lists checked every few poses.
+void expect_brute_force_over_poses(const ProstateScene& scene, std::uint64_t seed, int poses, int list_every) {
+  Collider collider;
+  std::mt19937_64 rng(seed);
+  for (int i = 0; i < poses; ++i) {
+    const RigidTransform pose = random_channel_pose(rng);
+    ASSERT_TRUE(collider.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
+    ASSERT_EQ(pairs_of(collider), collide_brute_force(scene.prostate.surface, scene.tool, pose)) << "pose " << i;
+    if (i % list_every == 0) expect_leaf_lists(collider, scene.tissue_tree, scene.tool_tree);
+  }
+}
+
 TEST(Collide, EqualsBruteForceOnTheGlandOverThousandsOfPoses) {
   ProstateScene scene(1296);
   Collider collider;
@@ -82,26 +94,12 @@ TEST(Collide, EqualsBruteForceOnTheGlandOverThousandsOfPoses) {
 TEST(Collide, EqualsBruteForceWhenBothTreesAreSlicedFinely) {
   ProstateScene scene(1296, 1.0);
   ASSERT_GT(scene.tissue_tree.leaf_count(), static_cast<std::int32_t>(scene.prostate.surface.triangle_count()));
-  Collider collider;
-  std::mt19937_64 rng(17);
-  for (int i = 0; i < 300; ++i) {
-    const RigidTransform pose = random_channel_pose(rng);
-    ASSERT_TRUE(collider.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
-    ASSERT_EQ(pairs_of(collider), collide_brute_force(scene.prostate.surface, scene.tool, pose)) << "pose " << i;
-    if (i % 20 == 0) expect_leaf_lists(collider, scene.tissue_tree, scene.tool_tree);
-  }
+  expect_brute_force_over_poses(scene, 17, 300, 20);
 }
 
 TEST(Collide, EqualsBruteForceOnALargerGlandWithTheLoopPressedIn) {
   ProstateScene scene(8640);
-  Collider collider;
-  std::mt19937_64 rng(11);
-  for (int i = 0; i < 60; ++i) {
-    const RigidTransform pose = random_channel_pose(rng);
-    ASSERT_TRUE(collider.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
-    ASSERT_EQ(pairs_of(collider), collide_brute_force(scene.prostate.surface, scene.tool, pose)) << "pose " << i;
-    expect_leaf_lists(collider, scene.tissue_tree, scene.tool_tree);
-  }
+  expect_brute_force_over_poses(scene, 11, 60, 1);
 }
 
 // Triangles on a coarse integer grid: shared vertices, shared edges, coplanar overlaps and pure
