@@ -3,10 +3,8 @@
 // statistics; `--json` ends with one summary object. `device calibrate` lives in its own file.
 #include <array>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <memory>
-#include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -25,6 +23,7 @@
 #include "resecto/lp3500_protocol.h"
 #include "rtcore/base/units.h"
 #ifdef RESECTO_HAVE_EMULATOR
+#include "device/input/sweep_motion.h"
 #include "device/transport/emulator_transport.h"
 #endif
 
@@ -103,22 +102,6 @@ struct MonitorOptions {
   HidOptions hid;
 };
 
-#ifdef RESECTO_HAVE_EMULATOR
-/// A hand that sweeps every axis slowly, presses the loop out and back, and cuts while it extends:
-/// something to watch on the monitor without a device.
-firmware::MotionState demo_motion(std::uint64_t time_us) {
-  const double t = static_cast<double>(time_us) * 1e-6;
-  const double two_pi = 2.0 * std::numbers::pi;
-  firmware::MotionState m;
-  m.yaw_rad = 0.15 * std::sin(two_pi * 0.2 * t);
-  m.pitch_rad = 0.10 * std::sin(two_pi * 0.13 * t);
-  m.roll_rad = 0.6 * std::sin(two_pi * 0.07 * t);
-  m.insertion_mm = 160.0 + 15.0 * std::sin(two_pi * 0.1 * t);
-  m.loop_mm = 15.0 - 15.0 * std::cos(two_pi * 0.5 * t);
-  m.cut = std::sin(two_pi * 0.5 * t) > 0.0;
-  return m;
-}
-#endif
 
 nlohmann::json summary_json(const MonitorOptions& o, const LinkCounters& c, const InjectedFaults& injected,
                             const std::string& description, double seconds) {
@@ -181,7 +164,7 @@ void run_monitor(const MonitorOptions& o) {
     firmware::EmulatorOptions emulator_options;
     emulator_options.seed = o.seed;
     emulator = std::make_unique<firmware::Emulator>(emulator_options);
-    emulator->set_motion(&demo_motion);
+    emulator->set_motion(&sweep_motion);
     transport = std::make_unique<EmulatorTransport>(*emulator, clock);
 #else
     fail("this build has no emulator (firmware_emulator was not built)");
