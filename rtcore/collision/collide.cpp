@@ -37,14 +37,13 @@ inline bool spheres_meet(const Sphere& tissue, const Sphere& tool, double slack)
   return within_reach(length_squared(tissue.center - tool.center), tissue.radius, tool.radius, slack);
 }
 
-// True when `leaf` is the first leaf of its triangle (chain order) whose sphere meets `other`.
+// True when tissue `leaf` is the first leaf of its triangle (chain order) whose sphere meets the tool's.
 // The descent reaches every leaf pair whose spheres meet (ancestors cover their leaves with room to
 // spare), so the triangle pair is tested exactly once, at that first leaf, with no table.
-template <bool kTissueSide>
 bool first_meeting_leaf(const SphereTree& tree, const Sphere* spheres, std::uint32_t triangle, std::int32_t leaf,
-                        const Sphere& other, double slack) {
+                        const Sphere& tool_sphere, double slack) {
   for (std::int32_t n = tree.first_leaf_of_triangle(triangle); n != leaf; n = tree.next_leaf_of_triangle(n)) {
-    if (kTissueSide ? spheres_meet(spheres[n], other, slack) : spheres_meet(other, spheres[n], slack)) return false;
+    if (spheres_meet(spheres[n], tool_sphere, slack)) return false;
   }
   return true;
 }
@@ -75,6 +74,19 @@ void Collider::prepare(const SphereTree& tissue_tree, const SphereTree& tool_tre
   tool_spheres_.resize(tool_nodes);
   tool_vertices_.resize(tool.vertex_count());
   tool_boxes_.resize(tool.triangle_count());
+  tool_chain_begin_.resize(tool.triangle_count() + 1);
+  tool_chain_.resize(static_cast<std::size_t>(tool_tree.leaf_count()));
+  tool_leaf_rank_.resize(tool_nodes);
+  std::int32_t at = 0;
+  for (std::uint32_t t = 0; t < tool.triangle_count(); ++t) {
+    tool_chain_begin_[t] = at;
+    std::int32_t rank = 0;
+    for (std::int32_t n = tool_tree.first_leaf_of_triangle(t); n != SphereTree::kNoNode; n = tool_tree.next_leaf_of_triangle(n)) {
+      tool_chain_[static_cast<std::size_t>(at++)] = n;
+      tool_leaf_rank_[static_cast<std::size_t>(n)] = rank++;
+    }
+  }
+  tool_chain_begin_[tool.triangle_count()] = at;
   l1_stamp_.resize(tissue_nodes, 0);
   l1_.resize(tissue_nodes);
   l2_stamp_.resize(tool_nodes, 0);
@@ -207,11 +219,14 @@ bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue
       if (kTableForSlices ? (a.slices > 1 || b.slices > 1) : (a.slices > 1 && b.slices > 1)) {
         test_triangles(tissue, a.triangle, b.triangle, true);
       } else if (b.slices > 1) {
-        if (first_meeting_leaf<false>(tool_tree, tool_spheres, b.triangle, pair.tool, s1, slack)) {
-          test_triangles(tissue, a.triangle, b.triangle, false);
-        }
+        // Tested at the first slab (chain order) whose sphere meets s1: scanning the earlier slabs
+        // nearest first finds a meeting neighbour at once when there is one.
+        const std::int32_t* chain = tool_chain_.data() + tool_chain_begin_[b.triangle];
+        std::int32_t k = tool_leaf_rank_[static_cast<std::size_t>(pair.tool)] - 1;
+        while (k >= 0 && !spheres_meet(s1, tool_spheres[chain[k]], slack)) --k;
+        if (k < 0) test_triangles(tissue, a.triangle, b.triangle, false);
       } else if (a.slices > 1) {
-        if (first_meeting_leaf<true>(tissue_tree, tissue_spheres, a.triangle, pair.tissue, s2, slack)) {
+        if (first_meeting_leaf(tissue_tree, tissue_spheres, a.triangle, pair.tissue, s2, slack)) {
           test_triangles(tissue, a.triangle, b.triangle, false);
         }
       } else {

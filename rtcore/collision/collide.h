@@ -84,6 +84,11 @@ class Collider {
   std::vector<Vec3> tool_vertices_;
   std::vector<Aabb> tool_boxes_;
   const TriangleMesh* tool_mesh_ = nullptr;
+  // The tool's leaves grouped by triangle in chain order (slab 0, 1, ...), and each leaf's rank in
+  // its group: a sliced tool triangle's earlier slabs are scanned nearest first.
+  std::vector<std::int32_t> tool_chain_begin_;  // per tool triangle, into tool_chain_
+  std::vector<std::int32_t> tool_chain_;
+  std::vector<std::int32_t> tool_leaf_rank_;  // per tool node
   std::vector<std::uint32_t> l1_stamp_;
   std::vector<std::uint32_t> l2_stamp_;
   std::vector<std::int32_t> l1_;
