@@ -25,6 +25,7 @@ MassSpringTissue::MassSpringTissue(const TetMesh& mesh, const TissueParameters& 
   mass_.assign(n, 0.0);
   stiffness_bound_.assign(n, 0.0);
   damping_bound_.assign(n, 0.0);
+  step_mass_.assign(n, 0.0);
   spring_k_.assign(s, 0.0);
   spring_c_.assign(s, 0.0);
   anchor_k_.assign(network_.anchor_nodes.size(), 0.0);
@@ -117,9 +118,15 @@ void MassSpringTissue::step_bounded_symplectic(double h_s) {
   // Gershgorin: every eigenvalue of D^-1 K is below max R_K / D and of D^-1 C below max R_C / D, so
   // with D = m + h^2 R_K / 2 + h R_C the step has h^2 lambda < 2 and h mu < 1, inside symplectic
   // Euler's region (h^2 lambda + 2 h mu < 4) for any stiffness, damping or resolution.
+  // D follows the state (stretch, contacts), and an inertia that changes with the motion pumps
+  // energy into it (parametric resonance: with no damping the stiffest and softest corners of the
+  // ranges diverged). So a rise of D keeps the momentum D v and a fall keeps the velocity: both can
+  // only lower the kinetic energy 1/2 D v^2, and the step stays symplectic while D holds still.
   const std::size_t n = x_.size();
   for (std::size_t i = 0; i < n; ++i) {
     const double d = mass_[i] + 0.5 * h_s * h_s * stiffness_bound_[i] + h_s * damping_bound_[i];
+    if (d > step_mass_[i]) v_[i] *= step_mass_[i] / d;
+    step_mass_[i] = d;
     v_[i] += (h_s / d) * force_[i];
     x_[i] += h_s * v_[i];
   }

@@ -19,7 +19,8 @@ namespace resecto {
 enum class TissueIntegrator : std::uint8_t {
   /// Symplectic Euler whose per-node mass is raised by a Gershgorin bound of the step's stiffness
   /// and damping (D = m + h^2 R_K / 2 + h R_C): stable for every stiffness, one force pass a step,
-  /// statics exact; fast modes are slowed instead of exploding. The default.
+  /// statics exact; fast modes are slowed instead of exploding. D follows the state, so a rise of D
+  /// keeps each node's momentum and a fall keeps its velocity (no parametric pumping). The default.
   kBoundedSymplectic,
   /// Plain symplectic Euler split into as many sub-steps as the same bound demands: exact dynamics,
   /// cost that grows with sqrt(stiffness) and with resolution.
@@ -105,6 +106,7 @@ class MassSpringTissue {
   // Hot, per node.
   std::vector<Vec3> x_, v_, rest_, force_;
   std::vector<double> mass_, stiffness_bound_, damping_bound_;
+  std::vector<double> step_mass_;  // D of the last bounded symplectic step (0 before the first)
   // Hot, per spring (node pairs live in network_.spring_nodes).
   std::vector<double> spring_k_, spring_c_;
   // Per anchor.
