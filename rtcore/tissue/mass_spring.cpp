@@ -26,8 +26,12 @@ MassSpringTissue::MassSpringTissue(const TetMesh& mesh, const TissueParameters& 
   stiffness_bound_.assign(n, 0.0);
   damping_bound_.assign(n, 0.0);
   step_mass_.assign(n, 0.0);
-  spring_k_.assign(s, 0.0);
-  spring_c_.assign(s, 0.0);
+  base_stiffness_bound_.assign(n, 0.0);
+  base_damping_bound_.assign(n, 0.0);
+  springs_.resize(s);
+  for (std::size_t i = 0; i < s; ++i) {
+    springs_[i] = {network_.spring_nodes[2 * i], network_.spring_nodes[2 * i + 1], network_.rest_length_m[i], 0.0, 0.0};
+  }
   anchor_k_.assign(network_.anchor_nodes.size(), 0.0);
   if (config_.integrator == TissueIntegrator::kImplicitEuler) {
     spring_direction_.assign(s, Vec3(0.0));
@@ -44,12 +48,27 @@ void MassSpringTissue::update_material() {
   const double viscosity = parameters_.si(TissueParameter::kSpringDamping);
   const double density = parameters_.si(TissueParameter::kDensity);
   const double anchor = parameters_.si(TissueParameter::kAnchorStiffness);
-  for (std::size_t i = 0; i < spring_k_.size(); ++i) {
-    spring_k_[i] = edge_spring_constant(modulus, network_.volume_share_m3[i], network_.rest_length_m[i]);
-    spring_c_[i] = edge_spring_constant(viscosity, network_.volume_share_m3[i], network_.rest_length_m[i]);
+  const double viscous_rate = parameters_.si(TissueParameter::kViscousDamping);
+  for (std::size_t i = 0; i < mass_.size(); ++i) {
+    mass_[i] = density * network_.node_volume_m3[i];
+    base_stiffness_bound_[i] = 0.0;
+    base_damping_bound_[i] = viscous_rate * mass_[i];
   }
-  for (std::size_t i = 0; i < mass_.size(); ++i) mass_[i] = density * network_.node_volume_m3[i];
-  for (std::size_t a = 0; a < anchor_k_.size(); ++a) anchor_k_[a] = anchor * network_.anchor_area_m2[a];
+  // Gershgorin rows at rest: each spring's Hessian blocks have norm k (more only when compressed
+  // below half its length, added per step) and each row holds two of them; likewise the dampers.
+  for (std::size_t s = 0; s < springs_.size(); ++s) {
+    SpringTerm& spring = springs_[s];
+    spring.k = edge_spring_constant(modulus, network_.volume_share_m3[s], network_.rest_length_m[s]);
+    spring.c = edge_spring_constant(viscosity, network_.volume_share_m3[s], network_.rest_length_m[s]);
+    base_stiffness_bound_[spring.i] += 2.0 * spring.k;
+    base_stiffness_bound_[spring.j] += 2.0 * spring.k;
+    base_damping_bound_[spring.i] += 2.0 * spring.c;
+    base_damping_bound_[spring.j] += 2.0 * spring.c;
+  }
+  for (std::size_t a = 0; a < anchor_k_.size(); ++a) {
+    anchor_k_[a] = anchor * network_.anchor_area_m2[a];
+    base_stiffness_bound_[network_.anchor_nodes[a]] += anchor_k_[a];
+  }
 }
 
 void MassSpringTissue::apply(const ParameterCommand& command) {
@@ -70,44 +89,55 @@ void MassSpringTissue::collision_step() {
   if (tool_.stats().overflowed) ++faults_.contact_overflows;
 }
 
+template <bool kLinearise>
+void MassSpringTissue::add_spring_forces() {
+  // The hot loop: one packed record per spring, in spring order (sorted by first node). The bound's
+  // constant part (2 k per spring end) is precomputed; only a spring compressed below half its rest
+  // length, whose Hessian norm k |1 - L0/L| then exceeds k, adds its excess here.
+  Vec3* const x = x_.data();
+  Vec3* const v = v_.data();
+  Vec3* const force = force_.data();
+  double* const bound = stiffness_bound_.data();
+  const std::size_t count = springs_.size();
+  for (std::size_t s = 0; s < count; ++s) {
+    const SpringTerm& spring = springs_[s];
+    const std::uint32_t i = spring.i, j = spring.j;
+    const Vec3 d = x[j] - x[i];
+    const double length = std::sqrt(glm::dot(d, d));
+    const double inverse_length = length > 0.0 ? 1.0 / length : 0.0;
+    const Vec3 u = d * inverse_length;
+    const double stretch = length - spring.rest_m;
+    const Vec3 f = (spring.k * stretch + spring.c * glm::dot(v[j] - v[i], u)) * u;
+    force[i] += f;
+    force[j] -= f;
+    if (length > 0.0 && 2.0 * length < spring.rest_m) [[unlikely]] {
+      const double excess = 2.0 * spring.k * (spring.rest_m * inverse_length - 2.0);
+      bound[i] += excess;
+      bound[j] += excess;
+    }
+    if constexpr (kLinearise) {
+      spring_direction_[s] = u;
+      spring_transverse_k_[s] = spring.k * std::max(0.0, stretch * inverse_length);  // tension only: keeps K >= 0
+    }
+  }
+}
+
 void MassSpringTissue::accumulate_forces(double h_s) {
   const double viscous_rate = parameters_.si(TissueParameter::kViscousDamping);
   const std::size_t n = x_.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    force_[i] = -viscous_rate * mass_[i] * v_[i];
-    stiffness_bound_[i] = 0.0;
-    damping_bound_[i] = viscous_rate * mass_[i];
-  }
-  const std::uint32_t* pairs = network_.spring_nodes.data();
-  const double* rest = network_.rest_length_m.data();
-  const bool linearise = config_.integrator == TissueIntegrator::kImplicitEuler;
-  for (std::size_t s = 0; s < spring_k_.size(); ++s) {
-    const std::uint32_t i = pairs[2 * s], j = pairs[2 * s + 1];
-    const Vec3 d = x_[j] - x_[i];
-    const double length = glm::length(d);
-    const double inverse_length = length > 0.0 ? 1.0 / length : 0.0;
-    const Vec3 u = d * inverse_length;
-    const double stretch = length - rest[s];
-    const double k = spring_k_[s], c = spring_c_[s];
-    const Vec3 f = (k * stretch + c * glm::dot(v_[j] - v_[i], u)) * u;
-    force_[i] += f;
-    force_[j] -= f;
-    // The spring's Hessian blocks have norm k * max(1, |1 - L0/L|); each row holds two of them.
-    const double geometric = length > 0.0 ? std::abs(stretch) * inverse_length : 1.0;
-    const double row_k = 2.0 * k * std::max(1.0, geometric);
-    stiffness_bound_[i] += row_k;
-    stiffness_bound_[j] += row_k;
-    damping_bound_[i] += 2.0 * c;
-    damping_bound_[j] += 2.0 * c;
-    if (linearise) {
-      spring_direction_[s] = u;
-      spring_transverse_k_[s] = k * std::max(0.0, stretch * inverse_length);  // tension only: keeps K >= 0
-    }
+  for (std::size_t i = 0; i < n; ++i) force_[i] = -viscous_rate * mass_[i] * v_[i];
+  // Springs, dampers, anchors and viscous damping bound the same every step until a parameter
+  // changes (update_material); what varies is added on top.
+  std::copy(base_stiffness_bound_.begin(), base_stiffness_bound_.end(), stiffness_bound_.begin());
+  std::copy(base_damping_bound_.begin(), base_damping_bound_.end(), damping_bound_.begin());
+  if (config_.integrator == TissueIntegrator::kImplicitEuler) {
+    add_spring_forces<true>();
+  } else {
+    add_spring_forces<false>();
   }
   for (std::size_t a = 0; a < anchor_k_.size(); ++a) {
     const std::uint32_t i = network_.anchor_nodes[a];
     force_[i] -= anchor_k_[a] * (x_[i] - rest_[i]);
-    stiffness_bound_[i] += anchor_k_[a];
   }
   reaction_ = tool_.add_forces(x_, v_, surface_.triangles, parameters_.si(TissueParameter::kPenaltyStiffness),
                                parameters_.si(TissueParameter::kPenaltyDamping), h_s, force_, stiffness_bound_, damping_bound_);
@@ -172,13 +202,13 @@ void MassSpringTissue::apply_system(double mass_coefficient, double damping_coef
     const std::uint32_t i = network_.anchor_nodes[a];
     out[i] += stiffness_coefficient * anchor_k_[a] * p[i];
   }
-  const std::uint32_t* pairs = network_.spring_nodes.data();
-  for (std::size_t s = 0; s < spring_k_.size(); ++s) {
-    const std::uint32_t i = pairs[2 * s], j = pairs[2 * s + 1];
+  for (std::size_t s = 0; s < springs_.size(); ++s) {
+    const SpringTerm& spring = springs_[s];
+    const std::uint32_t i = spring.i, j = spring.j;
     const Vec3& u = spring_direction_[s];
     const Vec3 dp = p[j] - p[i];
     const double along = glm::dot(u, dp);
-    const Vec3 value = (stiffness_coefficient * spring_k_[s] + damping_coefficient * spring_c_[s]) * along * u +
+    const Vec3 value = (stiffness_coefficient * spring.k + damping_coefficient * spring.c) * along * u +
                        (stiffness_coefficient * spring_transverse_k_[s]) * (dp - along * u);
     out[i] -= value;
     out[j] += value;

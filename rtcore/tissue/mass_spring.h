@@ -91,6 +91,8 @@ class MassSpringTissue {
  private:
   void update_material();
   void accumulate_forces(double h_s);
+  template <bool kLinearise>
+  void add_spring_forces();
   void step_bounded_symplectic(double h_s);
   void step_substepped_symplectic(double h_s);
   void step_implicit_euler(double h_s);
@@ -107,8 +109,15 @@ class MassSpringTissue {
   std::vector<Vec3> x_, v_, rest_, force_;
   std::vector<double> mass_, stiffness_bound_, damping_bound_;
   std::vector<double> step_mass_;  // D of the last bounded symplectic step (0 before the first)
-  // Hot, per spring (node pairs live in network_.spring_nodes).
-  std::vector<double> spring_k_, spring_c_;
+  /// One spring's hot data, packed so the force loop reads one stream.
+  struct SpringTerm {
+    std::uint32_t i, j;  // nodes, i < j
+    double rest_m, k, c;  // rest length, stiffness (N/m), damping (N*s/m)
+  };
+  // Hot, per spring, in network_ order.
+  std::vector<SpringTerm> springs_;
+  // The parameters' part of the per-node bounds (springs at rest, dampers, anchors, viscous).
+  std::vector<double> base_stiffness_bound_, base_damping_bound_;
   // Per anchor.
   std::vector<double> anchor_k_;
   // Implicit Euler only: per-spring linearisation and CG vectors.
