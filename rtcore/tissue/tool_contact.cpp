@@ -47,7 +47,16 @@ bool sphere_near(const Sphere& s, const Vec3& p, double radius) {
 /// an edge or vertex) the one whose plane it is furthest from decides the side, which is the
 /// pseudo-normal's answer for convex corners.
 struct Closest {
+  static constexpr double kTie = 1e-18;  // m^2: closest points this close are the same feature
   double distance2 = 1e300;
+  double reach = 1e300;  // sqrt(distance2 + kTie): a triangle whose bounding sphere is further cannot win
+  /// True when no point of a triangle in the sphere (c, r) can be offered successfully (exact prune).
+  bool beyond(const Vec3& p, const Vec3& center, double radius) const {
+    const Vec3 d = p - center;
+    return glm::dot(d, d) > (radius + reach) * (radius + reach);
+  }
+  /// True when a closest point at squared distance d2 cannot be offered successfully.
+  bool further(double d2) const { return d2 > distance2 + kTie; }
   double plane_distance = 0.0;  // |signed distance to the plane| of the chosen triangle
   double side = 1.0;            // < 0: the point is behind the chosen triangle
   Vec3 point{0.0};
@@ -55,9 +64,9 @@ struct Closest {
   void offer(const Vec3& p, const Vec3& q, const Vec3& unit_normal, std::uint32_t t) {
     const double d2 = glm::dot(p - q, p - q);
     const double plane = glm::dot(p - q, unit_normal);
-    constexpr double kTie = 1e-18;  // m^2: closest points this close are the same feature
     if (d2 < distance2 - kTie || (d2 <= distance2 + kTie && std::abs(plane) > plane_distance)) {
       distance2 = d2;
+      reach = std::sqrt(d2 + kTie);
       plane_distance = std::abs(plane);
       side = plane;
       point = q;
@@ -84,6 +93,11 @@ int ToolContacts::add_part(const TriangleMesh& mesh) {
     const Vec3 n2 = triangle_normal_x2(mesh, t);
     const double length = glm::length(n2);
     part.face_normals.push_back(length > 0.0 ? n2 / length : Vec3(0.0));
+    const Triangle& tri = mesh.triangles[t];
+    const Vec3 centroid = (mesh.positions[tri[0]] + mesh.positions[tri[1]] + mesh.positions[tri[2]]) / 3.0;
+    double radius = 0.0;
+    for (std::uint32_t v : tri) radius = std::max(radius, glm::length(mesh.positions[v] - centroid));
+    part.triangle_spheres.push_back({centroid, radius});
     for (std::uint32_t v : mesh.triangles[t]) vertex_normals[v] += n2;
   }
   for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
@@ -244,6 +258,8 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
     const Vec3 p = to_tool_frame(part.pose, x[pc.point]);
     Closest best;
     for (std::uint32_t e = pc.first; e < pc.first + pc.count; ++e) {
+      const Sphere& bounds = part.triangle_spheres[pair_triangles_[e]];
+      if (best.beyond(p, bounds.center, bounds.radius)) continue;
       const Triangle& t = part.mesh.triangles[pair_triangles_[e]];
       const Vec3 q = closest_point_on_triangle(p, part.mesh.positions[t[0]], part.mesh.positions[t[1]], part.mesh.positions[t[2]]);
       best.offer(p, q, part.face_normals[pair_triangles_[e]], pair_triangles_[e]);
@@ -275,7 +291,13 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
     Closest best;
     for (std::uint32_t e = pc.first; e < pc.first + pc.count; ++e) {
       const Triangle& t = surface_triangles[pair_triangles_[e]];
+      // The tissue's faces move, so their bounding spheres are formed here (cheaper than the test).
+      const Vec3 centroid = (x[t[0]] + x[t[1]] + x[t[2]]) / 3.0;
+      const double radius2 = std::max({glm::dot(x[t[0]] - centroid, x[t[0]] - centroid), glm::dot(x[t[1]] - centroid, x[t[1]] - centroid),
+                                       glm::dot(x[t[2]] - centroid, x[t[2]] - centroid)});
+      if (best.beyond(w, centroid, std::sqrt(radius2))) continue;
       const Vec3 q = closest_point_on_triangle(w, x[t[0]], x[t[1]], x[t[2]]);
+      if (best.further(glm::dot(w - q, w - q))) continue;
       const Vec3 n2 = glm::cross(x[t[1]] - x[t[0]], x[t[2]] - x[t[0]]);
       const double length = glm::length(n2);
       best.offer(w, q, length > 0.0 ? n2 / length : Vec3(0.0), pair_triangles_[e]);

@@ -75,6 +75,7 @@ class ToolContacts {
     TriangleMesh mesh;          // tool frame
     TriangleMesh inflated;      // every vertex pushed out by the margin along its normal
     std::vector<Vec3> face_normals;  // unit, tool frame
+    std::vector<Sphere> triangle_spheres;  // per face, tool frame: prunes the closest-point tests
     SphereTree tree;            // over `inflated`, so the query's contact is the margin's
     Collider collider;
     RigidTransform pose, previous_pose;
