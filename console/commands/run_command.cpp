@@ -25,6 +25,7 @@ struct RunOptions {
   int triangles = 8640;
   int collision_hz = 60;
   int substeps = 16;
+  bool inline_collision = false;
   std::uint64_t seed = 1;
   std::string calibration;
   bool json = false;
@@ -45,6 +46,7 @@ void run(const RunOptions& o) {
   options.simulation.prostate_triangles = o.triangles;
   options.simulation.collision_hz = o.collision_hz;
   options.simulation.physics_per_collision = o.substeps;
+  options.simulation.collision_thread = !o.inline_collision;
   options.simulation.parameters = parameters_from_assignments(o.sets);
   if (!o.calibration.empty()) {
     Result<device::Calibration> calibration = device::read_calibration(o.calibration);
@@ -79,6 +81,8 @@ void register_run(CLI::App& app) {
   cmd->add_option("--triangles", o->triangles, "Prostate surface triangles")->check(CLI::Range(200, 1000000))->capture_default_str();
   cmd->add_option("--collision-hz", o->collision_hz, "Collision steps per second")->check(CLI::Range(10, 1000))->capture_default_str();
   cmd->add_option("--substeps", o->substeps, "Physics steps per collision step")->check(CLI::Range(1, 64))->capture_default_str();
+  cmd->add_flag("--inline-collision", o->inline_collision,
+                "Refit and query on the core's own thread instead of the collision thread (same state hashes)");
   cmd->add_option("--calibration", o->calibration, "Device calibration file (default: the reference device's)");
   cmd->add_option("--seed", o->seed, "Seed of the emulated sensors' noise")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print the JSON report instead of the summary");

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include "console/headless/lockstep_device.h"
@@ -19,12 +20,18 @@
 #include "rtcore/concurrency/spsc_ring.h"
 #include "rtcore/concurrency/triple_buffer.h"
 #include "rtcore/core/fixed_step_scheduler.h"
+#include "rtcore/core/thread_priority.h"
 #include "rtcore/tissue/state_hash.h"
 
 namespace resecto {
 namespace {
 
 using nlohmann::ordered_json;
+
+// Real-time priorities (1..99): above every normal thread, below the kernel's threaded interrupt
+// handlers (FIFO 50 on PREEMPT_RT kernels), which carry the device's USB reports; the core first.
+constexpr int kCoreFifoPriority = 45;
+constexpr int kCollisionFifoPriority = 40;
 
 /// Takes the core's snapshots on its own thread, as the console will; optionally slow on purpose.
 class SnapshotConsumer {
@@ -148,6 +155,16 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   std::int64_t newest_sample_host_ns = 0;   // host receipt of the newest sample latched
   std::int64_t published_sample_host_ns = 0;
 
+  // Real time: the core's thread first, the collision thread next (it has a whole collision period),
+  // both before any normal thread of the machine. Batch runs keep normal priority.
+  std::optional<ScopedFifoPriority> core_priority;
+  bool collision_raised = false;
+  if (options.realtime) {
+    core_priority.emplace(kCoreFifoPriority);
+    if (core_priority->raised() && sim.collision_thread()) {
+      collision_raised = raise_to_fifo(sim.collision_thread()->native_handle(), kCollisionFifoPriority);
+    }
+  }
   const auto wall_start = std::chrono::steady_clock::now();
   scheduler.run(0, ticks, [&](std::uint64_t tick) {
     const std::int64_t tick_begin_ns = FrameProfiler::now_ns();
@@ -184,6 +201,8 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
     return true;
   });
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  const bool core_raised = core_priority && core_priority->raised();
+  core_priority.reset();
   consumer.stop();
   if (live) live->link.stop();
 
@@ -202,11 +221,15 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   r["simulated_s"] = static_cast<double>(result.ticks) * tick_s;
   r["wall_s"] = wall_s;
   r["rates_hz"] = {{"physics", 1.0 / tick_s}, {"collision", config.collision_hz}};
+  r["collision_thread"] = config.collision_thread;
+  r["scheduling"] = {{"core", core_raised ? "SCHED_FIFO " + std::to_string(kCoreFifoPriority) : std::string("normal")},
+                     {"collision", collision_raised ? "SCHED_FIFO " + std::to_string(kCollisionFifoPriority) : std::string("normal")}};
   r["model"] = {{"surface_triangles", sim.prostate().surface.triangle_count()},
                 {"tetrahedra", sim.tetrahedron_count()},
                 {"nodes", sim.tissue().node_count()}};
   ordered_json stages = ordered_json::object();
-  for (Stage stage : {Stage::kInput, Stage::kKinematics, Stage::kPhysics, Stage::kQuery, Stage::kResponse, Stage::kPublish, Stage::kTick}) {
+  for (Stage stage : {Stage::kInput, Stage::kKinematics, Stage::kCollisionWait, Stage::kPhysics, Stage::kRefit, Stage::kQuery,
+                      Stage::kResponse, Stage::kPublish, Stage::kTick}) {
     stages[stage_name(stage)] = stage_json(profiler.statistics(stage));
   }
   r["stages"] = stages;
@@ -245,13 +268,16 @@ std::string summarize_report(const ordered_json& r) {
   char text[2048];
   const auto& m = r.at("metrics");
   const auto& physics = r.at("stages").at("physics");
+  const auto& refit = r.at("stages").at("refit");
   const auto& query = r.at("stages").at("query");
+  const auto& wait = r.at("stages").at("collision_wait");
   const auto& tick = r.at("stages").at("tick");
   std::snprintf(text, sizeof text,
                 "%s run of '%s': %llu ticks (%.2f s simulated in %.2f s), final state hash %s\n"
                 "  model      %llu surface triangles, %llu tetrahedra\n"
                 "  physics    median %.0f us, p99 %.0f us (budget %.0f us)\n"
-                "  collision  median %.0f us, p99 %.0f us (budget %.0f us)\n"
+                "  refit      median %.0f us, p99 %.0f us (budget %.0f us)\n"
+                "  query      median %.0f us, p99 %.0f us (budget %.0f us), %s; core waited for it: p99 %.0f us\n"
                 "  tick       median %.0f us, p99 %.0f us, max %.0f us; deadline misses %llu\n"
                 "  device     %llu reports, %llu lost, %.0f Hz\n"
                 "  procedure  contact %.2f s, peak force %.2f N, cut pedal %.2f s (%.2f s in contact), tissue moved up to %.2f mm\n",
@@ -260,8 +286,11 @@ std::string summarize_report(const ordered_json& r) {
                 r.at("wall_s").get<double>(), r.at("state_hash").get<std::string>().c_str(),
                 static_cast<unsigned long long>(r.at("model").at("surface_triangles").get<std::uint64_t>()),
                 static_cast<unsigned long long>(r.at("model").at("tetrahedra").get<std::uint64_t>()), physics.at("median_us").get<double>(),
-                physics.at("p99_us").get<double>(), physics.at("budget_us").get<double>(), query.at("median_us").get<double>(),
-                query.at("p99_us").get<double>(), query.at("budget_us").get<double>(), tick.at("median_us").get<double>(),
+                physics.at("p99_us").get<double>(), physics.at("budget_us").get<double>(), refit.at("median_us").get<double>(),
+                refit.at("p99_us").get<double>(), refit.at("budget_us").get<double>(), query.at("median_us").get<double>(),
+                query.at("p99_us").get<double>(), query.at("budget_us").get<double>(),
+                r.at("collision_thread").get<bool>() ? "on the collision thread" : "on the core's thread",
+                wait.at("p99_us").get<double>(), tick.at("median_us").get<double>(),
                 tick.at("p99_us").get<double>(), tick.at("max_us").get<double>(),
                 static_cast<unsigned long long>(r.at("deadline_misses").get<std::uint64_t>()),
                 static_cast<unsigned long long>(r.at("device").at("reports").get<std::uint64_t>()),

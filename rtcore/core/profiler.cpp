@@ -24,12 +24,16 @@ int bin_of(double us) {
 /// The upper edge of a bin, the value a quantile falling into it reports.
 double bin_upper_us(int bin) { return bin == 0 ? kSmallestUs : kSmallestUs * std::pow(kBinGrowth, bin); }
 
+/// The stages the collision thread runs get their own track in the trace.
+bool runs_on_collision_thread(Stage stage) { return stage == Stage::kRefit || stage == Stage::kQuery; }
+
 }  // namespace
 
 const char* stage_name(Stage stage) {
   switch (stage) {
     case Stage::kInput: return "input";
     case Stage::kKinematics: return "kinematics";
+    case Stage::kCollisionWait: return "collision_wait";
     case Stage::kPhysics: return "physics";
     case Stage::kRefit: return "refit";
     case Stage::kQuery: return "query";
@@ -94,14 +98,15 @@ Status FrameProfiler::write_chrome_trace(const std::filesystem::path& path) cons
     if (!out) return Error{path.string() + ": cannot open for writing"};
     out << "{\"displayTimeUnit\":\"ms\",\"traceEvents\":[\n";
     out << R"({"name":"process_name","ph":"M","pid":1,"tid":1,"args":{"name":"resecto core"}},)" << "\n";
-    out << R"json({"name":"thread_name","ph":"M","pid":1,"tid":1,"args":{"name":"core (fixed step)"}})json";
+    out << R"json({"name":"thread_name","ph":"M","pid":1,"tid":1,"args":{"name":"core (fixed step)"}},)json" << "\n";
+    out << R"json({"name":"thread_name","ph":"M","pid":1,"tid":2,"args":{"name":"collision (refit + query)"}})json";
     char line[256];
     // Oldest first: the order the stages ran in.
     for (std::uint64_t i = first; i < trace_written_; ++i) {
       const StageTiming& t = trace_[i % trace_.size()];
       std::snprintf(line, sizeof line,
-                    ",\n{\"name\":\"%s\",\"cat\":\"core\",\"ph\":\"X\",\"pid\":1,\"tid\":1,\"ts\":%.3f,\"dur\":%.3f,\"args\":{\"tick\":%llu}}",
-                    stage_name(t.stage), static_cast<double>(t.begin_ns - origin_ns) * 1e-3, static_cast<double>(t.duration_ns) * 1e-3,
+                    ",\n{\"name\":\"%s\",\"cat\":\"core\",\"ph\":\"X\",\"pid\":1,\"tid\":%d,\"ts\":%.3f,\"dur\":%.3f,\"args\":{\"tick\":%llu}}",
+                    stage_name(t.stage), runs_on_collision_thread(t.stage) ? 2 : 1, static_cast<double>(t.begin_ns - origin_ns) * 1e-3, static_cast<double>(t.duration_ns) * 1e-3,
                     static_cast<unsigned long long>(t.tick));
       out << line;
     }

@@ -13,8 +13,10 @@
 namespace resecto {
 
 /// The stages of a core tick, in execution order.
-enum class Stage : std::uint8_t { kInput, kKinematics, kPhysics, kRefit, kQuery, kResponse, kPublish, kTick };
-inline constexpr int kStageCount = 8;
+/// kRefit and kQuery run on the collision thread, alongside the ticks after their own; kCollisionWait
+/// is the core's wait for them at the next collision tick.
+enum class Stage : std::uint8_t { kInput, kKinematics, kCollisionWait, kPhysics, kRefit, kQuery, kResponse, kPublish, kTick };
+inline constexpr int kStageCount = 9;
 
 /// Lower-case name used in reports and traces ("physics").
 const char* stage_name(Stage stage);

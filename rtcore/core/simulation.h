@@ -1,7 +1,9 @@
 // Simulation: the deterministic core, state(k+1) = step(state(k), input(k), commands(k)). Ticks are
 // physics steps (960 Hz by default); every `physics_per_collision` ticks a collision step refits the
 // tissue's sphere tree and finds the tool's contact candidates (60 Hz), and the state hash is taken.
-// Wall-clock time never enters: the profiler only watches.
+// The refit and search of collision step n run alongside the physics ticks up to step n+1, whose tick
+// publishes their candidates: a fixed one-step pipeline, so the result never depends on when the
+// search finishes, or on which thread it ran. Wall-clock time never enters: the profiler only watches.
 #pragma once
 
 #include <cstdint>
@@ -13,6 +15,7 @@
 #include "rtcore/anatomy/prostate.h"
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/base/result.h"
+#include "rtcore/concurrency/job_thread.h"
 #include "rtcore/core/profiler.h"
 #include "rtcore/tissue/mass_spring.h"
 #include "rtcore/tissue/tissue_parameters.h"
@@ -24,6 +27,9 @@ struct SimulationConfig {
   int prostate_triangles = 8640;
   int collision_hz = 60;
   int physics_per_collision = 16;  ///< physics ticks per collision step: 16 gives 960 Hz
+  /// Runs each collision step's refit and search on a thread of its own, concurrently with the
+  /// physics ticks that follow it. The results are the same either way (see Simulation::step).
+  bool collision_thread = true;
   TissueParameters parameters;     ///< initial values; later changes come as commands
   GimbalGeometry gimbal;
   double max_tet_volume_m3 = 0.0;  ///< TetGen -a bound for the tissue model; 0 = unbounded
@@ -71,8 +77,10 @@ class Simulation {
   /// Builds the gland, its tetrahedral model, the tissue and the tool. Allocates everything here.
   static Result<std::unique_ptr<Simulation>> create(const SimulationConfig& config);
 
-  /// Runs tick `tick()`: applies the commands stamped for it, places the tool, steps the tissue, and
-  /// on collision ticks refits, queries and hashes. Allocates nothing, locks nothing, does no I/O.
+  /// Runs tick `tick()`: applies the commands stamped for it, places the tool; on collision ticks
+  /// publishes the previous collision step's candidates and starts this one's refit and search (on
+  /// the collision thread, or here); steps the tissue; on collision ticks hashes. Allocates nothing,
+  /// locks nothing, does no I/O.
   void step(const TickInput& input, std::span<const ParameterCommand> commands, FrameProfiler* profiler = nullptr);
 
   std::uint64_t tick() const { return tick_; }
@@ -86,6 +94,8 @@ class Simulation {
   const ToolPoses& tool_poses() const { return poses_; }
   const ToolReaction& reaction() const { return reaction_; }
   std::size_t tetrahedron_count() const { return tetrahedra_; }
+  /// The thread that runs the collision refit and search; null when they run inline.
+  JobThread* collision_thread() { return collision_thread_.get(); }
 
   /// Copies the publishable state into `snapshot` (whose surface array is sized by make_snapshot()).
   void fill_snapshot(SimulationSnapshot& snapshot) const;
@@ -95,10 +105,21 @@ class Simulation {
   Simulation() = default;
   void place_tool(const TickInput& input);
   void update_metrics(const TickInput& input, bool collision_tick);
+  /// Publishes the running collision step's candidates (waiting for its search) and starts the next.
+  void advance_collision_pipeline(std::uint64_t tick, FrameProfiler* profiler);
+  /// The collision step's refit and search, on whichever thread runs them; timed for the profiler.
+  void run_collision_search();
 
   SimulationConfig config_;
   ProstateModel prostate_;
   std::unique_ptr<MassSpringTissue> tissue_;
+  /// When the last refit and search ran (written by their thread, read after the wait).
+  struct SearchTiming {
+    std::uint64_t tick = 0;
+    std::int64_t begin_ns = 0, refit_end_ns = 0, query_end_ns = 0;
+  };
+  SearchTiming search_timing_;
+  bool search_pending_ = false;  ///< a collision step's candidates await publishing
   int sheath_part_ = 0;
   int loop_part_ = 0;
   std::size_t tetrahedra_ = 0;
@@ -111,6 +132,7 @@ class Simulation {
   std::uint64_t contact_ticks_ = 0;
   double contact_force_sum_n_ = 0.0;
   ProcedureMetrics metrics_;
+  std::unique_ptr<JobThread> collision_thread_;  // last: stops before what its job uses goes
 };
 
 /// The stages' budgets at a tick rate, microseconds (the tick's time split among its stages).

@@ -82,10 +82,25 @@ void MassSpringTissue::set_parameters(const TissueParameters& parameters) {
 }
 
 void MassSpringTissue::collision_step() {
-  // The surface shares the tetrahedral mesh's node indices; its positions are the nodes'.
+  begin_collision_step();
+  refit_surface_tree();
+  search_contact_candidates();
+  end_collision_step();
+}
+
+void MassSpringTissue::begin_collision_step() {
+  // The surface shares the tetrahedral mesh's node indices; its positions are the nodes' at this
+  // moment, a copy the refit and search may read while the physics steps move the nodes on.
   std::copy(x_.begin(), x_.end(), surface_.positions.begin());
-  surface_tree_.refit(surface_);
-  tool_.update_candidates(surface_tree_, surface_);
+  tool_.latch_query_poses();
+}
+
+void MassSpringTissue::refit_surface_tree() { surface_tree_.refit(surface_); }
+
+void MassSpringTissue::search_contact_candidates() { tool_.search_candidates(surface_tree_, surface_); }
+
+void MassSpringTissue::end_collision_step() {
+  tool_.publish_candidates();
   if (tool_.stats().overflowed) ++faults_.contact_overflows;
 }
 

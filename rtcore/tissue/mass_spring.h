@@ -64,8 +64,22 @@ class MassSpringTissue {
   const ToolContacts& tool() const { return tool_; }
 
   /// The 60 Hz collision step: copies the node positions into the surface, refits its sphere tree,
-  /// and lets the tool find its candidate pairs.
+  /// and lets the tool find its candidate pairs, which the following physics steps use.
   void collision_step();
+
+  // The same step in parts, for the core's pipeline: the refit and search may run on another thread
+  // while physics steps go on with the candidates already published.
+  /// Takes the node positions and the tool's poses the refit and search will use. Call between
+  /// physics steps while no refit or search runs.
+  void begin_collision_step();
+  /// Refits the surface's sphere tree to the positions taken by begin_collision_step(). Reads and
+  /// writes nothing a physics step touches.
+  void refit_surface_tree();
+  /// Finds the tool's candidate pairs against the refitted tree, into the tool's back buffer.
+  void search_contact_candidates();
+  /// Publishes the search's candidates to the physics steps; call between physics steps once the
+  /// search has finished.
+  void end_collision_step();
   /// One physics step of h_s seconds (default 1/960 s). Returns the reaction on the tool.
   ToolReaction physics_step(double h_s);
 

@@ -78,9 +78,13 @@ struct Closest {
 }  // namespace
 
 ToolContacts::ToolContacts(double margin_m, const ToolContactCapacity& capacity) : margin_m_(margin_m), capacity_(capacity) {
+  // Both buffers at full capacity: publishing swaps them, so neither side ever grows.
   node_candidates_.resize(static_cast<std::size_t>(capacity.max_tissue_nodes));
   vertex_candidates_.resize(static_cast<std::size_t>(capacity.max_tool_vertices));
   pair_triangles_.resize(static_cast<std::size_t>(capacity.max_pair_entries));
+  search_.nodes.resize(static_cast<std::size_t>(capacity.max_tissue_nodes));
+  search_.vertices.resize(static_cast<std::size_t>(capacity.max_tool_vertices));
+  search_.pair_triangles.resize(static_cast<std::size_t>(capacity.max_pair_entries));
   stack_.reserve(256);
 }
 
@@ -129,11 +133,11 @@ void ToolContacts::reset_pose(int part, const RigidTransform& pose) {
 }
 
 bool ToolContacts::push_pair(std::uint32_t triangle) {
-  if (pair_count_ >= pair_triangles_.size()) {
-    stats_.overflowed = true;
+  if (search_.pair_count >= search_.pair_triangles.size()) {
+    search_.stats.overflowed = true;
     return false;
   }
-  pair_triangles_[pair_count_++] = triangle;
+  search_.pair_triangles[search_.pair_count++] = triangle;
   return true;
 }
 
@@ -159,7 +163,7 @@ void ToolContacts::gather_triangles(const SphereTree& tree, const Vec3& p, doubl
       stack_.push_back(links[static_cast<std::size_t>(node)].right);
       stack_.push_back(links[static_cast<std::size_t>(node)].left);
     } else {
-      stats_.overflowed = true;
+      search_.stats.overflowed = true;
     }
   }
 }
@@ -167,16 +171,43 @@ void ToolContacts::gather_triangles(const SphereTree& tree, const Vec3& p, doubl
 void ToolContacts::keep_within_margin(std::uint32_t first, const Vec3& p, const std::vector<Vec3>& positions,
                                       const std::vector<Triangle>& triangles) {
   // The sphere descent over-approximates; the substeps only need triangles really within the margin.
+  std::vector<std::uint32_t>& pairs = search_.pair_triangles;
   std::size_t kept = first;
-  for (std::size_t e = first; e < pair_count_; ++e) {
-    const Triangle& t = triangles[pair_triangles_[e]];
+  for (std::size_t e = first; e < search_.pair_count; ++e) {
+    const Triangle& t = triangles[pairs[e]];
     const Vec3 q = closest_point_on_triangle(p, positions[t[0]], positions[t[1]], positions[t[2]]);
-    if (glm::dot(p - q, p - q) <= margin_m_ * margin_m_) pair_triangles_[kept++] = pair_triangles_[e];
+    if (glm::dot(p - q, p - q) <= margin_m_ * margin_m_) pairs[kept++] = pairs[e];
   }
-  pair_count_ = kept;
+  search_.pair_count = kept;
 }
 
 void ToolContacts::update_candidates(const SphereTree& tissue_tree, const TriangleMesh& surface) {
+  latch_query_poses();
+  search_candidates(tissue_tree, surface);
+  publish_candidates();
+}
+
+void ToolContacts::latch_query_poses() {
+  for (Part& part : parts_) {
+    part.query_pose = part.pose;
+    part.query_enabled = part.enabled;
+  }
+}
+
+void ToolContacts::publish_candidates() {
+  std::swap(node_candidates_, search_.nodes);
+  std::swap(vertex_candidates_, search_.vertices);
+  std::swap(pair_triangles_, search_.pair_triangles);
+  node_count_ = search_.node_count;
+  vertex_count_ = search_.vertex_count;
+  pair_count_ = search_.pair_count;
+  // `penetrating` belongs to the physics step that last ran, not to the search.
+  const std::int32_t penetrating = stats_.penetrating;
+  stats_ = search_.stats;
+  stats_.penetrating = penetrating;
+}
+
+void ToolContacts::search_candidates(const SphereTree& tissue_tree, const TriangleMesh& surface) {
   // Sized once for this tissue; a tissue whose size changes (resection) grows them at that step.
   if (node_stamp_.size() < surface.vertex_count()) node_stamp_.assign(surface.vertex_count(), 0);
   if (tissue_triangle_stamp_.size() < surface.triangle_count()) tissue_triangle_stamp_.assign(surface.triangle_count(), 0);
@@ -187,17 +218,19 @@ void ToolContacts::update_candidates(const SphereTree& tissue_tree, const Triang
     std::fill(tool_vertex_stamp_.begin(), tool_vertex_stamp_.end(), 0u);
     stamp_ = 0;
   }
-  node_count_ = vertex_count_ = pair_count_ = 0;
-  stats_ = {};
+  CandidateSet& out = search_;
+  out.node_count = out.vertex_count = out.pair_count = 0;
+  out.stats = {};
   const double search_radius = margin_m_;
   std::uint32_t vertex_offset = 0;
   // Parts in index order, leaves in the collider's order, triangles' corners in order: deterministic.
   for (std::size_t pi = 0; pi < parts_.size(); vertex_offset += static_cast<std::uint32_t>(parts_[pi].mesh.vertex_count()), ++pi) {
     Part& part = parts_[pi];
-    if (!part.enabled) continue;
-    if (!part.collider.collide(tissue_tree, surface, part.tree, part.inflated, part.pose)) stats_.overflowed = true;
-    stats_.tissue_leaves += static_cast<std::int32_t>(part.collider.tissue_leaves().size());
-    stats_.tool_leaves += static_cast<std::int32_t>(part.collider.tool_leaves().size());
+    if (!part.query_enabled) continue;
+    const RigidTransform& pose = part.query_pose;
+    if (!part.collider.collide(tissue_tree, surface, part.tree, part.inflated, pose)) out.stats.overflowed = true;
+    out.stats.tissue_leaves += static_cast<std::int32_t>(part.collider.tissue_leaves().size());
+    out.stats.tool_leaves += static_cast<std::int32_t>(part.collider.tool_leaves().size());
 
     // Tissue nodes of the colliding tissue leaves, each once per part, against nearby tool triangles.
     const std::uint32_t node_mark = ++stamp_;
@@ -206,16 +239,16 @@ void ToolContacts::update_candidates(const SphereTree& tissue_tree, const Triang
       for (std::uint32_t n : tri) {
         if (node_stamp_[n] == node_mark) continue;
         node_stamp_[n] = node_mark;
-        if (node_count_ >= node_candidates_.size()) {
-          stats_.overflowed = true;
+        if (out.node_count >= out.nodes.size()) {
+          out.stats.overflowed = true;
           continue;
         }
-        const auto first = static_cast<std::uint32_t>(pair_count_);
-        const Vec3 p = to_tool_frame(part.pose, surface.positions[n]);
+        const auto first = static_cast<std::uint32_t>(out.pair_count);
+        const Vec3 p = to_tool_frame(pose, surface.positions[n]);
         gather_triangles(part.tree, p, search_radius, triangle_stamp_);
         keep_within_margin(first, p, part.mesh.positions, part.mesh.triangles);
-        if (pair_count_ > first) {
-          node_candidates_[node_count_++] = {n, static_cast<std::uint16_t>(pi), first, static_cast<std::uint32_t>(pair_count_ - first)};
+        if (out.pair_count > first) {
+          out.nodes[out.node_count++] = {n, static_cast<std::uint16_t>(pi), first, static_cast<std::uint32_t>(out.pair_count - first)};
         }
       }
     }
@@ -226,23 +259,23 @@ void ToolContacts::update_candidates(const SphereTree& tissue_tree, const Triang
       for (std::uint32_t v : tri) {
         if (tool_vertex_stamp_[vertex_offset + v] == vertex_mark) continue;
         tool_vertex_stamp_[vertex_offset + v] = vertex_mark;
-        if (vertex_count_ >= vertex_candidates_.size()) {
-          stats_.overflowed = true;
+        if (out.vertex_count >= out.vertices.size()) {
+          out.stats.overflowed = true;
           continue;
         }
-        const auto first = static_cast<std::uint32_t>(pair_count_);
-        const Vec3 w = transform_point(part.pose, part.mesh.positions[v]);
+        const auto first = static_cast<std::uint32_t>(out.pair_count);
+        const Vec3 w = transform_point(pose, part.mesh.positions[v]);
         gather_triangles(tissue_tree, w, search_radius, tissue_triangle_stamp_);
         keep_within_margin(first, w, surface.positions, surface.triangles);
-        if (pair_count_ > first) {
-          vertex_candidates_[vertex_count_++] = {v, static_cast<std::uint16_t>(pi), first, static_cast<std::uint32_t>(pair_count_ - first)};
+        if (out.pair_count > first) {
+          out.vertices[out.vertex_count++] = {v, static_cast<std::uint16_t>(pi), first, static_cast<std::uint32_t>(out.pair_count - first)};
         }
       }
     }
   }
-  stats_.tissue_nodes = static_cast<std::int32_t>(node_count_);
-  stats_.tool_vertices = static_cast<std::int32_t>(vertex_count_);
-  stats_.pair_entries = static_cast<std::int32_t>(pair_count_);
+  out.stats.tissue_nodes = static_cast<std::int32_t>(out.node_count);
+  out.stats.tool_vertices = static_cast<std::int32_t>(out.vertex_count);
+  out.stats.pair_entries = static_cast<std::int32_t>(out.pair_count);
 }
 
 ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const Vec3> v, const std::vector<Triangle>& surface_triangles,

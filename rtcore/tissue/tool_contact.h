@@ -56,10 +56,21 @@ class ToolContacts {
   void set_enabled(int part, bool enabled) { parts_[static_cast<std::size_t>(part)].enabled = enabled; }
   const RigidTransform& pose(int part) const { return parts_[static_cast<std::size_t>(part)].pose; }
 
-  /// The 60 Hz collision step: queries each part's tree against the tissue surface tree (already
-  /// refitted to `surface`'s positions) and rebuilds the candidate pairs. Allocates nothing once the
-  /// capacities are reserved.
+  /// The 60 Hz collision step, all at once: latch_query_poses(), search_candidates(),
+  /// publish_candidates(). Allocates nothing once the capacities are reserved.
   void update_candidates(const SphereTree& tissue_tree, const TriangleMesh& surface);
+
+  // The same step in three parts, so the search can run on another thread while physics steps go on
+  // with the candidates already published (the core's collision pipeline):
+  /// Takes the parts' current poses and enabled flags as the ones the next search uses. Call on the
+  /// thread that sets poses, while no search runs.
+  void latch_query_poses();
+  /// Queries each part's tree (at its latched pose) against the tissue surface tree, already refitted
+  /// to `surface`'s positions, into a back buffer. Touches nothing add_forces() or set_pose() use, so
+  /// it may run concurrently with them; never with latch_query_poses() or publish_candidates().
+  void search_candidates(const SphereTree& tissue_tree, const TriangleMesh& surface);
+  /// Makes the last search's candidates the ones add_forces() uses (a swap: no allocation).
+  void publish_candidates();
 
   /// One substep's penalty forces on the candidate pairs at positions x, velocities v: adds to
   /// `force`, and to the per-node bounds of the contact stiffness and damping the integrator needs.
@@ -80,6 +91,8 @@ class ToolContacts {
     Collider collider;
     RigidTransform pose, previous_pose;
     bool enabled = true;
+    RigidTransform query_pose;  // latched for the search (the search's thread reads only these)
+    bool query_enabled = true;
   };
   /// A point with its candidate triangles: entries [first, first + count) of pair_triangles_.
   struct PointCandidates {
@@ -87,6 +100,13 @@ class ToolContacts {
     std::uint16_t part;
     std::uint32_t first;
     std::uint32_t count;
+  };
+  /// A search's result, built in the back buffer and swapped in by publish_candidates().
+  struct CandidateSet {
+    std::vector<PointCandidates> nodes, vertices;
+    std::vector<std::uint32_t> pair_triangles;
+    std::size_t node_count = 0, vertex_count = 0, pair_count = 0;
+    ToolContactStats stats;
   };
   /// Appends the triangles of `tree` with a leaf sphere within `radius` of `point`, each once.
   void gather_triangles(const SphereTree& tree, const Vec3& point, double radius, std::vector<std::uint32_t>& seen);
@@ -98,10 +118,13 @@ class ToolContacts {
   double margin_m_;
   ToolContactCapacity capacity_;
   std::vector<Part> parts_;
+  // The published candidates, which add_forces() reads.
   std::vector<PointCandidates> node_candidates_;    // tissue node against tool triangles
   std::vector<PointCandidates> vertex_candidates_;  // tool vertex against tissue triangles
   std::vector<std::uint32_t> pair_triangles_;
   std::size_t node_count_ = 0, vertex_count_ = 0, pair_count_ = 0;
+  // The search's side: its result and its scratch (stamps, stack), never read by add_forces().
+  CandidateSet search_;
   std::vector<std::uint32_t> node_stamp_, tool_vertex_stamp_, triangle_stamp_, tissue_triangle_stamp_;
   std::uint32_t stamp_ = 0;
   std::vector<std::int32_t> stack_;

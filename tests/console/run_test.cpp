@@ -35,7 +35,11 @@ TEST(RunCommand, ReportFollowsTheContractAndTheTraceMatchesIt) {
   const auto trace = nlohmann::json::parse(read_text(dir / "t.json"));
   std::map<std::string, std::vector<double>> durations;
   for (const auto& event : trace.at("traceEvents")) {
-    if (event.at("ph") == "X") durations[event.at("name").get<std::string>()].push_back(event.at("dur").get<double>());
+    if (event.at("ph") != "X") continue;
+    const std::string name = event.at("name");
+    durations[name].push_back(event.at("dur").get<double>());
+    // The refit and query run on the collision thread: their own track.
+    EXPECT_EQ(event.at("tid").get<int>(), name == "refit" || name == "query" ? 2 : 1) << name;
   }
   for (const auto& [name, stage] : report.at("stages").items()) {
     SCOPED_TRACE(name);
@@ -51,7 +55,9 @@ TEST(RunCommand, ReportFollowsTheContractAndTheTraceMatchesIt) {
     const double trace_median = d[(d.size() + 1) / 2 - 1];
     EXPECT_NEAR(median, trace_median, 0.011 * trace_median + 0.01);  // the histogram's 1% bins
   }
-  for (const char* stage : {"input", "kinematics", "physics", "query", "publish", "tick"}) EXPECT_TRUE(durations.count(stage)) << stage;
+  for (const char* stage : {"input", "kinematics", "collision_wait", "physics", "refit", "query", "response", "publish", "tick"}) {
+    EXPECT_TRUE(durations.count(stage)) << stage;
+  }
 }
 
 TEST(RunCommand, TwoRunsWithTheSameArgumentsPrintTheSameHash) {
@@ -66,6 +72,10 @@ TEST(RunCommand, TwoRunsWithTheSameArgumentsPrintTheSameHash) {
   }
   EXPECT_EQ(hashes[0], hashes[1]);
   EXPECT_EQ(chains[0], chains[1]);
+  // The collision search on the core's own thread instead of its own: the same states.
+  const auto inline_search = dir / "inline.json";
+  ASSERT_EQ(run_resecto(std::string(kShortRun) + " --inline-collision --report " + inline_search.string()).exit_code, 0);
+  EXPECT_EQ(nlohmann::json::parse(read_text(inline_search)).at("hash_chain").get<std::string>(), chains[0]);
   // A different tissue gives a different trajectory.
   const auto stiff = dir / "stiff.json";
   ASSERT_EQ(run_resecto(std::string(kShortRun) + " --set stiffness=60 --report " + stiff.string()).exit_code, 0);

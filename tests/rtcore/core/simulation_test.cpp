@@ -56,6 +56,34 @@ TEST(Simulation, SameInputsGiveTheSameHashAtEveryCollisionStep) {
   EXPECT_NE(first.front(), first.back());
 }
 
+TEST(Simulation, TheCollisionThreadChangesNothingButWhereTheSearchRuns) {
+  // The pipeline publishes a collision step's candidates at the next collision tick whichever thread
+  // searched, so the state is bit-identical with the search on the core's own thread.
+  SimulationConfig threaded = small_config();
+  SimulationConfig inline_search = small_config();
+  inline_search.collision_thread = false;
+  const auto a = run_hashes(threaded, 2 * 960);
+  const auto b = run_hashes(inline_search, 2 * 960);
+  ASSERT_EQ(a.size(), 120u);
+  EXPECT_EQ(a, b);
+}
+
+TEST(Simulation, ContactWaitsForTheCandidatesOfThePreviousCollisionStep) {
+  // The one-step pipeline: a tool pressed in at tick 0 finds nothing before the second collision
+  // tick publishes what the first one searched.
+  auto sim = Simulation::create(small_config());
+  ASSERT_TRUE(sim) << sim.error();
+  const double h = (*sim)->config().tick_s();
+  TickInput pressed = input_at(static_cast<std::uint64_t>(1.2 / h), h);  // in a lobe
+  pressed.joints.yaw_rad = 0.05;
+  int first_contact_tick = -1;
+  for (int tick = 0; tick < 64 && first_contact_tick < 0; ++tick) {
+    (*sim)->step(pressed, {});
+    if ((*sim)->tissue().tool().stats().penetrating > 0) first_contact_tick = tick;
+  }
+  EXPECT_EQ(first_contact_tick, 16);
+}
+
 TEST(Simulation, ACommandChangesTheStateFromItsTickOn) {
   const SimulationConfig config = small_config();
   ParameterCommand stiffer;

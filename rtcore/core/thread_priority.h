@@ -1,0 +1,34 @@
+// Real-time scheduling for the threads of a real-time run. On a machine shared with other work (a
+// compiler, a browser) a normal thread can be preempted for milliseconds, several ticks; SCHED_FIFO
+// threads run before every normal one. Only where the OS permits it (root or CAP_SYS_NICE); otherwise
+// the run goes on at normal priority and says so.
+#pragma once
+
+#include <pthread.h>
+
+#include <string>
+
+namespace resecto {
+
+/// Puts `thread` under SCHED_FIFO at `priority` (1..99); false (nothing changed) if not permitted.
+bool raise_to_fifo(pthread_t thread, int priority);
+/// Back to the default time-sharing policy.
+void restore_normal_scheduling(pthread_t thread);
+
+/// Raises the calling thread for its lifetime and restores it after.
+class ScopedFifoPriority {
+ public:
+  explicit ScopedFifoPriority(int priority) : thread_(pthread_self()), raised_(raise_to_fifo(thread_, priority)) {}
+  ~ScopedFifoPriority() {
+    if (raised_) restore_normal_scheduling(thread_);
+  }
+  ScopedFifoPriority(const ScopedFifoPriority&) = delete;
+  ScopedFifoPriority& operator=(const ScopedFifoPriority&) = delete;
+  bool raised() const { return raised_; }
+
+ private:
+  pthread_t thread_;
+  bool raised_;
+};
+
+}  // namespace resecto
