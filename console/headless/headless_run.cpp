@@ -297,7 +297,19 @@ std::string summarize_report(const ordered_json& r) {
                 static_cast<unsigned long long>(r.at("device").at("lost").get<std::uint64_t>()), r.at("device").at("rate_hz").get<double>(),
                 m.at("contact_time_s").get<double>(), m.at("peak_reaction_force_n").get<double>(), m.at("cut_pedal_time_s").get<double>(),
                 m.at("cut_in_contact_time_s").get<double>(), m.at("max_tissue_displacement_mm").get<double>());
-  return text;
+  std::string summary = text;
+  if (r.at("mode") == "realtime") {
+    const auto& d = r.at("deadlines");
+    std::snprintf(text, sizeof text,
+                  "  deadlines  %llu of %llu ticks missed (%.3f%%), worst %.0f us late, %llu re-anchorings; "
+                  "threads: core %s, collision %s\n",
+                  static_cast<unsigned long long>(d.at("misses").get<std::uint64_t>()),
+                  static_cast<unsigned long long>(d.at("ticks").get<std::uint64_t>()), 100.0 * d.at("miss_fraction").get<double>(),
+                  d.at("max_late_us").get<double>(), static_cast<unsigned long long>(d.at("resynchronizations").get<std::uint64_t>()),
+                  r.at("scheduling").at("core").get<std::string>().c_str(), r.at("scheduling").at("collision").get<std::string>().c_str());
+    summary += text;
+  }
+  return summary;
 }
 
 }  // namespace resecto

@@ -82,6 +82,29 @@ TEST(RunCommand, TwoRunsWithTheSameArgumentsPrintTheSameHash) {
   EXPECT_NE(nlohmann::json::parse(read_text(stiff)).at("hash_chain").get<std::string>(), chains[0]);
 }
 
+TEST(RunCommand, RealTimeReportsItsDeadlinesAndScheduling) {
+  // One real-time second: the figures must be consistent with each other (how many ticks missed is
+  // the machine's business, not a test's).
+  const auto dir = scratch_directory("run_realtime");
+  const CommandOutput run = run_resecto("run --headless --realtime --triangles 1296 --seconds 1 --report " + (dir / "r.json").string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("ticks missed"), std::string::npos) << run.out;
+  const auto report = nlohmann::json::parse(read_text(dir / "r.json"));
+  EXPECT_EQ(report.at("mode"), "realtime");
+  const auto& d = report.at("deadlines");
+  EXPECT_EQ(d.at("ticks").get<int>(), 960);
+  EXPECT_EQ(d.at("misses"), report.at("deadline_misses"));
+  EXPECT_LE(d.at("misses").get<int>(), 960);
+  EXPECT_NEAR(d.at("miss_fraction").get<double>(), d.at("misses").get<double>() / 960.0, 1e-12);
+  if (d.at("misses").get<int>() > 0) {
+    EXPECT_GT(d.at("max_late_us").get<double>(), 0.0);
+  }
+  EXPECT_GE(report.at("wall_s").get<double>(), 0.99);  // it kept to the clock
+  for (const char* thread : {"core", "collision"}) EXPECT_TRUE(report.at("scheduling").at(thread).is_string()) << thread;
+  EXPECT_GT(report.at("device").at("reports").get<int>(), 900);
+  EXPECT_TRUE(report.at("input_to_snapshot_us").at("median").is_number());
+}
+
 TEST(RunCommand, BadArgumentsFailWithOneLine) {
   const auto dir = scratch_directory("run_errors");
   std::ofstream(dir / "bad.txt") << "0 0 0 0 100 0 0 0\n1 0 0 0 100 0 0\n";
