@@ -105,7 +105,9 @@ ordered_json metrics_json(const ProcedureMetrics& m) {
           {"distal_margin_mm", m.distal_margin_mm > 1e8 ? ordered_json(nullptr) : ordered_json(m.distal_margin_mm)},
           {"verumontanum_violations", m.verumontanum_violations},
           {"non_finite_steps", m.non_finite_steps},
-          {"contact_overflows", m.contact_overflows}};
+          {"contact_overflows", m.contact_overflows},
+          {"contact_margin_exceeded_ticks", m.contact_margin_exceeded_ticks},
+          {"max_tool_travel_since_search_mm", m.max_tool_travel_since_search_mm}};
 }
 
 }  // namespace

@@ -70,7 +70,9 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
   Result<TetMesh> tetra = tetrahedralize(sim->prostate_.surface, tet);
   if (!tetra) return Error{"building the tissue model: " + tetra.error()};
   sim->tetrahedra_ = tetra->tetrahedron_count();
-  sim->tissue_ = std::make_unique<MassSpringTissue>(*tetra, config.parameters);
+  const TissueConfig tissue_config;
+  sim->contact_margin_m_ = tissue_config.contact_margin_m;
+  sim->tissue_ = std::make_unique<MassSpringTissue>(*tetra, config.parameters, tissue_config);
 
   const ResectoscopeModel tool = generate_resectoscope();
   sim->sheath_part_ = sim->tissue_->tool().add_part(tool.sheath);
@@ -83,6 +85,7 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
   sim->tissue_->tool().reset_pose(sim->sheath_part_, away);
   sim->tissue_->tool().reset_pose(sim->loop_part_, away);
   sim->poses_ = {withdrawn_pose(), withdrawn_pose()};
+  sim->searching_poses_ = sim->published_poses_ = sim->poses_;
   sim->metrics_.distal_margin_mm = 1e9;
   sim->state_hash_ = sim->tissue_->state_hash();
   if (config.collision_thread) {
@@ -93,6 +96,7 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
 }
 
 void Simulation::place_tool(const TickInput& input) {
+  tool_present_ = input.tool_present;
   poses_ = input.tool_present ? resecto::tool_poses(input.joints, config_.gimbal) : ToolPoses{withdrawn_pose(), withdrawn_pose()};
   tissue_->tool().set_pose(sheath_part_, to_transform(poses_.sheath));
   tissue_->tool().set_pose(loop_part_, to_transform(poses_.loop));
@@ -139,12 +143,16 @@ void Simulation::advance_collision_pipeline(std::uint64_t tick, FrameProfiler* p
       if (collision_thread_) collision_thread_->wait();
     }
     tissue_->end_collision_step();
+    published_poses_ = searching_poses_;
+    published_tool_present_ = searching_tool_present_;
     if (profiler) {
       profiler->record(Stage::kRefit, search_timing_.tick, search_timing_.begin_ns, search_timing_.refit_end_ns);
       profiler->record(Stage::kQuery, search_timing_.tick, search_timing_.refit_end_ns, search_timing_.query_end_ns);
     }
   }
   tissue_->begin_collision_step();
+  searching_poses_ = poses_;
+  searching_tool_present_ = tool_present_;
   search_timing_.tick = tick;
   search_pending_ = true;
   if (collision_thread_) {
@@ -178,6 +186,14 @@ void Simulation::update_metrics(const TickInput& input, bool collision_tick) {
     if (contact) metrics_.cut_in_contact_time_s += h;
   }
   if (input.tool_present) metrics_.max_insertion_mm = std::max(metrics_.max_insertion_mm, units::m_to_mm(input.joints.insertion_m));
+  // The candidates in use were searched with the tool where published_poses_ has it; the sheath's tip
+  // and the loop's front move furthest.
+  const double travel_m = std::max(length(poses_.sheath.translation - published_poses_.sheath.translation),
+                                   length(poses_.loop.apply_point(loop_front_tool_) - published_poses_.loop.apply_point(loop_front_tool_)));
+  if (input.tool_present && published_tool_present_) {
+    metrics_.max_tool_travel_since_search_mm = std::max(metrics_.max_tool_travel_since_search_mm, units::m_to_mm(travel_m));
+    if (travel_m > contact_margin_m_) ++metrics_.contact_margin_exceeded_ticks;
+  }
   if (!collision_tick) return;
   // The costlier measures once per collision step.
   metrics_.max_tissue_displacement_mm = std::max(metrics_.max_tissue_displacement_mm, units::m_to_mm(tissue_->max_displacement_m()));

@@ -59,6 +59,10 @@ struct ProcedureMetrics {
   std::uint64_t verumontanum_violations = 0;  ///< collision steps cutting distal to the verumontanum
   std::uint64_t non_finite_steps = 0;
   std::uint64_t contact_overflows = 0;
+  /// Ticks at which the tool had moved further than the contact margin from where the candidates in
+  /// use were searched: motion faster than contact can follow (margin / two collision periods).
+  std::uint64_t contact_margin_exceeded_ticks = 0;
+  double max_tool_travel_since_search_mm = 0.0;  ///< the largest such travel
 };
 
 /// What the core publishes for the console and recorder (taken at collision steps).
@@ -126,6 +130,11 @@ class Simulation {
   double verumontanum_z_m_ = 0.0;
   Vec3 loop_front_tool_{0.0};  ///< the loop wire's front, tool frame
   ToolPoses poses_;
+  ToolPoses searching_poses_;  ///< where the tool was for the search in flight
+  ToolPoses published_poses_;  ///< where the tool was for the candidates in use
+  bool searching_tool_present_ = false, published_tool_present_ = false;
+  bool tool_present_ = false;
+  double contact_margin_m_ = 0.0;
   ToolReaction reaction_;
   std::uint64_t tick_ = 0;
   std::uint64_t state_hash_ = 0;

@@ -27,8 +27,10 @@ TEST(HeadlessRun, SlowConsumerGivesTheSameHashesAtEveryCollisionStep) {
   ASSERT_EQ(a->collision_hashes.size(), 120u);
   EXPECT_EQ(a->collision_hashes, b->collision_hashes);
   EXPECT_EQ(a->final_hash, b->final_hash);
-  // The slow consumer really was slow: it saw fewer snapshots than were published.
-  EXPECT_LT(b->report.at("snapshots").at("received").get<std::uint64_t>(), 120u);
+  // The slow consumer really was slow: at most one snapshot per 25 ms of the run (on a normal build
+  // far fewer than the 120 published; a sanitizer build may run slowly enough to see them all).
+  const double wall_ms = b->report.at("wall_s").get<double>() * 1000.0;
+  EXPECT_LE(static_cast<double>(b->report.at("snapshots").at("received").get<std::uint64_t>()), wall_ms / 25.0 + 1.0);
 }
 
 TEST(HeadlessRun, TheToolStaysWithdrawnUntilTheDeviceReports) {

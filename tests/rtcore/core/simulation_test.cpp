@@ -84,6 +84,28 @@ TEST(Simulation, ContactWaitsForTheCandidatesOfThePreviousCollisionStep) {
   EXPECT_EQ(first_contact_tick, 16);
 }
 
+TEST(Simulation, CountsToolMotionFasterThanTheContactMarginCovers) {
+  // The scripted hand moves at most ~40 mm/s: within the 1.5 mm margin over two collision periods.
+  // A hand that plunges at 200 mm/s outruns it, and the metrics say so.
+  auto run = [](double insertion_speed_m_s) {
+    auto sim = Simulation::create(small_config());
+    EXPECT_TRUE(sim) << (sim ? "" : sim.error());
+    const double h = (*sim)->config().tick_s();
+    for (std::uint64_t tick = 0; tick < 960; ++tick) {
+      TickInput input = input_at(tick, h);
+      input.joints.insertion_m = 0.130 + std::min(insertion_speed_m_s * static_cast<double>(tick) * h, 0.04);
+      (*sim)->step(input, {});
+    }
+    return (*sim)->metrics();
+  };
+  const ProcedureMetrics calm = run(0.04), hasty = run(0.2);
+  EXPECT_GT(calm.max_tool_travel_since_search_mm, 0.0);
+  EXPECT_LT(calm.max_tool_travel_since_search_mm, 1.5);
+  EXPECT_EQ(calm.contact_margin_exceeded_ticks, 0u);
+  EXPECT_GT(hasty.max_tool_travel_since_search_mm, 1.5);
+  EXPECT_GT(hasty.contact_margin_exceeded_ticks, 0u);
+}
+
 TEST(Simulation, ACommandChangesTheStateFromItsTickOn) {
   const SimulationConfig config = small_config();
   ParameterCommand stiffer;
