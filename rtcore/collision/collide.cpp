@@ -211,6 +211,7 @@ bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue
         l2_stamp_[pair.tool] = stamp_;
         l2_[l2_count_++] = pair.tool;
       }
+      if (!pairs_wanted_) continue;
       const LeafPiece& a = tissue_pieces[pair.tissue];
       const LeafPiece& b = tool_pieces[pair.tool];
       // A triangle pair can meet through several leaf pairs only when a triangle has several

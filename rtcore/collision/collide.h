@@ -56,6 +56,9 @@ class Collider {
   bool collide(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
                const TriangleMesh& tool, const RigidTransform& tool_pose);
 
+  /// Whether queries find the intersecting triangle pairs (the default) or only the leaf lists, as
+  /// the contact response needs: that skips every exact triangle test.
+  void set_pairs_wanted(bool wanted) { pairs_wanted_ = wanted; }
   std::span<const TrianglePair> pairs() const { return {pairs_.data(), pair_count_}; }
   /// L1: the tissue leaves whose spheres met a tool leaf sphere, each once, in the order found.
   std::span<const std::int32_t> tissue_leaves() const { return {l1_.data(), l1_count_}; }
@@ -103,6 +106,7 @@ class Collider {
   std::vector<TestedSlot> tested_;  // open addressing: triangle pairs tested this query
   std::size_t tested_count_ = 0;
   std::vector<TrianglePair> pairs_;
+  bool pairs_wanted_ = true;
   std::size_t pair_count_ = 0;
   std::vector<NodePair> stack_;
   bool overflowed_ = false;

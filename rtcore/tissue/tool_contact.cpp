@@ -109,6 +109,7 @@ int ToolContacts::add_part(const TriangleMesh& mesh) {
     if (length > 0.0) part.inflated.positions[v] += margin_m_ * vertex_normals[v] / length;
   }
   part.tree.build(part.inflated);
+  part.collider.set_pairs_wanted(false);  // the response reads only the leaf lists
   parts_.push_back(std::move(part));
   std::size_t max_triangles = 0;
   for (const Part& p : parts_) max_triangles = std::max(max_triangles, p.mesh.triangle_count());

@@ -89,6 +89,25 @@ TEST(Collide, EqualsBruteForceOnTheGlandOverThousandsOfPoses) {
   EXPECT_GT(total_pairs, 10 * poses);
 }
 
+TEST(Collide, LeafListsAloneAreTheSameListsWithoutTheTriangleTests) {
+  // The contact response reads only L1 and L2: without the pairs the walk lists the same leaves in
+  // the same order and tests no triangle.
+  ProstateScene scene(1296);
+  Collider with_pairs, lists_only;
+  lists_only.set_pairs_wanted(false);
+  std::mt19937_64 rng(11);
+  for (int i = 0; i < 300; ++i) {
+    const RigidTransform pose = random_channel_pose(rng);
+    ASSERT_TRUE(with_pairs.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
+    ASSERT_TRUE(lists_only.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
+    const auto l1 = with_pairs.tissue_leaves(), l2 = with_pairs.tool_leaves();
+    ASSERT_TRUE(std::equal(l1.begin(), l1.end(), lists_only.tissue_leaves().begin(), lists_only.tissue_leaves().end())) << "pose " << i;
+    ASSERT_TRUE(std::equal(l2.begin(), l2.end(), lists_only.tool_leaves().begin(), lists_only.tool_leaves().end())) << "pose " << i;
+    EXPECT_TRUE(lists_only.pairs().empty());
+    EXPECT_EQ(lists_only.stats().triangle_tests, 0);
+  }
+}
+
 // Slabs as wide as long cut most tissue triangles too: a triangle pair then meets through several
 // leaf pairs on one side or both, and must still come out once (first meeting slab, or the table).
 TEST(Collide, EqualsBruteForceWhenBothTreesAreSlicedFinely) {
