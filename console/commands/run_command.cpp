@@ -26,6 +26,7 @@ struct RunOptions {
   int collision_hz = 60;
   int substeps = 16;
   bool inline_collision = false;
+  std::int64_t spin_us = 250;
   std::uint64_t seed = 1;
   std::string calibration;
   bool json = false;
@@ -47,6 +48,7 @@ void run(const RunOptions& o) {
   options.simulation.collision_hz = o.collision_hz;
   options.simulation.physics_per_collision = o.substeps;
   options.simulation.collision_thread = !o.inline_collision;
+  options.spin_us = o.spin_us;
   options.simulation.parameters = parameters_from_assignments(o.sets);
   if (!o.calibration.empty()) {
     Result<device::Calibration> calibration = device::read_calibration(o.calibration);
@@ -83,6 +85,9 @@ void register_run(CLI::App& app) {
   cmd->add_option("--substeps", o->substeps, "Physics steps per collision step")->check(CLI::Range(1, 64))->capture_default_str();
   cmd->add_flag("--inline-collision", o->inline_collision,
                 "Refit and query on the core's own thread instead of the collision thread (same state hashes)");
+  cmd->add_option("--spin-us", o->spin_us, "Real time: spin this long before each tick instead of sleeping")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
   cmd->add_option("--calibration", o->calibration, "Device calibration file (default: the reference device's)");
   cmd->add_option("--seed", o->seed, "Seed of the emulated sensors' noise")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print the JSON report instead of the summary");

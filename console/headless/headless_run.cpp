@@ -134,6 +134,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   SchedulerConfig schedule;
   schedule.period_ns = period_ns;
   schedule.realtime = options.realtime;
+  schedule.spin_ns = options.spin_us * 1000;
   FixedStepScheduler scheduler(schedule);
 
   const device::Calibration& calibration = options.calibration;

@@ -17,4 +17,18 @@ void FixedStepScheduler::sleep_until(std::int64_t deadline_ns) {
   }
 }
 
+void FixedStepScheduler::wait_until(std::int64_t deadline_ns) const {
+  if (config_.spin_ns <= 0) {
+    sleep_until(deadline_ns);
+    return;
+  }
+  const std::int64_t spin_from_ns = deadline_ns - config_.spin_ns;
+  if (FrameProfiler::now_ns() < spin_from_ns) sleep_until(spin_from_ns);
+  while (FrameProfiler::now_ns() < deadline_ns) {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();  // tells the core (and a hypervisor) this is a spin
+#endif
+  }
+}
+
 }  // namespace resecto

@@ -16,6 +16,10 @@ struct SchedulerConfig {
   bool realtime = false;
   /// Ticks the schedule may fall behind before it gives up catching up and starts afresh.
   std::uint64_t max_catch_up_ticks = 8;
+  /// The last part of each wait is spent spinning instead of sleeping: a sleeping thread's wake-up
+  /// can come late by far more than a tick's slack (an idle virtual CPU halts, and the host wakes it
+  /// when it pleases), a spinning one is already running. Costs that much CPU per tick.
+  std::int64_t spin_ns = 0;
 };
 
 /// How well the real-time schedule held.
@@ -41,7 +45,7 @@ class FixedStepScheduler {
         const std::int64_t start_ns = anchor_ns + static_cast<std::int64_t>(tick - anchor_tick) * config_.period_ns;
         const std::int64_t now = FrameProfiler::now_ns();
         if (now < start_ns) {
-          sleep_until(start_ns);
+          wait_until(start_ns);
         } else if (now - start_ns > static_cast<std::int64_t>(config_.max_catch_up_ticks) * config_.period_ns) {
           // Too far behind to catch up without a burst: start the schedule afresh from here.
           anchor_ns = now;
@@ -69,6 +73,8 @@ class FixedStepScheduler {
 
  private:
   static void sleep_until(std::int64_t deadline_ns);
+  /// Sleeps until `spin_ns` before the deadline, then spins to it.
+  void wait_until(std::int64_t deadline_ns) const;
 
   SchedulerConfig config_;
   DeadlineReport report_;

@@ -40,6 +40,23 @@ TEST(FixedStepScheduler, RealTimeTakesTheScheduledTimeAndCountsAnOverrun) {
   EXPECT_GE(scheduler.report().max_late_us, 2000.0);
 }
 
+TEST(FixedStepScheduler, SpinningTheLastStretchNeverStartsATickEarly) {
+  SchedulerConfig config;
+  config.realtime = true;
+  config.period_ns = 1'000'000;
+  config.spin_ns = 300'000;
+  FixedStepScheduler scheduler(config);
+  std::vector<std::int64_t> starts;
+  starts.reserve(50);
+  scheduler.run(0, 50, [&](std::uint64_t) {
+    starts.push_back(FrameProfiler::now_ns());
+    return true;
+  });
+  ASSERT_EQ(starts.size(), 50u);
+  // Tick 0 starts at the anchor (within the few microseconds before the first clock read).
+  for (std::size_t k = 1; k < starts.size(); ++k) EXPECT_GE(starts[k] - starts[0], static_cast<std::int64_t>(k) * 1'000'000 - 20'000) << k;
+}
+
 TEST(FixedStepScheduler, FarBehindReanchorsInsteadOfBursting) {
   SchedulerConfig config;
   config.realtime = true;
