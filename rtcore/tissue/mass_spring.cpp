@@ -15,6 +15,7 @@ MassSpringTissue::MassSpringTissue(const TetMesh& mesh, const TissueParameters& 
       config_(config),
       network_(build_spring_network(mesh)),
       tetrahedra_(mesh.tetrahedra),
+      springs_(network_),
       tool_(config.contact_margin_m, config.contact_capacity) {
   const std::size_t n = mesh.node_count();
   const std::size_t s = network_.spring_count();
@@ -28,11 +29,9 @@ MassSpringTissue::MassSpringTissue(const TetMesh& mesh, const TissueParameters& 
   step_mass_.assign(n, 0.0);
   base_stiffness_bound_.assign(n, 0.0);
   base_damping_bound_.assign(n, 0.0);
-  springs_.resize(s);
-  for (std::size_t i = 0; i < s; ++i) {
-    springs_[i] = {network_.spring_nodes[2 * i], network_.spring_nodes[2 * i + 1], network_.rest_length_m[i], 0.0, 0.0};
-  }
   anchor_k_.assign(network_.anchor_nodes.size(), 0.0);
+  node_anchor_.assign(n, -1);
+  for (std::size_t a = 0; a < network_.anchor_nodes.size(); ++a) node_anchor_[network_.anchor_nodes[a]] = static_cast<std::int32_t>(a);
   if (config_.integrator == TissueIntegrator::kImplicitEuler) {
     spring_direction_.assign(s, Vec3(0.0));
     spring_transverse_k_.assign(s, 0.0);
@@ -56,14 +55,15 @@ void MassSpringTissue::update_material() {
   }
   // Gershgorin rows at rest: each spring's Hessian blocks have norm k (more only when compressed
   // below half its length, added per step) and each row holds two of them; likewise the dampers.
-  for (std::size_t s = 0; s < springs_.size(); ++s) {
-    SpringTerm& spring = springs_[s];
-    spring.k = edge_spring_constant(modulus, network_.volume_share_m3[s], network_.rest_length_m[s]);
-    spring.c = edge_spring_constant(viscosity, network_.volume_share_m3[s], network_.rest_length_m[s]);
-    base_stiffness_bound_[spring.i] += 2.0 * spring.k;
-    base_stiffness_bound_[spring.j] += 2.0 * spring.k;
-    base_damping_bound_[spring.i] += 2.0 * spring.c;
-    base_damping_bound_[spring.j] += 2.0 * spring.c;
+  for (std::size_t s = 0; s < springs_.spring_count(); ++s) {
+    const double k = edge_spring_constant(modulus, network_.volume_share_m3[s], network_.rest_length_m[s]);
+    const double c = edge_spring_constant(viscosity, network_.volume_share_m3[s], network_.rest_length_m[s]);
+    springs_.set_material(s, k, c);
+    const std::uint32_t i = network_.spring_nodes[2 * s], j = network_.spring_nodes[2 * s + 1];
+    base_stiffness_bound_[i] += 2.0 * k;
+    base_stiffness_bound_[j] += 2.0 * k;
+    base_damping_bound_[i] += 2.0 * c;
+    base_damping_bound_[j] += 2.0 * c;
   }
   for (std::size_t a = 0; a < anchor_k_.size(); ++a) {
     anchor_k_[a] = anchor * network_.anchor_area_m2[a];
@@ -104,56 +104,24 @@ void MassSpringTissue::end_collision_step() {
   if (tool_.stats().overflowed) ++faults_.contact_overflows;
 }
 
-template <bool kLinearise>
-void MassSpringTissue::add_spring_forces() {
-  // The hot loop: one packed record per spring, in spring order (sorted by first node). The bound's
-  // constant part (2 k per spring end) is precomputed; only a spring compressed below half its rest
-  // length, whose Hessian norm k |1 - L0/L| then exceeds k, adds its excess here.
-  Vec3* const x = x_.data();
-  Vec3* const v = v_.data();
-  Vec3* const force = force_.data();
-  double* const bound = stiffness_bound_.data();
-  const std::size_t count = springs_.size();
-  for (std::size_t s = 0; s < count; ++s) {
-    const SpringTerm& spring = springs_[s];
-    const std::uint32_t i = spring.i, j = spring.j;
-    const Vec3 d = x[j] - x[i];
-    const double length = std::sqrt(glm::dot(d, d));
-    const double inverse_length = length > 0.0 ? 1.0 / length : 0.0;
-    const Vec3 u = d * inverse_length;
-    const double stretch = length - spring.rest_m;
-    const Vec3 f = (spring.k * stretch + spring.c * glm::dot(v[j] - v[i], u)) * u;
-    force[i] += f;
-    force[j] -= f;
-    if (length > 0.0 && 2.0 * length < spring.rest_m) [[unlikely]] {
-      const double excess = 2.0 * spring.k * (spring.rest_m * inverse_length - 2.0);
-      bound[i] += excess;
-      bound[j] += excess;
-    }
-    if constexpr (kLinearise) {
-      spring_direction_[s] = u;
-      spring_transverse_k_[s] = spring.k * std::max(0.0, stretch * inverse_length);  // tension only: keeps K >= 0
-    }
-  }
-}
-
 void MassSpringTissue::accumulate_forces(double h_s) {
+  // Springs first, each into its own slot; then one pass per node in node order: viscous damping,
+  // its springs in ascending spring order (SpringForces::gather), its anchor. Each node's force is
+  // thus the same sum in the same order every run, and the bounds start from their constant part.
+  const std::size_t compressed = springs_.compute(x_.data(), v_.data());
   const double viscous_rate = parameters_.si(TissueParameter::kViscousDamping);
   const std::size_t n = x_.size();
-  for (std::size_t i = 0; i < n; ++i) force_[i] = -viscous_rate * mass_[i] * v_[i];
-  // Springs, dampers, anchors and viscous damping bound the same every step until a parameter
-  // changes (update_material); what varies is added on top.
-  std::copy(base_stiffness_bound_.begin(), base_stiffness_bound_.end(), stiffness_bound_.begin());
-  std::copy(base_damping_bound_.begin(), base_damping_bound_.end(), damping_bound_.begin());
-  if (config_.integrator == TissueIntegrator::kImplicitEuler) {
-    add_spring_forces<true>();
-  } else {
-    add_spring_forces<false>();
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec3 f = springs_.gather(i, -viscous_rate * mass_[i] * v_[i]);
+    if (const std::int32_t a = node_anchor_[i]; a >= 0) f -= anchor_k_[static_cast<std::size_t>(a)] * (x_[i] - rest_[i]);
+    force_[i] = f;
+    // Springs, dampers, anchors and viscous damping bound the same every step until a parameter
+    // changes (update_material); what varies is added on top.
+    stiffness_bound_[i] = base_stiffness_bound_[i];
+    damping_bound_[i] = base_damping_bound_[i];
   }
-  for (std::size_t a = 0; a < anchor_k_.size(); ++a) {
-    const std::uint32_t i = network_.anchor_nodes[a];
-    force_[i] -= anchor_k_[a] * (x_[i] - rest_[i]);
-  }
+  if (compressed > 0) [[unlikely]] springs_.add_compression_bounds(x_.data(), stiffness_bound_.data());
+  if (config_.integrator == TissueIntegrator::kImplicitEuler) springs_.linearise(x_.data(), spring_direction_.data(), spring_transverse_k_.data());
   reaction_ = tool_.add_forces(x_, v_, surface_.triangles, parameters_.si(TissueParameter::kPenaltyStiffness),
                                parameters_.si(TissueParameter::kPenaltyDamping), h_s, force_, stiffness_bound_, damping_bound_);
 }
@@ -167,14 +135,22 @@ void MassSpringTissue::step_bounded_symplectic(double h_s) {
   // energy into it (parametric resonance: with no damping the stiffest and softest corners of the
   // ranges diverged). So a rise of D keeps the momentum D v and a fall keeps the velocity: both can
   // only lower the kinetic energy 1/2 D v^2, and the step stays symplectic while D holds still.
+  // The finite check rides along: a node's sum is formed once it has moved.
   const std::size_t n = x_.size();
+  std::size_t first_non_finite = n;
   for (std::size_t i = 0; i < n; ++i) {
     const double d = mass_[i] + 0.5 * h_s * h_s * stiffness_bound_[i] + h_s * damping_bound_[i];
-    if (d > step_mass_[i]) v_[i] *= step_mass_[i] / d;
+    Vec3 v = v_[i];
+    if (d > step_mass_[i]) v *= step_mass_[i] / d;
     step_mass_[i] = d;
-    v_[i] += (h_s / d) * force_[i];
-    x_[i] += h_s * v_[i];
+    v += (h_s / d) * force_[i];
+    const Vec3 x = x_[i] + h_s * v;
+    v_[i] = v;
+    x_[i] = x;
+    const double sum = x.x + x.y + x.z + v.x + v.y + v.z;
+    if (!std::isfinite(sum) && first_non_finite == n) first_non_finite = i;
   }
+  if (first_non_finite < n) [[unlikely]] note_non_finite(first_non_finite);
   last_substeps_ = 1;
 }
 
@@ -217,13 +193,13 @@ void MassSpringTissue::apply_system(double mass_coefficient, double damping_coef
     const std::uint32_t i = network_.anchor_nodes[a];
     out[i] += stiffness_coefficient * anchor_k_[a] * p[i];
   }
-  for (std::size_t s = 0; s < springs_.size(); ++s) {
-    const SpringTerm& spring = springs_[s];
-    const std::uint32_t i = spring.i, j = spring.j;
+  const SpringArrays& springs = springs_.arrays();
+  for (std::size_t s = 0; s < springs_.spring_count(); ++s) {
+    const std::uint32_t i = springs.i[s], j = springs.j[s];
     const Vec3& u = spring_direction_[s];
     const Vec3 dp = p[j] - p[i];
     const double along = glm::dot(u, dp);
-    const Vec3 value = (stiffness_coefficient * spring.k + damping_coefficient * spring.c) * along * u +
+    const Vec3 value = (stiffness_coefficient * springs.k[s] + damping_coefficient * springs.c[s]) * along * u +
                        (stiffness_coefficient * spring_transverse_k_[s]) * (dp - along * u);
     out[i] -= value;
     out[j] += value;
@@ -275,11 +251,16 @@ void MassSpringTissue::step_implicit_euler(double h_s) {
 
 ToolReaction MassSpringTissue::physics_step(double h_s) {
   switch (config_.integrator) {
-    case TissueIntegrator::kBoundedSymplectic: step_bounded_symplectic(h_s); break;
-    case TissueIntegrator::kSubsteppedSymplectic: step_substepped_symplectic(h_s); break;
-    case TissueIntegrator::kImplicitEuler: step_implicit_euler(h_s); break;
+    case TissueIntegrator::kBoundedSymplectic: step_bounded_symplectic(h_s); break;  // checks finiteness itself
+    case TissueIntegrator::kSubsteppedSymplectic:
+      step_substepped_symplectic(h_s);
+      check_finite();
+      break;
+    case TissueIntegrator::kImplicitEuler:
+      step_implicit_euler(h_s);
+      check_finite();
+      break;
   }
-  check_finite();
   return reaction_;
 }
 
@@ -287,11 +268,15 @@ void MassSpringTissue::check_finite() {
   for (std::size_t i = 0; i < x_.size(); ++i) {
     const double sum = x_[i].x + x_[i].y + x_[i].z + v_[i].x + v_[i].y + v_[i].z;
     if (!std::isfinite(sum)) {
-      if (faults_.first_non_finite_node < 0) faults_.first_non_finite_node = static_cast<std::int64_t>(i);
-      ++faults_.non_finite_steps;
+      note_non_finite(i);
       return;
     }
   }
+}
+
+void MassSpringTissue::note_non_finite(std::size_t node) {
+  if (faults_.first_non_finite_node < 0) faults_.first_non_finite_node = static_cast<std::int64_t>(node);
+  ++faults_.non_finite_steps;
 }
 
 std::uint64_t MassSpringTissue::state_hash() const {

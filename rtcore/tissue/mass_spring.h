@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rtcore/collision/sphere_tree.h"
+#include "rtcore/tissue/spring_forces.h"
 #include "rtcore/tissue/springs.h"
 #include "rtcore/tissue/tet_mesh.h"
 #include "rtcore/tissue/tissue_parameters.h"
@@ -105,14 +106,13 @@ class MassSpringTissue {
  private:
   void update_material();
   void accumulate_forces(double h_s);
-  template <bool kLinearise>
-  void add_spring_forces();
   void step_bounded_symplectic(double h_s);
   void step_substepped_symplectic(double h_s);
   void step_implicit_euler(double h_s);
   void apply_system(double mass_coefficient, double damping_coefficient, double stiffness_coefficient,
                     std::span<const Vec3> p, std::span<Vec3> out) const;
   void check_finite();
+  void note_non_finite(std::size_t node);
 
   TissueParameters parameters_;
   TissueConfig config_;
@@ -123,17 +123,13 @@ class MassSpringTissue {
   std::vector<Vec3> x_, v_, rest_, force_;
   std::vector<double> mass_, stiffness_bound_, damping_bound_;
   std::vector<double> step_mass_;  // D of the last bounded symplectic step (0 before the first)
-  /// One spring's hot data, packed so the force loop reads one stream.
-  struct SpringTerm {
-    std::uint32_t i, j;  // nodes, i < j
-    double rest_m, k, c;  // rest length, stiffness (N/m), damping (N*s/m)
-  };
   // Hot, per spring, in network_ order.
-  std::vector<SpringTerm> springs_;
+  SpringForces springs_;
   // The parameters' part of the per-node bounds (springs at rest, dampers, anchors, viscous).
   std::vector<double> base_stiffness_bound_, base_damping_bound_;
-  // Per anchor.
+  // Per anchor, and per node its anchor (-1: none).
   std::vector<double> anchor_k_;
+  std::vector<std::int32_t> node_anchor_;
   // Implicit Euler only: per-spring linearisation and CG vectors.
   std::vector<Vec3> spring_direction_;
   std::vector<double> spring_transverse_k_;

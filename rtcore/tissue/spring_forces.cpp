@@ -1,0 +1,100 @@
+// Spring forces: the incidence list built once, the per-spring pass, and the rare compressed-spring
+// and linearisation passes. Every pass forms a spring's length and direction with the same operations
+// (spring_geometry), so they agree bit for bit.
+#include "rtcore/tissue/spring_forces.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace resecto {
+namespace {
+
+struct SpringGeometry {
+  Vec3 d;  // x[j] - x[i]
+  double length;
+  double inverse_length;  // 0 for a spring of zero length (no direction, no force)
+};
+
+[[gnu::always_inline]] inline SpringGeometry spring_geometry(const Vec3* x, std::uint32_t i, std::uint32_t j) {
+  const Vec3 d = x[j] - x[i];
+  const double length = std::sqrt(glm::dot(d, d));
+  return {d, length, length > 0.0 ? 1.0 / length : 0.0};
+}
+
+[[gnu::always_inline]] inline bool compressed_below_half(double length, double rest_m) { return length > 0.0 && 2.0 * length < rest_m; }
+
+}  // namespace
+
+SpringForces::SpringForces(const SpringNetwork& network) {
+  const std::size_t count = network.spring_count();
+  const std::size_t nodes = network.node_volume_m3.size();
+  arrays_.i.resize(count);
+  arrays_.j.resize(count);
+  arrays_.rest_m = network.rest_length_m;
+  arrays_.k.assign(count, 0.0);
+  arrays_.c.assign(count, 0.0);
+  for (auto* f : {&arrays_.fx, &arrays_.fy, &arrays_.fz}) f->assign(count, 0.0);
+  // Counting sort by node, springs visited in ascending order: each node's list is ascending.
+  second_first_.assign(nodes + 1, 0);
+  first_first_.assign(nodes + 1, 0);
+  for (std::size_t s = 0; s < count; ++s) {
+    arrays_.i[s] = network.spring_nodes[2 * s];
+    arrays_.j[s] = network.spring_nodes[2 * s + 1];
+    ++first_first_[arrays_.i[s] + 1];
+    ++second_first_[arrays_.j[s] + 1];
+  }
+  for (std::size_t n = 0; n < nodes; ++n) {
+    first_first_[n + 1] += first_first_[n];
+    second_first_[n + 1] += second_first_[n];
+  }
+  second_springs_.resize(count);
+  std::vector<std::uint32_t> fill(second_first_.begin(), second_first_.end() - 1);
+  for (std::size_t s = 0; s < count; ++s) second_springs_[fill[arrays_.j[s]]++] = static_cast<std::uint32_t>(s);
+}
+
+std::size_t SpringForces::compute(const Vec3* x, const Vec3* v) {
+  // Each iteration writes only its own spring's slot: no order between them matters.
+  const std::size_t count = spring_count();
+  const std::uint32_t* const first = arrays_.i.data();
+  const std::uint32_t* const second = arrays_.j.data();
+  const double* const rest = arrays_.rest_m.data();
+  const double* const k = arrays_.k.data();
+  const double* const c = arrays_.c.data();
+  double* const fx = arrays_.fx.data();
+  double* const fy = arrays_.fy.data();
+  double* const fz = arrays_.fz.data();
+  std::size_t compressed = 0;
+  for (std::size_t s = 0; s < count; ++s) {
+    const SpringGeometry g = spring_geometry(x, first[s], second[s]);
+    const Vec3 u = g.d * g.inverse_length;
+    const double stretch = g.length - rest[s];
+    const Vec3 f = (k[s] * stretch + c[s] * glm::dot(v[second[s]] - v[first[s]], u)) * u;
+    fx[s] = f.x;
+    fy[s] = f.y;
+    fz[s] = f.z;
+    compressed += compressed_below_half(g.length, rest[s]) ? 1 : 0;
+  }
+  return compressed;
+}
+
+void SpringForces::add_compression_bounds(const Vec3* x, double* stiffness_bound) const {
+  // Spring order: each node's bound sums its springs' excesses in the same order every run.
+  for (std::size_t s = 0; s < spring_count(); ++s) {
+    const SpringGeometry g = spring_geometry(x, arrays_.i[s], arrays_.j[s]);
+    if (!compressed_below_half(g.length, arrays_.rest_m[s])) continue;
+    const double excess = 2.0 * arrays_.k[s] * (arrays_.rest_m[s] * g.inverse_length - 2.0);
+    stiffness_bound[arrays_.i[s]] += excess;
+    stiffness_bound[arrays_.j[s]] += excess;
+  }
+}
+
+void SpringForces::linearise(const Vec3* x, Vec3* direction, double* transverse_k) const {
+  for (std::size_t s = 0; s < spring_count(); ++s) {
+    const SpringGeometry g = spring_geometry(x, arrays_.i[s], arrays_.j[s]);
+    direction[s] = g.d * g.inverse_length;
+    const double stretch = g.length - arrays_.rest_m[s];
+    transverse_k[s] = arrays_.k[s] * std::max(0.0, stretch * g.inverse_length);  // tension only: keeps K >= 0
+  }
+}
+
+}  // namespace resecto
