@@ -1,6 +1,6 @@
-// Spring forces: the incidence list built once, the per-spring pass, and the rare compressed-spring
-// and linearisation passes. Every pass forms a spring's length and direction with the same operations
-// (spring_geometry), so they agree bit for bit.
+// Spring forces: the incidence list built once, and the rare compressed-spring and linearisation
+// passes (the per-spring pass is spring_kernel.cpp); they form a spring's length and direction with
+// the kernel's operations, so they see the same lengths.
 #include "rtcore/tissue/spring_forces.h"
 
 #include <algorithm>
@@ -50,31 +50,6 @@ SpringForces::SpringForces(const SpringNetwork& network) {
   second_springs_.resize(count);
   std::vector<std::uint32_t> fill(second_first_.begin(), second_first_.end() - 1);
   for (std::size_t s = 0; s < count; ++s) second_springs_[fill[arrays_.j[s]]++] = static_cast<std::uint32_t>(s);
-}
-
-std::size_t SpringForces::compute(const Vec3* x, const Vec3* v) {
-  // Each iteration writes only its own spring's slot: no order between them matters.
-  const std::size_t count = spring_count();
-  const std::uint32_t* const first = arrays_.i.data();
-  const std::uint32_t* const second = arrays_.j.data();
-  const double* const rest = arrays_.rest_m.data();
-  const double* const k = arrays_.k.data();
-  const double* const c = arrays_.c.data();
-  double* const fx = arrays_.fx.data();
-  double* const fy = arrays_.fy.data();
-  double* const fz = arrays_.fz.data();
-  std::size_t compressed = 0;
-  for (std::size_t s = 0; s < count; ++s) {
-    const SpringGeometry g = spring_geometry(x, first[s], second[s]);
-    const Vec3 u = g.d * g.inverse_length;
-    const double stretch = g.length - rest[s];
-    const Vec3 f = (k[s] * stretch + c[s] * glm::dot(v[second[s]] - v[first[s]], u)) * u;
-    fx[s] = f.x;
-    fy[s] = f.y;
-    fz[s] = f.z;
-    compressed += compressed_below_half(g.length, rest[s]) ? 1 : 0;
-  }
-  return compressed;
 }
 
 void SpringForces::add_compression_bounds(const Vec3* x, double* stiffness_bound) const {

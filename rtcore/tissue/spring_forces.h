@@ -8,17 +8,10 @@
 #include <vector>
 
 #include "rtcore/geometry/vec3.h"
+#include "rtcore/tissue/spring_kernel.h"
 #include "rtcore/tissue/springs.h"
 
 namespace resecto {
-
-/// Per-spring inputs and outputs, one array per field, in the network's spring order.
-struct SpringArrays {
-  std::vector<std::uint32_t> i, j;  ///< nodes, i < j (springs sorted by i, then j)
-  std::vector<double> rest_m;       ///< rest length
-  std::vector<double> k, c;         ///< stiffness (N/m), damping (N*s/m)
-  std::vector<double> fx, fy, fz;   ///< the spring's force on node i of the last pass (node j gets minus)
-};
 
 class SpringForces {
  public:
@@ -32,9 +25,9 @@ class SpringForces {
     arrays_.c[s] = c_ns_m;
   }
 
-  /// The per-spring pass at positions x and velocities v. Returns how many springs are compressed
-  /// below half their rest length (add_compression_bounds handles those; usually none).
-  std::size_t compute(const Vec3* x, const Vec3* v);
+  /// The per-spring pass at positions x and velocities v (spring_kernel.h). Returns how many springs
+  /// are compressed below half their rest length (add_compression_bounds handles those; usually none).
+  std::size_t compute(const Vec3* x, const Vec3* v) { return spring_forces(arrays_, x, v); }
 
   /// The per-node pass for node n: `sum` plus n's spring forces of the last compute(), added in
   /// ascending spring order, which is the order the scatter formed them in (same bits).

@@ -1,0 +1,103 @@
+// Spring force kernels. The AVX2 loop mirrors the portable one operation for operation (same
+// operands, same association: dot products as (x + y) + z), which is what keeps them bit-identical;
+// tests/rtcore/tissue/spring_kernel_test.cpp holds them to it. Change both or neither.
+#include "rtcore/tissue/spring_kernel.h"
+
+#include <immintrin.h>
+
+#include <bit>
+#include <cmath>
+
+namespace resecto {
+namespace {
+
+/// One node's (x, y, z, 0): a masked load, so the last node's row never reads past the array.
+__attribute__((target("avx2"), always_inline)) inline __m256d load_row(const Vec3& p) {
+  return _mm256_maskload_pd(&p.x, _mm256_set_epi64x(0, -1, -1, -1));
+}
+
+/// Four (x, y, z, _) rows as three columns (x0..x3), (y0..y3), (z0..z3): pure moves, no arithmetic.
+struct Columns {
+  __m256d x, y, z;
+};
+__attribute__((target("avx2"), always_inline)) inline Columns transpose(__m256d r0, __m256d r1, __m256d r2, __m256d r3) {
+  const __m256d xz01 = _mm256_unpacklo_pd(r0, r1), y01 = _mm256_unpackhi_pd(r0, r1);
+  const __m256d xz23 = _mm256_unpacklo_pd(r2, r3), y23 = _mm256_unpackhi_pd(r2, r3);
+  return {_mm256_permute2f128_pd(xz01, xz23, 0x20), _mm256_permute2f128_pd(y01, y23, 0x20), _mm256_permute2f128_pd(xz01, xz23, 0x31)};
+}
+
+/// Node j's row minus node i's row of `p` for four springs, as columns: the same subtractions the
+/// portable loop does per component, done before the transpose (gathers are slow on this class of
+/// processor, and rows subtract with one instruction).
+__attribute__((target("avx2"), always_inline)) inline Columns differences(const Vec3* p, const std::uint32_t* i, const std::uint32_t* j) {
+  return transpose(_mm256_sub_pd(load_row(p[j[0]]), load_row(p[i[0]])), _mm256_sub_pd(load_row(p[j[1]]), load_row(p[i[1]])),
+                   _mm256_sub_pd(load_row(p[j[2]]), load_row(p[i[2]])), _mm256_sub_pd(load_row(p[j[3]]), load_row(p[i[3]])));
+}
+
+}  // namespace
+
+std::size_t spring_forces_portable(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end) {
+  std::size_t compressed = 0;
+  for (std::size_t s = begin; s < end; ++s) {
+    const Vec3& xi = x[springs.i[s]];
+    const Vec3& xj = x[springs.j[s]];
+    const double dx = xj.x - xi.x, dy = xj.y - xi.y, dz = xj.z - xi.z;
+    const double length = std::sqrt((dx * dx + dy * dy) + dz * dz);
+    const double inverse_length = length > 0.0 ? 1.0 / length : 0.0;
+    const double ux = dx * inverse_length, uy = dy * inverse_length, uz = dz * inverse_length;
+    const double stretch = length - springs.rest_m[s];
+    const Vec3& vi = v[springs.i[s]];
+    const Vec3& vj = v[springs.j[s]];
+    const double along = ((vj.x - vi.x) * ux + (vj.y - vi.y) * uy) + (vj.z - vi.z) * uz;
+    const double magnitude = springs.k[s] * stretch + springs.c[s] * along;
+    springs.fx[s] = magnitude * ux;
+    springs.fy[s] = magnitude * uy;
+    springs.fz[s] = magnitude * uz;
+    compressed += (length > 0.0 && 2.0 * length < springs.rest_m[s]) ? 1 : 0;
+  }
+  return compressed;
+}
+
+__attribute__((target("avx2"))) std::size_t spring_forces_avx2(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin,
+                                                               std::size_t end) {
+  const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), two = _mm256_set1_pd(2.0);
+  std::size_t compressed = 0;
+  std::size_t s = begin;
+  for (; s + 4 <= end; s += 4) {
+    const Columns d = differences(x, springs.i.data() + s, springs.j.data() + s);
+    const __m256d dx = d.x, dy = d.y, dz = d.z;
+    const __m256d length =
+        _mm256_sqrt_pd(_mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)), _mm256_mul_pd(dz, dz)));
+    // length > 0 ? 1 / length : 0 (a NaN length compares false too, as in the portable loop).
+    const __m256d positive = _mm256_cmp_pd(length, zero, _CMP_GT_OQ);
+    const __m256d inverse_length = _mm256_and_pd(_mm256_div_pd(one, length), positive);
+    const __m256d ux = _mm256_mul_pd(dx, inverse_length);
+    const __m256d uy = _mm256_mul_pd(dy, inverse_length);
+    const __m256d uz = _mm256_mul_pd(dz, inverse_length);
+    const __m256d rest = _mm256_loadu_pd(springs.rest_m.data() + s);
+    const __m256d stretch = _mm256_sub_pd(length, rest);
+    const Columns dv = differences(v, springs.i.data() + s, springs.j.data() + s);
+    const __m256d dvx = dv.x, dvy = dv.y, dvz = dv.z;
+    const __m256d along = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dvx, ux), _mm256_mul_pd(dvy, uy)), _mm256_mul_pd(dvz, uz));
+    const __m256d magnitude = _mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(springs.k.data() + s), stretch),
+                                            _mm256_mul_pd(_mm256_loadu_pd(springs.c.data() + s), along));
+    _mm256_storeu_pd(springs.fx.data() + s, _mm256_mul_pd(magnitude, ux));
+    _mm256_storeu_pd(springs.fy.data() + s, _mm256_mul_pd(magnitude, uy));
+    _mm256_storeu_pd(springs.fz.data() + s, _mm256_mul_pd(magnitude, uz));
+    const __m256d short_spring = _mm256_and_pd(positive, _mm256_cmp_pd(_mm256_mul_pd(two, length), rest, _CMP_LT_OQ));
+    compressed += static_cast<std::size_t>(std::popcount(static_cast<unsigned>(_mm256_movemask_pd(short_spring))));
+  }
+  return compressed + spring_forces_portable(springs, x, v, s, end);
+}
+
+bool cpu_has_avx2() {
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+}
+
+std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v) {
+  const std::size_t count = springs.i.size();
+  return cpu_has_avx2() ? spring_forces_avx2(springs, x, v, 0, count) : spring_forces_portable(springs, x, v, 0, count);
+}
+
+}  // namespace resecto

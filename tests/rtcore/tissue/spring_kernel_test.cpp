@@ -1,0 +1,60 @@
+// The spring force kernels agree bit for bit: the AVX2 path must give exactly the portable path's
+// forces (determinism across machines with and without it), including zero-length, compressed and
+// non-finite springs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+
+#include "rtcore/anatomy/resectoscope.h"
+#include "rtcore/tissue/indentation.h"
+#include "rtcore/tissue/spring_forces.h"
+
+namespace resecto {
+namespace {
+
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+TEST(SpringKernel, Avx2PathMatchesThePortablePathBitForBit) {
+  if (!cpu_has_avx2()) GTEST_SKIP() << "no AVX2 on this processor: only the portable path runs";
+  Result<ProstateTissueModel> model = build_prostate_tissue_model(generate_prostate(1296), generate_resectoscope().loop);
+  ASSERT_TRUE(model) << model.error();
+  const SpringNetwork network = build_spring_network(model->mesh);
+  SpringForces forces(network);
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> jitter(-1e-3, 1e-3), speed(-0.05, 0.05), stiffness(0.1, 500.0);
+  for (std::size_t s = 0; s < forces.spring_count(); ++s) forces.set_material(s, stiffness(random), 1e-3 * stiffness(random));
+  std::vector<Vec3> x = model->mesh.positions, v(x.size());
+  for (std::size_t n = 0; n < x.size(); ++n) {
+    x[n] += Vec3(jitter(random), jitter(random), jitter(random));
+    v[n] = Vec3(speed(random), speed(random), speed(random));
+  }
+  // A spring of zero length, one compressed below half its rest length, and a non-finite node.
+  const SpringArrays& springs = forces.arrays();
+  x[springs.j[10]] = x[springs.i[10]];
+  x[springs.j[21]] = x[springs.i[21]] + 0.3 * (x[springs.j[21]] - x[springs.i[21]]);
+  v[springs.j[33]].y = std::numeric_limits<double>::quiet_NaN();
+
+  const std::size_t count = forces.spring_count();
+  for (auto [begin, end] : {std::pair<std::size_t, std::size_t>{0, count}, {1, count - 2}, {5, 7}}) {
+    SpringArrays portable = springs, simd = springs;
+    const std::size_t compressed_portable = spring_forces_portable(portable, x.data(), v.data(), begin, end);
+    const std::size_t compressed_simd = spring_forces_avx2(simd, x.data(), v.data(), begin, end);
+    EXPECT_EQ(compressed_portable, compressed_simd);
+    EXPECT_TRUE(same_bits(portable.fx, simd.fx)) << begin << ".." << end;
+    EXPECT_TRUE(same_bits(portable.fy, simd.fy)) << begin << ".." << end;
+    EXPECT_TRUE(same_bits(portable.fz, simd.fz)) << begin << ".." << end;
+    if (begin == 0) {
+      EXPECT_GE(compressed_portable, 1u);
+      EXPECT_EQ(portable.fx[10], 0.0);
+      EXPECT_TRUE(std::isnan(portable.fy[33]));
+    }
+  }
+}
+
+}  // namespace
+}  // namespace resecto
