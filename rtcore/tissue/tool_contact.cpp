@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <glm/common.hpp>
+
 #include "rtcore/geometry/closest_point.h"
 
 namespace resecto {
@@ -54,6 +56,12 @@ struct Closest {
   bool beyond(const Vec3& p, const Vec3& center, double radius) const {
     const Vec3 d = p - center;
     return glm::dot(d, d) > (radius + reach) * (radius + reach);
+  }
+  /// The same for a triangle inside the box [lo, hi]: the box's distance is a lower bound of the
+  /// triangle's, and needs neither a square root nor a division.
+  bool beyond_box(const Vec3& p, const Vec3& lo, const Vec3& hi) const {
+    const Vec3 gap = glm::max(glm::max(lo - p, p - hi), Vec3(0.0));
+    return glm::dot(gap, gap) > distance2 + kTie;
   }
   /// True when a closest point at squared distance d2 cannot be offered successfully.
   bool further(double d2) const { return d2 > distance2 + kTie; }
@@ -325,11 +333,8 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
     Closest best;
     for (std::uint32_t e = pc.first; e < pc.first + pc.count; ++e) {
       const Triangle& t = surface_triangles[pair_triangles_[e]];
-      // The tissue's faces move, so their bounding spheres are formed here (cheaper than the test).
-      const Vec3 centroid = (x[t[0]] + x[t[1]] + x[t[2]]) / 3.0;
-      const double radius2 = std::max({glm::dot(x[t[0]] - centroid, x[t[0]] - centroid), glm::dot(x[t[1]] - centroid, x[t[1]] - centroid),
-                                       glm::dot(x[t[2]] - centroid, x[t[2]] - centroid)});
-      if (best.beyond(w, centroid, std::sqrt(radius2))) continue;
+      // The tissue's faces move, so their bounds are formed here: a box, cheaper than a sphere.
+      if (best.beyond_box(w, glm::min(x[t[0]], glm::min(x[t[1]], x[t[2]])), glm::max(x[t[0]], glm::max(x[t[1]], x[t[2]])))) continue;
       const Vec3 q = closest_point_on_triangle(w, x[t[0]], x[t[1]], x[t[2]]);
       if (best.further(glm::dot(w - q, w - q))) continue;
       const Vec3 n2 = glm::cross(x[t[1]] - x[t[0]], x[t[2]] - x[t[0]]);
