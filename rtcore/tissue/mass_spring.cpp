@@ -39,6 +39,7 @@ MassSpringTissue::MassSpringTissue(const TetMesh& mesh, const TissueParameters& 
   }
   surface_ = boundary_surface(mesh);
   surface_tree_.build(surface_);
+  topology_hash_ = topology_hash();
   update_material();
 }
 
@@ -279,12 +280,18 @@ void MassSpringTissue::note_non_finite(std::size_t node) {
   ++faults_.non_finite_steps;
 }
 
+std::uint64_t MassSpringTissue::topology_hash() const {
+  StateHasher hasher;
+  hasher.add(std::span<const std::uint32_t>(network_.spring_nodes));
+  hasher.add(std::span<const Triangle>(surface_.triangles));
+  return hasher.value();
+}
+
 std::uint64_t MassSpringTissue::state_hash() const {
   StateHasher hasher;
   hasher.add(std::span<const Vec3>(x_));
   hasher.add(std::span<const Vec3>(v_));
-  hasher.add(std::span<const std::uint32_t>(network_.spring_nodes));
-  hasher.add(std::span<const Triangle>(surface_.triangles));
+  hasher.add(std::span<const std::uint64_t>(&topology_hash_, 1));
   return hasher.value();
 }
 

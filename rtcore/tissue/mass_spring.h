@@ -84,7 +84,8 @@ class MassSpringTissue {
   /// One physics step of h_s seconds (default 1/960 s). Returns the reaction on the tool.
   ToolReaction physics_step(double h_s);
 
-  /// 64-bit hash of positions, velocities and topology, bytes in index order.
+  /// 64-bit hash of positions, velocities and topology, bytes in index order. The topology's part is
+  /// hashed once (about half the bytes at 8640 triangles); whatever changes the topology must renew it.
   std::uint64_t state_hash() const;
 
   std::size_t node_count() const { return x_.size(); }
@@ -112,6 +113,7 @@ class MassSpringTissue {
   void apply_system(double mass_coefficient, double damping_coefficient, double stiffness_coefficient,
                     std::span<const Vec3> p, std::span<Vec3> out) const;
   void check_finite();
+  std::uint64_t topology_hash() const;
   void note_non_finite(std::size_t node);
 
   TissueParameters parameters_;
@@ -137,6 +139,7 @@ class MassSpringTissue {
 
   TriangleMesh surface_;
   SphereTree surface_tree_;
+  std::uint64_t topology_hash_ = 0;  // of the springs' nodes and the surface's triangles
   ToolContacts tool_;
   ToolReaction reaction_;
   TissueFaults faults_;
