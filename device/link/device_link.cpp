@@ -69,7 +69,7 @@ LinkCounters DeviceLink::counters() const {
   if (span_ns > 0) snapshot.rate_hz = static_cast<double>(intervals) * 1e9 / static_cast<double>(span_ns);
   snapshot.latency_median_us = latency_.quantile(0.5);
   snapshot.latency_p99_us = latency_.quantile(0.99);
-  snapshot.latency_max_us = latency_.max_us();
+  snapshot.latency_max_us = latency_.max();
   return snapshot;
 }
 

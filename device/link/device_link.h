@@ -20,6 +20,7 @@
 #include "device/link/sequence_tracker.h"
 #include "device/transport/device_transport.h"
 #include "device/transport/host_clock.h"
+#include "rtcore/base/timing_histogram.h"
 #include "rtcore/concurrency/spsc_ring.h"
 
 namespace resecto {
@@ -87,7 +88,7 @@ class DeviceLink {
 
   // Link-thread state.
   LinkCounters counters_;
-  LatencyHistogram latency_;
+  TimingHistogram latency_;
   ClockOffsetEstimator clock_offset_;
   SequenceTracker sequence_;
   bool link_up_ = false;

@@ -1,12 +1,11 @@
 // LinkStatistics: what the link thread counts about the report stream — rate, loss, duplicates,
 // reordering, rejections by reason, device-time jumps, disconnections — and the device-to-host latency
-// after estimating the offset between the two clocks. Fixed-size (a latency histogram), so updating
-// it per report allocates nothing.
+// after estimating the offset between the two clocks (the latency itself goes into the project's
+// TimingHistogram). Fixed-size, so updating it per report allocates nothing.
 #pragma once
 
 #include <array>
 #include <cstdint>
-#include <vector>
 
 #include "device/link/report_decoder.h"
 
@@ -36,24 +35,6 @@ struct LinkCounters {
   double latency_p99_us = 0.0;
   double latency_max_us = 0.0;
   bool connected = false;
-};
-
-/// Histogram of latencies in 1 us bins up to kLatencyHistogramUs, plus an overflow count and the max.
-class LatencyHistogram {
- public:
-  static constexpr int kLatencyHistogramUs = 20000;
-  LatencyHistogram() : bins_(kLatencyHistogramUs + 1, 0) {}
-  void add(double latency_us);
-  /// The q-quantile (0..1) in microseconds (bin centre; overflow reports the max). 0 when empty.
-  double quantile(double q) const;
-  double max_us() const { return max_us_; }
-  std::uint64_t count() const { return count_; }
-  void clear();
-
- private:
-  std::vector<std::uint32_t> bins_;  ///< allocated once at construction
-  std::uint64_t count_ = 0;
-  double max_us_ = 0.0;
 };
 
 /// Estimates host_time - device_time as the lower envelope of observed differences (the fastest

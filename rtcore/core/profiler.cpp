@@ -1,4 +1,4 @@
-// Histograms, statistics and the Chrome trace export of the frame-budget profiler.
+// Statistics and the Chrome trace export of the frame-budget profiler.
 #include "rtcore/core/profiler.h"
 
 #include <algorithm>
@@ -9,20 +9,6 @@
 
 namespace resecto {
 namespace {
-
-constexpr double kSmallestUs = 0.01;     // 10 ns
-constexpr double kLargestUs = 1e8;       // 100 s
-constexpr double kBinGrowth = 1.01;      // 1% wide bins
-const double kLogGrowth = std::log(kBinGrowth);
-const int kBinCount = static_cast<int>(std::ceil(std::log(kLargestUs / kSmallestUs) / std::log(kBinGrowth))) + 2;
-
-int bin_of(double us) {
-  if (!(us > kSmallestUs)) return 0;
-  return std::min(kBinCount - 1, 1 + static_cast<int>(std::log(us / kSmallestUs) / kLogGrowth));
-}
-
-/// The upper edge of a bin, the value a quantile falling into it reports.
-double bin_upper_us(int bin) { return bin == 0 ? kSmallestUs : kSmallestUs * std::pow(kBinGrowth, bin); }
 
 /// The stages the collision thread runs get their own track in the trace.
 bool runs_on_collision_thread(Stage stage) { return stage == Stage::kRefit || stage == Stage::kQuery; }
@@ -42,25 +28,6 @@ const char* stage_name(Stage stage) {
     case Stage::kTick: return "tick";
   }
   return "unknown";
-}
-
-TimingHistogram::TimingHistogram() : bins_(static_cast<std::size_t>(kBinCount), 0) {}
-
-void TimingHistogram::add(double microseconds) {
-  ++bins_[static_cast<std::size_t>(bin_of(microseconds))];
-  ++count_;
-  max_us_ = std::max(max_us_, microseconds);
-}
-
-double TimingHistogram::quantile(double q) const {
-  if (count_ == 0) return 0.0;
-  const auto rank = static_cast<std::uint64_t>(std::ceil(std::clamp(q, 0.0, 1.0) * static_cast<double>(count_)));
-  std::uint64_t seen = 0;
-  for (int b = 0; b < kBinCount; ++b) {
-    seen += bins_[static_cast<std::size_t>(b)];
-    if (seen >= std::max<std::uint64_t>(rank, 1)) return std::min(bin_upper_us(b), max_us_);
-  }
-  return max_us_;
 }
 
 FrameProfiler::FrameProfiler(const std::array<double, kStageCount>& budgets_us, std::size_t trace_capacity)

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "rtcore/base/result.h"
+#include "rtcore/base/timing_histogram.h"
 
 namespace resecto {
 
@@ -20,23 +21,6 @@ inline constexpr int kStageCount = 9;
 
 /// Lower-case name used in reports and traces ("physics").
 const char* stage_name(Stage stage);
-
-/// Running distribution of durations in fixed memory: log-spaced bins 1% wide from 10 ns to 100 s,
-/// so percentiles are within 1% and adding a sample never allocates.
-class TimingHistogram {
- public:
-  TimingHistogram();
-  void add(double microseconds);
-  /// The q-quantile (0..1) in microseconds; 0 when empty.
-  double quantile(double q) const;
-  double max() const { return max_us_; }
-  std::uint64_t count() const { return count_; }
-
- private:
-  std::vector<std::uint32_t> bins_;
-  std::uint64_t count_ = 0;
-  double max_us_ = 0.0;
-};
 
 /// Percentiles of one stage against its budget, microseconds.
 struct StageStatistics {
