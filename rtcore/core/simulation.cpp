@@ -70,9 +70,7 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
   Result<TetMesh> tetra = tetrahedralize(sim->prostate_.surface, tet);
   if (!tetra) return Error{"building the tissue model: " + tetra.error()};
   sim->tetrahedra_ = tetra->tetrahedron_count();
-  const TissueConfig tissue_config;
-  sim->contact_margin_m_ = tissue_config.contact_margin_m;
-  sim->tissue_ = std::make_unique<MassSpringTissue>(*tetra, config.parameters, tissue_config);
+  sim->tissue_ = std::make_unique<MassSpringTissue>(*tetra, config.parameters);
 
   const ResectoscopeModel tool = generate_resectoscope();
   sim->sheath_part_ = sim->tissue_->tool().add_part(tool.sheath);
@@ -84,8 +82,8 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
   const RigidTransform away = to_transform(withdrawn_pose());
   sim->tissue_->tool().reset_pose(sim->sheath_part_, away);
   sim->tissue_->tool().reset_pose(sim->loop_part_, away);
-  sim->poses_ = {withdrawn_pose(), withdrawn_pose()};
-  sim->searching_poses_ = sim->published_poses_ = sim->poses_;
+  sim->placed_.poses = {withdrawn_pose(), withdrawn_pose()};
+  sim->searching_ = sim->published_ = sim->placed_;
   sim->metrics_.distal_margin_mm = 1e9;
   sim->state_hash_ = sim->tissue_->state_hash();
   if (config.collision_thread) {
@@ -96,10 +94,10 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
 }
 
 void Simulation::place_tool(const TickInput& input) {
-  tool_present_ = input.tool_present;
-  poses_ = input.tool_present ? resecto::tool_poses(input.joints, config_.gimbal) : ToolPoses{withdrawn_pose(), withdrawn_pose()};
-  tissue_->tool().set_pose(sheath_part_, to_transform(poses_.sheath));
-  tissue_->tool().set_pose(loop_part_, to_transform(poses_.loop));
+  placed_.present = input.tool_present;
+  placed_.poses = input.tool_present ? resecto::tool_poses(input.joints, config_.gimbal) : ToolPoses{withdrawn_pose(), withdrawn_pose()};
+  tissue_->tool().set_pose(sheath_part_, to_transform(placed_.poses.sheath));
+  tissue_->tool().set_pose(loop_part_, to_transform(placed_.poses.loop));
 }
 
 void Simulation::step(const TickInput& input, std::span<const ParameterCommand> commands, FrameProfiler* profiler) {
@@ -127,7 +125,7 @@ void Simulation::step(const TickInput& input, std::span<const ParameterCommand> 
       const std::uint64_t tissue_hash = tissue_->state_hash();
       hasher.add(std::span<const std::uint64_t>(&tissue_hash, 1));
       hasher.add(std::span<const std::uint64_t>(&tick, 1));
-      hasher.add(std::span<const RigidPose>(&poses_.sheath, 2));
+      hasher.add(std::span<const RigidPose>(&placed_.poses.sheath, 2));
       state_hash_ = hasher.value();
     }
   }
@@ -143,16 +141,14 @@ void Simulation::advance_collision_pipeline(std::uint64_t tick, FrameProfiler* p
       if (collision_thread_) collision_thread_->wait();
     }
     tissue_->end_collision_step();
-    published_poses_ = searching_poses_;
-    published_tool_present_ = searching_tool_present_;
+    published_ = searching_;
     if (profiler) {
       profiler->record(Stage::kRefit, search_timing_.tick, search_timing_.begin_ns, search_timing_.refit_end_ns);
       profiler->record(Stage::kQuery, search_timing_.tick, search_timing_.refit_end_ns, search_timing_.query_end_ns);
     }
   }
   tissue_->begin_collision_step();
-  searching_poses_ = poses_;
-  searching_tool_present_ = tool_present_;
+  searching_ = placed_;
   search_timing_.tick = tick;
   search_pending_ = true;
   if (collision_thread_) {
@@ -186,19 +182,21 @@ void Simulation::update_metrics(const TickInput& input, bool collision_tick) {
     if (contact) metrics_.cut_in_contact_time_s += h;
   }
   if (input.tool_present) metrics_.max_insertion_mm = std::max(metrics_.max_insertion_mm, units::m_to_mm(input.joints.insertion_m));
-  // The candidates in use were searched with the tool where published_poses_ has it; the sheath's tip
+  // The candidates in use were searched with the tool where published_ has it; the sheath's tip
   // and the loop's front move furthest.
-  const double travel_m = std::max(length(poses_.sheath.translation - published_poses_.sheath.translation),
-                                   length(poses_.loop.apply_point(loop_front_tool_) - published_poses_.loop.apply_point(loop_front_tool_)));
-  if (input.tool_present && published_tool_present_) {
+  const ToolPoses& now = placed_.poses;
+  const ToolPoses& searched = published_.poses;
+  const double travel_m = std::max(length(now.sheath.translation - searched.sheath.translation),
+                                   length(now.loop.apply_point(loop_front_tool_) - searched.loop.apply_point(loop_front_tool_)));
+  if (placed_.present && published_.present) {
     metrics_.max_tool_travel_since_search_mm = std::max(metrics_.max_tool_travel_since_search_mm, units::m_to_mm(travel_m));
-    if (travel_m > contact_margin_m_) ++metrics_.contact_margin_exceeded_ticks;
+    if (travel_m > tissue_->tool().margin_m()) ++metrics_.contact_margin_exceeded_ticks;
   }
   if (!collision_tick) return;
   // The costlier measures once per collision step.
   metrics_.max_tissue_displacement_mm = std::max(metrics_.max_tissue_displacement_mm, units::m_to_mm(tissue_->max_displacement_m()));
   if (cutting) {
-    const double margin_m = poses_.loop.apply_point(loop_front_tool_).z - verumontanum_z_m_;
+    const double margin_m = placed_.poses.loop.apply_point(loop_front_tool_).z - verumontanum_z_m_;
     metrics_.distal_margin_mm = std::min(metrics_.distal_margin_mm, units::m_to_mm(margin_m));
     if (margin_m < 0.0) ++metrics_.verumontanum_violations;
   }
@@ -209,7 +207,7 @@ void Simulation::update_metrics(const TickInput& input, bool collision_tick) {
 void Simulation::fill_snapshot(SimulationSnapshot& snapshot) const {
   snapshot.tick = tick_;
   snapshot.state_hash = state_hash_;
-  snapshot.tool = poses_;
+  snapshot.tool = placed_.poses;
   snapshot.reaction = reaction_;
   snapshot.penetrating_points = tissue_->tool().stats().penetrating;
   const std::span<const Vec3> x = tissue_->positions();

@@ -95,7 +95,7 @@ class Simulation {
   const MassSpringTissue& tissue() const { return *tissue_; }
   const ProstateModel& prostate() const { return prostate_; }
   const SimulationConfig& config() const { return config_; }
-  const ToolPoses& tool_poses() const { return poses_; }
+  const ToolPoses& tool_poses() const { return placed_.poses; }
   const ToolReaction& reaction() const { return reaction_; }
   std::size_t tetrahedron_count() const { return tetrahedra_; }
   /// The thread that runs the collision refit and search; null when they run inline.
@@ -129,12 +129,14 @@ class Simulation {
   std::size_t tetrahedra_ = 0;
   double verumontanum_z_m_ = 0.0;
   Vec3 loop_front_tool_{0.0};  ///< the loop wire's front, tool frame
-  ToolPoses poses_;
-  ToolPoses searching_poses_;  ///< where the tool was for the search in flight
-  ToolPoses published_poses_;  ///< where the tool was for the candidates in use
-  bool searching_tool_present_ = false, published_tool_present_ = false;
-  bool tool_present_ = false;
-  double contact_margin_m_ = 0.0;
+  /// Where the tool is, and whether the device has placed it (else it waits withdrawn).
+  struct ToolPlacement {
+    ToolPoses poses;
+    bool present = false;
+  };
+  ToolPlacement placed_;     // this tick
+  ToolPlacement searching_;  // for the search in flight
+  ToolPlacement published_;  // for the candidates in use
   ToolReaction reaction_;
   std::uint64_t tick_ = 0;
   std::uint64_t state_hash_ = 0;

@@ -55,6 +55,8 @@ class ToolContacts {
   /// Takes a part out of (or back into) contact, e.g. the loop when it is not modelled.
   void set_enabled(int part, bool enabled) { parts_[static_cast<std::size_t>(part)].enabled = enabled; }
   const RigidTransform& pose(int part) const { return parts_[static_cast<std::size_t>(part)].pose; }
+  /// How far outside the tool a point may be and still become a candidate.
+  double margin_m() const { return margin_m_; }
 
   /// The 60 Hz collision step, all at once: latch_query_poses(), search_candidates(),
   /// publish_candidates(). Allocates nothing once the capacities are reserved.
