@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "resecto/lp3500_sensors.h"
+#include "rtcore/base/text_file.h"
 
 namespace resecto::device {
 namespace {
@@ -188,11 +189,9 @@ Result<Calibration> parse_calibration(const std::string& text, const std::string
 }
 
 Result<Calibration> read_calibration(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path.string() + ": cannot open"};
-  std::stringstream text;
-  text << in.rdbuf();
-  return parse_calibration(text.str(), path.string());
+  Result<std::string> text = read_text_file(path);
+  if (!text) return Error{text.error()};
+  return parse_calibration(*text, path.string());
 }
 
 std::string calibration_to_json(const Calibration& c) {

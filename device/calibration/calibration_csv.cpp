@@ -3,8 +3,9 @@
 #include "device/calibration/calibration_csv.h"
 
 #include <charconv>
-#include <fstream>
 #include <sstream>
+
+#include "rtcore/base/text_file.h"
 
 namespace resecto::device {
 namespace {
@@ -72,11 +73,9 @@ Result<NumericCsv> parse_numeric_csv(const std::string& text, const std::string&
 }
 
 Result<NumericCsv> read_numeric_csv(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path.string() + ": cannot open"};
-  std::stringstream text;
-  text << in.rdbuf();
-  return parse_numeric_csv(text.str(), path.string());
+  Result<std::string> text = read_text_file(path);
+  if (!text) return Error{text.error()};
+  return parse_numeric_csv(*text, path.string());
 }
 
 }  // namespace resecto::device

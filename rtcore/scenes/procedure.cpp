@@ -5,8 +5,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <optional>
-#include <fstream>
 #include <sstream>
+
+#include "rtcore/base/text_file.h"
 
 namespace resecto {
 namespace {
@@ -119,11 +120,9 @@ Result<Procedure> parse_procedure(const std::string& text, const std::string& so
 }
 
 Result<Procedure> load_procedure(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path.string() + ": cannot open the procedure file"};
-  std::stringstream text;
-  text << in.rdbuf();
-  return parse_procedure(text.str(), path.string());
+  Result<std::string> text = read_text_file(path, " the procedure file");
+  if (!text) return Error{text.error()};
+  return parse_procedure(*text, path.string());
 }
 
 Result<Procedure> builtin_procedure(const std::string& name) {
