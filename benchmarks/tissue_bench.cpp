@@ -96,6 +96,18 @@ void BM_CollisionStep(benchmark::State& state) {
 BENCHMARK(BM_PhysicsStep)->Arg(1296)->Arg(8640)->Arg(34560)->Arg(138240)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 BENCHMARK(BM_CollisionStep)->Arg(1296)->Arg(8640)->Arg(34560)->Arg(138240)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 
+/// What the locality numbering buys: the physics step with the nodes in the mesh's (TetGen's) order
+/// and in locality order, at 8640 and 34560 triangles. Run with --benchmark_repetitions and
+/// --benchmark_enable_random_interleaving so both orders see the same machine.
+void BM_NodeOrder(benchmark::State& state) {
+  TissueConfig config;
+  config.locality_order = state.range(1) != 0;
+  auto tissue = pressed_tissue(static_cast<int>(state.range(0)), {}, config);
+  for (auto _ : state) benchmark::DoNotOptimize(tissue->physics_step(kStepS));
+  state.SetLabel(config.locality_order ? "locality order" : "mesh order");
+}
+BENCHMARK(BM_NodeOrder)->Args({8640, 0})->Args({8640, 1})->Args({34560, 0})->Args({34560, 1})->Unit(benchmark::kMicrosecond)->MinTime(0.5);
+
 /// The integrators on the 8640 model: cost of a step, and whether 1 s of pressing (then the timed
 /// steps) at the default and the stiffest setting stays finite and bounded. The sub-stepped
 /// integrator needs hundreds of sub-steps a step, so pressing is capped at 30 s of wall time

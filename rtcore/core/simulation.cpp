@@ -210,9 +210,8 @@ void Simulation::fill_snapshot(SimulationSnapshot& snapshot) const {
   snapshot.tool = placed_.poses;
   snapshot.reaction = reaction_;
   snapshot.penetrating_points = tissue_->tool().stats().penetrating;
-  const std::span<const Vec3> x = tissue_->positions();
   // The surface's vertices are the tetrahedral mesh's first nodes (TetGen -Y keeps them in order).
-  std::copy_n(x.begin(), std::min(snapshot.surface_positions.size(), x.size()), snapshot.surface_positions.begin());
+  tissue_->copy_mesh_positions(snapshot.surface_positions);
   snapshot.metrics = metrics_;
 }
 

@@ -6,19 +6,40 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rtcore/tissue/node_order.h"
 #include "rtcore/tissue/state_hash.h"
 
 namespace resecto {
 
+MassSpringTissue::OrderedMesh MassSpringTissue::ordered(const TetMesh& mesh, bool locality) {
+  OrderedMesh out;
+  if (locality) {
+    out.mesh_node = locality_order(mesh);
+    out.mesh = renumbered(mesh, out.mesh_node);
+  } else {
+    out.mesh_node.resize(mesh.node_count());
+    for (std::size_t n = 0; n < mesh.node_count(); ++n) out.mesh_node[n] = static_cast<std::uint32_t>(n);
+    out.mesh = mesh;
+  }
+  return out;
+}
+
 MassSpringTissue::MassSpringTissue(const TetMesh& mesh, const TissueParameters& parameters, const TissueConfig& config)
+    : MassSpringTissue(ordered(mesh, config.locality_order), parameters, config) {}
+
+MassSpringTissue::MassSpringTissue(OrderedMesh&& ordered_mesh, const TissueParameters& parameters, const TissueConfig& config)
     : parameters_(parameters),
       config_(config),
-      network_(build_spring_network(mesh)),
-      tetrahedra_(mesh.tetrahedra),
+      mesh_node_(std::move(ordered_mesh.mesh_node)),
+      network_(build_spring_network(ordered_mesh.mesh)),
+      tetrahedra_(ordered_mesh.mesh.tetrahedra),
       springs_(network_),
       tool_(config.contact_margin_m, config.contact_capacity) {
+  const TetMesh& mesh = ordered_mesh.mesh;
   const std::size_t n = mesh.node_count();
   const std::size_t s = network_.spring_count();
+  tissue_node_.assign(n, 0);
+  for (std::size_t k = 0; k < n; ++k) tissue_node_[mesh_node_[k]] = static_cast<std::uint32_t>(k);
   x_ = mesh.positions;
   rest_ = mesh.positions;
   v_.assign(n, Vec3(0.0));
@@ -293,6 +314,11 @@ std::uint64_t MassSpringTissue::state_hash() const {
   hasher.add(std::span<const Vec3>(v_));
   hasher.add(std::span<const std::uint64_t>(&topology_hash_, 1));
   return hasher.value();
+}
+
+void MassSpringTissue::copy_mesh_positions(std::span<Vec3> out) const {
+  const std::size_t count = std::min(out.size(), x_.size());
+  for (std::size_t m = 0; m < count; ++m) out[m] = x_[tissue_node_[m]];
 }
 
 double MassSpringTissue::total_mass_kg() const {

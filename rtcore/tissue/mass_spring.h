@@ -39,6 +39,9 @@ struct TissueConfig {
   int max_substeps = 4096;             ///< cap of kSubsteppedSymplectic; hitting it is flagged
   double contact_margin_m = 0.0015;
   ToolContactCapacity contact_capacity;
+  /// Steps the nodes in locality order (node_order.h) rather than the mesh's; off only to measure
+  /// what the order buys.
+  bool locality_order = true;
 };
 
 /// Faults of the last step, counted rather than thrown (STYLE.md "Errors").
@@ -51,7 +54,9 @@ struct TissueFaults {
 
 class MassSpringTissue {
  public:
-  /// Builds the model from a tetrahedral mesh (metres). Allocates every array here.
+  /// Builds the model from a tetrahedral mesh (metres). Allocates every array here. The nodes are
+  /// renumbered for locality (TissueConfig::locality_order): positions(), velocities(), surface() and
+  /// network() use the tissue's own numbering; mesh_node() and copy_mesh_positions() map back.
   MassSpringTissue(const TetMesh& mesh, const TissueParameters& parameters = {}, const TissueConfig& config = {});
 
   /// Applies a parameter command; call only between steps (the tick boundary). Allocates nothing.
@@ -89,6 +94,11 @@ class MassSpringTissue {
   std::uint64_t state_hash() const;
 
   std::size_t node_count() const { return x_.size(); }
+  /// The mesh's index of the tissue's node `node`.
+  std::uint32_t mesh_node(std::size_t node) const { return mesh_node_[node]; }
+  /// out[m] = position of the mesh's node m, for m < out.size() (e.g. the anatomy surface's nodes,
+  /// which are the mesh's first ones). Allocates nothing.
+  void copy_mesh_positions(std::span<Vec3> out) const;
   std::span<const Vec3> positions() const { return x_; }
   std::span<const Vec3> velocities() const { return v_; }
   std::span<const Vec3> rest_positions() const { return rest_; }
@@ -105,6 +115,13 @@ class MassSpringTissue {
   int last_cg_iterations() const { return last_cg_iterations_; }
 
  private:
+  struct OrderedMesh {
+    std::vector<std::uint32_t> mesh_node;  // per tissue node, its mesh index
+    TetMesh mesh;                          // renumbered
+  };
+  static OrderedMesh ordered(const TetMesh& mesh, bool locality);
+  MassSpringTissue(OrderedMesh&& ordered, const TissueParameters& parameters, const TissueConfig& config);
+
   void update_material();
   void accumulate_forces(double h_s);
   void step_bounded_symplectic(double h_s);
@@ -118,6 +135,7 @@ class MassSpringTissue {
 
   TissueParameters parameters_;
   TissueConfig config_;
+  std::vector<std::uint32_t> mesh_node_, tissue_node_;  // tissue -> mesh numbering, and back
   SpringNetwork network_;
   std::vector<Tetrahedron> tetrahedra_;
 
