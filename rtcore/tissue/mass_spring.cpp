@@ -51,8 +51,6 @@ MassSpringTissue::MassSpringTissue(OrderedMesh&& ordered_mesh, const TissueParam
   base_stiffness_bound_.assign(n, 0.0);
   base_damping_bound_.assign(n, 0.0);
   anchor_k_.assign(network_.anchor_nodes.size(), 0.0);
-  node_anchor_.assign(n, -1);
-  for (std::size_t a = 0; a < network_.anchor_nodes.size(); ++a) node_anchor_[network_.anchor_nodes[a]] = static_cast<std::int32_t>(a);
   if (config_.integrator == TissueIntegrator::kImplicitEuler) {
     spring_direction_.assign(s, Vec3(0.0));
     spring_transverse_k_.assign(s, 0.0);
@@ -127,21 +125,22 @@ void MassSpringTissue::end_collision_step() {
 }
 
 void MassSpringTissue::accumulate_forces(double h_s) {
-  // Springs first, each into its own slot; then one pass per node in node order: viscous damping,
-  // its springs in ascending spring order (SpringForces::gather), its anchor. Each node's force is
+  // Springs first, each into its own slot; then per node, in node order: viscous damping, its
+  // springs in ascending spring order (SpringForces::add_sums), its anchor. Each node's force is
   // thus the same sum in the same order every run, and the bounds start from their constant part.
   const std::size_t compressed = springs_.compute(x_.data(), v_.data());
   const double viscous_rate = parameters_.si(TissueParameter::kViscousDamping);
   const std::size_t n = x_.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    Vec3 f = springs_.gather(i, -viscous_rate * mass_[i] * v_[i]);
-    if (const std::int32_t a = node_anchor_[i]; a >= 0) f -= anchor_k_[static_cast<std::size_t>(a)] * (x_[i] - rest_[i]);
-    force_[i] = f;
-    // Springs, dampers, anchors and viscous damping bound the same every step until a parameter
-    // changes (update_material); what varies is added on top.
-    stiffness_bound_[i] = base_stiffness_bound_[i];
-    damping_bound_[i] = base_damping_bound_[i];
+  for (std::size_t i = 0; i < n; ++i) force_[i] = -viscous_rate * mass_[i] * v_[i];
+  springs_.add_sums(force_.data());
+  for (std::size_t a = 0; a < anchor_k_.size(); ++a) {
+    const std::uint32_t i = network_.anchor_nodes[a];
+    force_[i] -= anchor_k_[a] * (x_[i] - rest_[i]);
   }
+  // Springs, dampers, anchors and viscous damping bound the same every step until a parameter
+  // changes (update_material); what varies is added on top.
+  std::copy(base_stiffness_bound_.begin(), base_stiffness_bound_.end(), stiffness_bound_.begin());
+  std::copy(base_damping_bound_.begin(), base_damping_bound_.end(), damping_bound_.begin());
   if (compressed > 0) [[unlikely]] springs_.add_compression_bounds(x_.data(), stiffness_bound_.data());
   if (config_.integrator == TissueIntegrator::kImplicitEuler) springs_.linearise(x_.data(), spring_direction_.data(), spring_transverse_k_.data());
   reaction_ = tool_.add_forces(x_, v_, surface_.triangles, parameters_.si(TissueParameter::kPenaltyStiffness),

@@ -147,9 +147,8 @@ class MassSpringTissue {
   SpringForces springs_;
   // The parameters' part of the per-node bounds (springs at rest, dampers, anchors, viscous).
   std::vector<double> base_stiffness_bound_, base_damping_bound_;
-  // Per anchor, and per node its anchor (-1: none).
+  // Per anchor (network_.anchor_nodes).
   std::vector<double> anchor_k_;
-  std::vector<std::int32_t> node_anchor_;
   // Implicit Euler only: per-spring linearisation and CG vectors.
   std::vector<Vec3> spring_direction_;
   std::vector<double> spring_transverse_k_;

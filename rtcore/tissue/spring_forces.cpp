@@ -33,23 +33,24 @@ SpringForces::SpringForces(const SpringNetwork& network) {
   arrays_.rest_m = network.rest_length_m;
   arrays_.k.assign(count, 0.0);
   arrays_.c.assign(count, 0.0);
-  for (auto* f : {&arrays_.fx, &arrays_.fy, &arrays_.fz}) f->assign(count, 0.0);
+  arrays_.f.assign(count, SpringForce{});
   // Counting sort by node, springs visited in ascending order: each node's list is ascending.
-  second_first_.assign(nodes + 1, 0);
-  first_first_.assign(nodes + 1, 0);
+  SpringIncidence& in = incidence_;
+  in.second_first.assign(nodes + 1, 0);
+  in.first_first.assign(nodes + 1, 0);
   for (std::size_t s = 0; s < count; ++s) {
     arrays_.i[s] = network.spring_nodes[2 * s];
     arrays_.j[s] = network.spring_nodes[2 * s + 1];
-    ++first_first_[arrays_.i[s] + 1];
-    ++second_first_[arrays_.j[s] + 1];
+    ++in.first_first[arrays_.i[s] + 1];
+    ++in.second_first[arrays_.j[s] + 1];
   }
   for (std::size_t n = 0; n < nodes; ++n) {
-    first_first_[n + 1] += first_first_[n];
-    second_first_[n + 1] += second_first_[n];
+    in.first_first[n + 1] += in.first_first[n];
+    in.second_first[n + 1] += in.second_first[n];
   }
-  second_springs_.resize(count);
-  std::vector<std::uint32_t> fill(second_first_.begin(), second_first_.end() - 1);
-  for (std::size_t s = 0; s < count; ++s) second_springs_[fill[arrays_.j[s]]++] = static_cast<std::uint32_t>(s);
+  in.second_springs.resize(count);
+  std::vector<std::uint32_t> fill(in.second_first.begin(), in.second_first.end() - 1);
+  for (std::size_t s = 0; s < count; ++s) in.second_springs[fill[arrays_.j[s]]++] = static_cast<std::uint32_t>(s);
 }
 
 void SpringForces::add_compression_bounds(const Vec3* x, double* stiffness_bound) const {

@@ -29,16 +29,10 @@ class SpringForces {
   /// are compressed below half their rest length (add_compression_bounds handles those; usually none).
   std::size_t compute(const Vec3* x, const Vec3* v) { return spring_forces(arrays_, x, v); }
 
-  /// The per-node pass for node n: `sum` plus n's spring forces of the last compute(), added in
-  /// ascending spring order, which is the order the scatter formed them in (same bits).
-  Vec3 gather(std::size_t n, Vec3 sum) const {
-    for (std::uint32_t e = second_first_[n]; e < second_first_[n + 1]; ++e) {
-      const std::uint32_t s = second_springs_[e];
-      sum -= Vec3(arrays_.fx[s], arrays_.fy[s], arrays_.fz[s]);
-    }
-    for (std::uint32_t s = first_first_[n]; s < first_first_[n + 1]; ++s) sum += Vec3(arrays_.fx[s], arrays_.fy[s], arrays_.fz[s]);
-    return sum;
-  }
+  /// The per-node pass: adds to each force[n] (n < node count) n's spring forces of the last
+  /// compute(), in ascending spring order, which is the order a scatter would form them in.
+  void add_sums(Vec3* force) const { add_spring_sums(incidence_, arrays_.f.data(), force, incidence_.first_first.size() - 1); }
+  const SpringIncidence& incidence() const { return incidence_; }
 
   /// Adds, in spring order, the Hessian-norm excess of each spring compressed below half its rest
   /// length to both its nodes' stiffness bounds (k |1 - L0/L| exceeds the k already counted).
@@ -49,11 +43,7 @@ class SpringForces {
 
  private:
   SpringArrays arrays_;
-  // Incidence: a node's springs as second node (all come before its springs as first node, since
-  // springs are sorted by first node), ascending; its springs as first node are one range.
-  std::vector<std::uint32_t> second_first_;    // per node + 1: offsets into second_springs_
-  std::vector<std::uint32_t> second_springs_;
-  std::vector<std::uint32_t> first_first_;     // per node + 1: spring index ranges
+  SpringIncidence incidence_;
 };
 
 }  // namespace resecto

@@ -1,6 +1,7 @@
-// Spring force kernels. The AVX2 loop mirrors the portable one operation for operation (same
-// operands, same association: dot products as (x + y) + z), which is what keeps them bit-identical;
-// tests/rtcore/tissue/spring_kernel_test.cpp holds them to it. Change both or neither.
+// Spring force kernels and the node sums. Each AVX2 loop mirrors its portable one operation for
+// operation (same operands, same association: dot products as (x + y) + z, sums in incidence order),
+// which is what keeps them bit-identical; tests/rtcore/tissue/spring_kernel_test.cpp holds them to
+// it. Change both or neither.
 #include "rtcore/tissue/spring_kernel.h"
 
 #include <immintrin.h>
@@ -34,6 +35,17 @@ __attribute__((target("avx2"), always_inline)) inline Columns differences(const 
                    _mm256_sub_pd(load_row(p[j[2]]), load_row(p[i[2]])), _mm256_sub_pd(load_row(p[j[3]]), load_row(p[i[3]])));
 }
 
+/// Four springs' force columns back to rows (x, y, z, 0), stored at f[0..3]: pure moves.
+__attribute__((target("avx2"), always_inline)) inline void store_rows(SpringForce* f, __m256d fx, __m256d fy, __m256d fz) {
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d xy02 = _mm256_unpacklo_pd(fx, fy), xy13 = _mm256_unpackhi_pd(fx, fy);  // (x0 y0 x2 y2), (x1 y1 x3 y3)
+  const __m256d z02 = _mm256_unpacklo_pd(fz, zero), z13 = _mm256_unpackhi_pd(fz, zero);
+  _mm256_store_pd(&f[0].x, _mm256_permute2f128_pd(xy02, z02, 0x20));
+  _mm256_store_pd(&f[1].x, _mm256_permute2f128_pd(xy13, z13, 0x20));
+  _mm256_store_pd(&f[2].x, _mm256_permute2f128_pd(xy02, z02, 0x31));
+  _mm256_store_pd(&f[3].x, _mm256_permute2f128_pd(xy13, z13, 0x31));
+}
+
 }  // namespace
 
 std::size_t spring_forces_portable(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end) {
@@ -50,9 +62,7 @@ std::size_t spring_forces_portable(SpringArrays& springs, const Vec3* x, const V
     const Vec3& vj = v[springs.j[s]];
     const double along = ((vj.x - vi.x) * ux + (vj.y - vi.y) * uy) + (vj.z - vi.z) * uz;
     const double magnitude = springs.k[s] * stretch + springs.c[s] * along;
-    springs.fx[s] = magnitude * ux;
-    springs.fy[s] = magnitude * uy;
-    springs.fz[s] = magnitude * uz;
+    springs.f[s] = {magnitude * ux, magnitude * uy, magnitude * uz, 0.0};
     compressed += (length > 0.0 && 2.0 * length < springs.rest_m[s]) ? 1 : 0;
   }
   return compressed;
@@ -81,13 +91,36 @@ __attribute__((target("avx2"))) std::size_t spring_forces_avx2(SpringArrays& spr
     const __m256d along = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dvx, ux), _mm256_mul_pd(dvy, uy)), _mm256_mul_pd(dvz, uz));
     const __m256d magnitude = _mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(springs.k.data() + s), stretch),
                                             _mm256_mul_pd(_mm256_loadu_pd(springs.c.data() + s), along));
-    _mm256_storeu_pd(springs.fx.data() + s, _mm256_mul_pd(magnitude, ux));
-    _mm256_storeu_pd(springs.fy.data() + s, _mm256_mul_pd(magnitude, uy));
-    _mm256_storeu_pd(springs.fz.data() + s, _mm256_mul_pd(magnitude, uz));
+    store_rows(springs.f.data() + s, _mm256_mul_pd(magnitude, ux), _mm256_mul_pd(magnitude, uy), _mm256_mul_pd(magnitude, uz));
     const __m256d short_spring = _mm256_and_pd(positive, _mm256_cmp_pd(_mm256_mul_pd(two, length), rest, _CMP_LT_OQ));
     compressed += static_cast<std::size_t>(std::popcount(static_cast<unsigned>(_mm256_movemask_pd(short_spring))));
   }
   return compressed + spring_forces_portable(springs, x, v, s, end);
+}
+
+void add_spring_sums_portable(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t begin, std::size_t end) {
+  for (std::size_t n = begin; n < end; ++n) {
+    Vec3 sum = force[n];
+    for (std::uint32_t e = incidence.second_first[n]; e < incidence.second_first[n + 1]; ++e) {
+      const SpringForce& g = f[incidence.second_springs[e]];
+      sum.x -= g.x, sum.y -= g.y, sum.z -= g.z;
+    }
+    for (std::uint32_t s = incidence.first_first[n]; s < incidence.first_first[n + 1]; ++s) sum.x += f[s].x, sum.y += f[s].y, sum.z += f[s].z;
+    force[n] = sum;
+  }
+}
+
+__attribute__((target("avx2"))) void add_spring_sums_avx2(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t begin,
+                                                          std::size_t end) {
+  const __m256i xyz = _mm256_set_epi64x(0, -1, -1, -1);
+  for (std::size_t n = begin; n < end; ++n) {
+    __m256d sum = _mm256_maskload_pd(&force[n].x, xyz);
+    for (std::uint32_t e = incidence.second_first[n]; e < incidence.second_first[n + 1]; ++e) {
+      sum = _mm256_sub_pd(sum, _mm256_load_pd(&f[incidence.second_springs[e]].x));
+    }
+    for (std::uint32_t s = incidence.first_first[n]; s < incidence.first_first[n + 1]; ++s) sum = _mm256_add_pd(sum, _mm256_load_pd(&f[s].x));
+    _mm256_maskstore_pd(&force[n].x, xyz, sum);
+  }
 }
 
 bool cpu_has_avx2() {
@@ -98,6 +131,14 @@ bool cpu_has_avx2() {
 std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v) {
   const std::size_t count = springs.i.size();
   return cpu_has_avx2() ? spring_forces_avx2(springs, x, v, 0, count) : spring_forces_portable(springs, x, v, 0, count);
+}
+
+void add_spring_sums(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t node_count) {
+  if (cpu_has_avx2()) {
+    add_spring_sums_avx2(incidence, f, force, 0, node_count);
+  } else {
+    add_spring_sums_portable(incidence, f, force, 0, node_count);
+  }
 }
 
 }  // namespace resecto

@@ -1,6 +1,7 @@
-// The per-spring force kernel: a portable loop and an AVX2 one chosen at run time. Both form every
-// spring's force with the same IEEE operations in the same order (no contraction, the build forbids
-// it; + - * / sqrt are correctly rounded), so the lane width cannot change a bit of the result.
+// The per-spring force kernel and the per-node sum of the springs' forces: a portable loop and an
+// AVX2 one for each, chosen at run time. Both form every value with the same IEEE operations in the
+// same order (no contraction, the build forbids it; + - * / sqrt are correctly rounded), so the lane
+// width cannot change a bit of the result.
 #pragma once
 
 #include <cstddef>
@@ -11,26 +12,48 @@
 
 namespace resecto {
 
+/// One spring's force on its node i, as a 32-byte row (x, y, z, 0): the node pass adds it with one
+/// aligned load, where three separate arrays cost three cache lines.
+struct alignas(32) SpringForce {
+  double x = 0.0, y = 0.0, z = 0.0, unused = 0.0;
+};
+
 /// Per-spring inputs and outputs, one array per field, in the network's spring order.
 struct SpringArrays {
   std::vector<std::uint32_t> i, j;  ///< nodes, i < j (springs sorted by i, then j)
   std::vector<double> rest_m;       ///< rest length
   std::vector<double> k, c;         ///< stiffness (N/m), damping (N*s/m)
-  std::vector<double> fx, fy, fz;   ///< the spring's force on node i of the last pass (node j gets minus)
+  std::vector<SpringForce> f;       ///< the spring's force on node i of the last pass (node j gets minus)
 };
 
-/// Writes the force of springs [begin, end) at positions x and velocities v into fx, fy, fz:
+/// Which springs meet at each node, in the order the node pass adds them.
+struct SpringIncidence {
+  /// Per node + 1: offsets into `second_springs` of the springs whose node j it is (ascending). All
+  /// come before its springs as node i, since springs are sorted by i.
+  std::vector<std::uint32_t> second_first;
+  std::vector<std::uint32_t> second_springs;
+  /// Per node + 1: the spring range whose node i it is.
+  std::vector<std::uint32_t> first_first;
+};
+
+/// Writes the force of springs [begin, end) at positions x and velocities v into f:
 /// f = (k (L - L0) + c (v_j - v_i).u) u with u = (x_j - x_i) / L (u = 0 when L = 0). Returns how
 /// many of them are compressed below half their rest length.
 std::size_t spring_forces_portable(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end);
-
 /// The same with four springs per instruction; call only where cpu_has_avx2().
 std::size_t spring_forces_avx2(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end);
 
-/// Whether this processor runs the AVX2 kernel (checked once).
+/// For nodes [begin, end): force[n] = force[n] - (n's forces as node j, ascending) + (its forces as
+/// node i, ascending), component by component.
+void add_spring_sums_portable(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t begin, std::size_t end);
+/// The same a row at a time; call only where cpu_has_avx2().
+void add_spring_sums_avx2(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t begin, std::size_t end);
+
+/// Whether this processor runs the AVX2 kernels (checked once).
 bool cpu_has_avx2();
 
-/// The fastest kernel this processor runs, over all springs.
+/// The fastest kernels this processor runs, over all springs and all nodes.
 std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v);
+void add_spring_sums(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t node_count);
 
 }  // namespace resecto

@@ -15,8 +15,9 @@
 namespace resecto {
 namespace {
 
-bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+template <class T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
 }
 
 TEST(SpringKernel, Avx2PathMatchesThePortablePathBitForBit) {
@@ -45,15 +46,45 @@ TEST(SpringKernel, Avx2PathMatchesThePortablePathBitForBit) {
     const std::size_t compressed_portable = spring_forces_portable(portable, x.data(), v.data(), begin, end);
     const std::size_t compressed_simd = spring_forces_avx2(simd, x.data(), v.data(), begin, end);
     EXPECT_EQ(compressed_portable, compressed_simd);
-    EXPECT_TRUE(same_bits(portable.fx, simd.fx)) << begin << ".." << end;
-    EXPECT_TRUE(same_bits(portable.fy, simd.fy)) << begin << ".." << end;
-    EXPECT_TRUE(same_bits(portable.fz, simd.fz)) << begin << ".." << end;
+    EXPECT_TRUE(same_bits(portable.f, simd.f)) << begin << ".." << end;
     if (begin == 0) {
       EXPECT_GE(compressed_portable, 1u);
-      EXPECT_EQ(portable.fx[10], 0.0);
-      EXPECT_TRUE(std::isnan(portable.fy[33]));
+      EXPECT_EQ(portable.f[10].x, 0.0);
+      EXPECT_TRUE(std::isnan(portable.f[33].y));
     }
   }
+
+  // The node sums over those forces, from a non-zero start, over all nodes and over a slice.
+  SpringArrays computed = springs;
+  spring_forces_portable(computed, x.data(), v.data(), 0, count);
+  for (auto [begin, end] : {std::pair<std::size_t, std::size_t>{0, x.size()}, {3, x.size() - 5}}) {
+    std::vector<Vec3> portable = v, simd = v;
+    add_spring_sums_portable(forces.incidence(), computed.f.data(), portable.data(), begin, end);
+    add_spring_sums_avx2(forces.incidence(), computed.f.data(), simd.data(), begin, end);
+    EXPECT_TRUE(same_bits(portable, simd)) << begin << ".." << end;
+    EXPECT_NE(portable[begin + 1], v[begin + 1]);
+  }
+}
+
+TEST(SpringKernel, NodeSumsAddEachSpringOnceWithOppositeSigns) {
+  // A brute-force oracle: scatter every spring's force to its two nodes in spring order.
+  Result<ProstateTissueModel> model = build_prostate_tissue_model(generate_prostate(1296), generate_resectoscope().loop);
+  ASSERT_TRUE(model) << model.error();
+  const SpringNetwork network = build_spring_network(model->mesh);
+  SpringForces forces(network);
+  for (std::size_t s = 0; s < forces.spring_count(); ++s) forces.set_material(s, 1.0 + static_cast<double>(s % 13), 1e-3);
+  std::vector<Vec3> x = model->mesh.positions, v(x.size(), Vec3(0.0));
+  for (std::size_t n = 0; n < x.size(); ++n) x[n] *= 1.0 + 1e-3 * static_cast<double>(n % 5);
+  forces.compute(x.data(), v.data());
+  std::vector<Vec3> summed(x.size(), Vec3(0.0)), scattered(x.size(), Vec3(0.0));
+  forces.add_sums(summed.data());
+  const SpringArrays& springs = forces.arrays();
+  for (std::size_t s = 0; s < forces.spring_count(); ++s) {
+    const Vec3 f(springs.f[s].x, springs.f[s].y, springs.f[s].z);
+    scattered[springs.i[s]] += f;
+    scattered[springs.j[s]] -= f;
+  }
+  for (std::size_t n = 0; n < x.size(); ++n) ASSERT_EQ(summed[n], scattered[n]) << "node " << n;
 }
 
 }  // namespace
