@@ -79,6 +79,7 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
     if (l.name == "verumontanum") sim->verumontanum_z_m_ = l.position.z;
   }
   sim->loop_front_tool_ = loop_front_point(tool.loop);
+  sim->input_filter_ = JointFilter(config.input_filter);
   const RigidTransform away = to_transform(withdrawn_pose());
   sim->tissue_->tool().reset_pose(sim->sheath_part_, away);
   sim->tissue_->tool().reset_pose(sim->loop_part_, away);
@@ -94,8 +95,17 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
 }
 
 void Simulation::place_tool(const TickInput& input) {
-  placed_.present = input.tool_present;
-  placed_.poses = input.tool_present ? resecto::tool_poses(input.joints, config_.gimbal) : ToolPoses{withdrawn_pose(), withdrawn_pose()};
+  if (!input.tool_present) {
+    placed_ = {ToolPoses{withdrawn_pose(), withdrawn_pose()}, false};
+  } else if (!placed_.present) {
+    // The first placement has nowhere to move from (the tool appears where the device is).
+    input_filter_.reset(input.joints);
+    placed_ = {resecto::tool_poses(input.joints, config_.gimbal), true};
+    placed_joints_ = input.joints;
+  } else {
+    placed_joints_ = input_filter_.filter(input.joints, config_.tick_s());
+    placed_ = {resecto::tool_poses(placed_joints_, config_.gimbal), true};
+  }
   tissue_->tool().set_pose(sheath_part_, to_transform(placed_.poses.sheath));
   tissue_->tool().set_pose(loop_part_, to_transform(placed_.poses.loop));
 }
@@ -181,7 +191,7 @@ void Simulation::update_metrics(const TickInput& input, bool collision_tick) {
     metrics_.cut_pedal_time_s += h;
     if (contact) metrics_.cut_in_contact_time_s += h;
   }
-  if (input.tool_present) metrics_.max_insertion_mm = std::max(metrics_.max_insertion_mm, units::m_to_mm(input.joints.insertion_m));
+  if (placed_.present) metrics_.max_insertion_mm = std::max(metrics_.max_insertion_mm, units::m_to_mm(placed_joints_.insertion_m));
   // The candidates in use were searched with the tool where published_ has it; the sheath's tip
   // and the loop's front move furthest.
   const ToolPoses& now = placed_.poses;

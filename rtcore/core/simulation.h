@@ -16,6 +16,7 @@
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/base/result.h"
 #include "rtcore/concurrency/job_thread.h"
+#include "rtcore/core/joint_filter.h"
 #include "rtcore/core/profiler.h"
 #include "rtcore/tissue/mass_spring.h"
 #include "rtcore/tissue/tissue_parameters.h"
@@ -33,6 +34,7 @@ struct SimulationConfig {
   TissueParameters parameters;     ///< initial values; later changes come as commands
   GimbalGeometry gimbal;
   double max_tet_volume_m3 = 0.0;  ///< TetGen -a bound for the tissue model; 0 = unbounded
+  JointFilterSettings input_filter;  ///< smoothing of the device's readings (joint_filter.h)
 
   double tick_s() const { return 1.0 / (static_cast<double>(collision_hz) * physics_per_collision); }
   /// The tick rates as a user would write them, or an error naming the bad value.
@@ -135,6 +137,8 @@ class Simulation {
     bool present = false;
   };
   ToolPlacement placed_;     // this tick
+  DeviceJoints placed_joints_;  // the smoothed joints placed_ was placed by
+  JointFilter input_filter_;
   ToolPlacement searching_;  // for the search in flight
   ToolPlacement published_;  // for the candidates in use
   ToolReaction reaction_;
