@@ -12,7 +12,7 @@ namespace resecto {
 
 struct JointFilterSettings {
   double min_cutoff_hz = 1.0;         ///< cut-off of a still joint
-  double derivative_cutoff_hz = 1.0;  ///< smoothing of the speed estimate that raises the cut-off
+  double derivative_cutoff_hz = 3.0;  ///< smoothing of the speed estimate that raises the cut-off
   /// How fast the cut-off rises with speed: +10 Hz at 50 mm/s (sheath and loop) and at 0.3 rad/s
   /// (yaw, pitch: the tip moves ~50 mm/s; roll: the loop's wire ~5 mm/s).
   double linear_beta_per_m = 200.0;

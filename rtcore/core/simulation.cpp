@@ -158,7 +158,28 @@ void Simulation::advance_collision_pipeline(std::uint64_t tick, FrameProfiler* p
     }
   }
   tissue_->begin_collision_step();
+  // The candidates found now are used from the next collision tick to the one after it, so the search
+  // looks for the tool where it will be in the middle of that window, 1.5 collision periods ahead,
+  // extrapolating the (smoothed) joints' motion of the last tick. The margin then has to cover only
+  // half the window's motion and the motion's change of speed: about twice the speed a search at the
+  // current pose covers. (The tissue's own motion is slower and left to the margin.)
   searching_ = placed_;
+  if (config_.predict_search_pose && placed_.present && last_search_present_) {
+    const double lead = 1.5;
+    const DeviceJoints& now = placed_joints_;
+    const DeviceJoints& before = last_search_joints_;
+    DeviceJoints ahead;
+    ahead.yaw_rad = now.yaw_rad + lead * (now.yaw_rad - before.yaw_rad);
+    ahead.pitch_rad = now.pitch_rad + lead * (now.pitch_rad - before.pitch_rad);
+    ahead.roll_rad = now.roll_rad + lead * (now.roll_rad - before.roll_rad);
+    ahead.insertion_m = now.insertion_m + lead * (now.insertion_m - before.insertion_m);
+    ahead.loop_travel_m = now.loop_travel_m + lead * (now.loop_travel_m - before.loop_travel_m);
+    searching_.poses = resecto::tool_poses(ahead, config_.gimbal);
+    tissue_->tool().set_query_pose(sheath_part_, to_transform(searching_.poses.sheath));
+    tissue_->tool().set_query_pose(loop_part_, to_transform(searching_.poses.loop));
+  }
+  last_search_joints_ = placed_joints_;
+  last_search_present_ = placed_.present;
   search_timing_.tick = tick;
   search_pending_ = true;
   if (collision_thread_) {

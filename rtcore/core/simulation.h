@@ -35,6 +35,9 @@ struct SimulationConfig {
   GimbalGeometry gimbal;
   double max_tet_volume_m3 = 0.0;  ///< TetGen -a bound for the tissue model; 0 = unbounded
   JointFilterSettings input_filter;  ///< smoothing of the device's readings (joint_filter.h)
+  /// Searches for contact candidates around the tool's extrapolated pose in the middle of the
+  /// window the candidates serve, rather than where it is at the search (Simulation::step).
+  bool predict_search_pose = true;
 
   double tick_s() const { return 1.0 / (static_cast<double>(collision_hz) * physics_per_collision); }
   /// The tick rates as a user would write them, or an error naming the bad value.
@@ -138,6 +141,8 @@ class Simulation {
   };
   ToolPlacement placed_;     // this tick
   DeviceJoints placed_joints_;  // the smoothed joints placed_ was placed by
+  DeviceJoints last_search_joints_;  // placed_joints_ at the last collision tick
+  bool last_search_present_ = false;
   JointFilter input_filter_;
   ToolPlacement searching_;  // for the search in flight
   ToolPlacement published_;  // for the candidates in use

@@ -67,6 +67,9 @@ class ToolContacts {
   /// Takes the parts' current poses and enabled flags as the ones the next search uses. Call on the
   /// thread that sets poses, while no search runs.
   void latch_query_poses();
+  /// Replaces a part's latched pose with where the search should look for it instead (e.g. where the
+  /// part is expected to be while the candidates are in use). Same rules as latch_query_poses().
+  void set_query_pose(int part, const RigidTransform& pose) { parts_[static_cast<std::size_t>(part)].query_pose = pose; }
   /// Queries each part's tree (at its latched pose) against the tissue surface tree, already refitted
   /// to `surface`'s positions, into a back buffer. Touches nothing add_forces() or set_pose() use, so
   /// it may run concurrently with them; never with latch_query_poses() or publish_candidates().
