@@ -56,6 +56,7 @@ MassSpringTissue::MassSpringTissue(OrderedMesh&& ordered_mesh, const TissueParam
     spring_transverse_k_.assign(s, 0.0);
     for (auto* vec : {&cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_dv_}) vec->assign(n, Vec3(0.0));
   }
+  tool_.set_clearance_skipping(config_.clearance_certificates);
   surface_ = boundary_surface(mesh);
   surface_tree_.build(surface_);
   topology_hash_ = topology_hash();
@@ -112,7 +113,7 @@ void MassSpringTissue::begin_collision_step() {
   // The surface shares the tetrahedral mesh's node indices; its positions are the nodes' at this
   // moment, a copy the refit and search may read while the physics steps move the nodes on.
   std::copy(x_.begin(), x_.end(), surface_.positions.begin());
-  tool_.latch_query_poses();
+  tool_.latch_query_poses(travel_m_);
 }
 
 void MassSpringTissue::refit_surface_tree() { surface_tree_.refit(surface_); }
@@ -144,7 +145,7 @@ void MassSpringTissue::accumulate_forces(double h_s) {
   if (compressed > 0) [[unlikely]] springs_.add_compression_bounds(x_.data(), stiffness_bound_.data());
   if (config_.integrator == TissueIntegrator::kImplicitEuler) springs_.linearise(x_.data(), spring_direction_.data(), spring_transverse_k_.data());
   reaction_ = tool_.add_forces(x_, v_, surface_.triangles, parameters_.si(TissueParameter::kPenaltyStiffness),
-                               parameters_.si(TissueParameter::kPenaltyDamping), h_s, force_, stiffness_bound_, damping_bound_);
+                               parameters_.si(TissueParameter::kPenaltyDamping), h_s, travel_m_, force_, stiffness_bound_, damping_bound_);
 }
 
 void MassSpringTissue::step_bounded_symplectic(double h_s) {
@@ -159,6 +160,7 @@ void MassSpringTissue::step_bounded_symplectic(double h_s) {
   // The finite check rides along: a node's sum is formed once it has moved.
   const std::size_t n = x_.size();
   std::size_t first_non_finite = n;
+  double fastest2 = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     const double d = mass_[i] + 0.5 * h_s * h_s * stiffness_bound_[i] + h_s * damping_bound_[i];
     Vec3 v = v_[i];
@@ -168,10 +170,12 @@ void MassSpringTissue::step_bounded_symplectic(double h_s) {
     const Vec3 x = x_[i] + h_s * v;
     v_[i] = v;
     x_[i] = x;
+    fastest2 = std::max(fastest2, glm::dot(v, v));
     const double sum = x.x + x.y + x.z + v.x + v.y + v.z;
     if (!std::isfinite(sum) && first_non_finite == n) first_non_finite = i;
   }
   if (first_non_finite < n) [[unlikely]] note_non_finite(first_non_finite);
+  travel_m_ += h_s * std::sqrt(fastest2);
   last_substeps_ = 1;
 }
 
@@ -194,10 +198,13 @@ void MassSpringTissue::step_substepped_symplectic(double h_s) {
     if (step > 0) accumulate_forces(h_s);
     total.force_n += reaction_.force_n;
     total.torque_nm += reaction_.torque_nm;
+    double fastest2 = 0.0;
     for (std::size_t i = 0; i < x_.size(); ++i) {
       v_[i] += (h / mass_[i]) * force_[i];
       x_[i] += h * v_[i];
+      fastest2 = std::max(fastest2, glm::dot(v_[i], v_[i]));
     }
+    travel_m_ += h * std::sqrt(fastest2);
   }
   reaction_.force_n = total.force_n / static_cast<double>(substeps);
   reaction_.torque_nm = total.torque_nm / static_cast<double>(substeps);
@@ -262,10 +269,13 @@ void MassSpringTissue::step_implicit_euler(double h_s) {
     rz = rz_next;
     for (std::size_t i = 0; i < n; ++i) cg_p_[i] = cg_z_[i] + beta * cg_p_[i];
   }
+  double fastest2 = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     v_[i] += cg_dv_[i];
     x_[i] += h_s * v_[i];
+    fastest2 = std::max(fastest2, glm::dot(v_[i], v_[i]));
   }
+  travel_m_ += h_s * std::sqrt(fastest2);
   last_cg_iterations_ = iteration;
   last_substeps_ = 1;
 }

@@ -42,6 +42,9 @@ struct TissueConfig {
   /// Steps the nodes in locality order (node_order.h) rather than the mesh's; off only to measure
   /// what the order buys.
   bool locality_order = true;
+  /// Lets the contact skip points whose clearance certificate holds (ToolContacts); off only for
+  /// the brute-force reference, which gives the same forces.
+  bool clearance_certificates = true;
 };
 
 /// Faults of the last step, counted rather than thrown (STYLE.md "Errors").
@@ -110,6 +113,9 @@ class MassSpringTissue {
   /// Largest distance of a node from its rest position.
   double max_displacement_m() const;
   const TissueFaults& faults() const { return faults_; }
+  /// A bound on how far any node has moved since construction: the sum over steps of the step's
+  /// largest node displacement. The tool contact's clearance certificates measure against it.
+  double travel_m() const { return travel_m_; }
   /// Sub-steps the last physics step took (1 except for kSubsteppedSymplectic) and CG iterations.
   int last_substeps() const { return last_substeps_; }
   int last_cg_iterations() const { return last_cg_iterations_; }
@@ -162,6 +168,7 @@ class MassSpringTissue {
   TissueFaults faults_;
   int last_substeps_ = 1;
   int last_cg_iterations_ = 0;
+  double travel_m_ = 0.0;
 };
 
 }  // namespace resecto

@@ -69,6 +69,9 @@ struct Closest {
   double side = 1.0;            // < 0: the point is behind the chosen triangle
   Vec3 point{0.0};
   std::uint32_t triangle = 0;
+  /// A distance no candidate triangle is nearer than: the chosen one's less the tie tolerance (an
+  /// equally near triangle may have lost the tie) and a picometre for the rounding of the tests.
+  double clearance() const { return std::max(0.0, std::sqrt(std::max(0.0, distance2 - kTie)) - 1e-12); }
   void offer(const Vec3& p, const Vec3& q, const Vec3& unit_normal, std::uint32_t t) {
     const double d2 = glm::dot(p - q, p - q);
     const double plane = glm::dot(p - q, unit_normal);
@@ -83,7 +86,51 @@ struct Closest {
   }
 };
 
+/// The nearest of a rigid part's candidate faces to p (tool frame): each face is skipped when its
+/// bounding sphere is further than the best so far (exact: same choice, fewer tests).
+Closest nearest_tool_face(const TriangleMesh& mesh, const std::vector<Vec3>& unit_normals, const std::vector<Sphere>& bounds,
+                          const Vec3& p, const std::uint32_t* faces, std::uint32_t count) {
+  Closest best;
+  for (std::uint32_t e = 0; e < count; ++e) {
+    const std::uint32_t face = faces[e];
+    if (best.beyond(p, bounds[face].center, bounds[face].radius)) continue;
+    const Triangle& t = mesh.triangles[face];
+    best.offer(p, closest_point_on_triangle(p, mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]), unit_normals[face], face);
+  }
+  return best;
+}
+
+/// The nearest of the tissue's candidate faces (corners at x) to w (world). The faces move, so
+/// their bounds are formed here: a box, cheaper than a sphere; a face's normal only for a winner.
+Closest nearest_tissue_face(const Vec3* x, const std::vector<Triangle>& triangles, const Vec3& w, const std::uint32_t* faces,
+                            std::uint32_t count) {
+  Closest best;
+  for (std::uint32_t e = 0; e < count; ++e) {
+    const Triangle& t = triangles[faces[e]];
+    if (best.beyond_box(w, glm::min(x[t[0]], glm::min(x[t[1]], x[t[2]])), glm::max(x[t[0]], glm::max(x[t[1]], x[t[2]])))) continue;
+    const Vec3 q = closest_point_on_triangle(w, x[t[0]], x[t[1]], x[t[2]]);
+    if (best.further(glm::dot(w - q, w - q))) continue;
+    const Vec3 n2 = glm::cross(x[t[1]] - x[t[0]], x[t[2]] - x[t[0]]);
+    const double length = glm::length(n2);
+    best.offer(w, q, length > 0.0 ? n2 / length : Vec3(0.0), faces[e]);
+  }
+  return best;
+}
+
+/// A point's certificate from its nearest face: none (radius 0) when it is behind that face.
+ToolContacts::Clearance certify(const Closest& best, const Vec3& at, double tissue_travel) {
+  if (best.side < 0.0) return {};
+  return {at, best.clearance(), tissue_travel};
+}
+
 }  // namespace
+
+bool ToolContacts::Clearance::holds(const Vec3& point, double tissue_travel_now) const {
+  const double slack = radius - (tissue_travel_now - tissue_travel);
+  if (!(slack > 0.0)) return false;
+  const Vec3 moved = point - at;
+  return glm::dot(moved, moved) < slack * slack;
+}
 
 ToolContacts::ToolContacts(double margin_m, const ToolContactCapacity& capacity) : margin_m_(margin_m), capacity_(capacity) {
   // Both buffers at full capacity: publishing swaps them, so neither side ever grows.
@@ -93,6 +140,11 @@ ToolContacts::ToolContacts(double margin_m, const ToolContactCapacity& capacity)
   search_.nodes.resize(static_cast<std::size_t>(capacity.max_tissue_nodes));
   search_.vertices.resize(static_cast<std::size_t>(capacity.max_tool_vertices));
   search_.pair_triangles.resize(static_cast<std::size_t>(capacity.max_pair_entries));
+  search_.pair_distance2.resize(static_cast<std::size_t>(capacity.max_pair_entries));
+  search_.node_clearance.resize(static_cast<std::size_t>(capacity.max_tissue_nodes));
+  search_.vertex_clearance.resize(static_cast<std::size_t>(capacity.max_tool_vertices));
+  node_clearance_.resize(static_cast<std::size_t>(capacity.max_tissue_nodes));
+  vertex_clearance_.resize(static_cast<std::size_t>(capacity.max_tool_vertices));
   stack_.reserve(256);
 }
 
@@ -180,23 +232,29 @@ void ToolContacts::gather_triangles(const SphereTree& tree, const Vec3& p, doubl
 void ToolContacts::keep_within_margin(std::uint32_t first, const Vec3& p, const std::vector<Vec3>& positions,
                                       const std::vector<Triangle>& triangles) {
   // The sphere descent over-approximates; the substeps only need triangles really within the margin.
+  // Kept in order by insertion (a point has tens of them): entry e is read before any shift reaches it.
   std::vector<std::uint32_t>& pairs = search_.pair_triangles;
+  std::vector<double>& distance2 = search_.pair_distance2;
   std::size_t kept = first;
   for (std::size_t e = first; e < search_.pair_count; ++e) {
-    const Triangle& t = triangles[pairs[e]];
+    const std::uint32_t triangle = pairs[e];
+    const Triangle& t = triangles[triangle];
     const Vec3 q = closest_point_on_triangle(p, positions[t[0]], positions[t[1]], positions[t[2]]);
-    if (glm::dot(p - q, p - q) <= margin_m_ * margin_m_) pairs[kept++] = pairs[e];
+    const double d2 = glm::dot(p - q, p - q);
+    if (d2 > margin_m_ * margin_m_) continue;
+    std::size_t slot = kept++;
+    for (; slot > first && (distance2[slot - 1] > d2 || (distance2[slot - 1] == d2 && pairs[slot - 1] > triangle)); --slot) {
+      pairs[slot] = pairs[slot - 1];
+      distance2[slot] = distance2[slot - 1];
+    }
+    pairs[slot] = triangle;
+    distance2[slot] = d2;
   }
   search_.pair_count = kept;
 }
 
-void ToolContacts::update_candidates(const SphereTree& tissue_tree, const TriangleMesh& surface) {
-  latch_query_poses();
-  search_candidates(tissue_tree, surface);
-  publish_candidates();
-}
-
-void ToolContacts::latch_query_poses() {
+void ToolContacts::latch_query_poses(double tissue_travel_m) {
+  query_tissue_travel_m_ = tissue_travel_m;
   for (Part& part : parts_) {
     part.query_pose = part.pose;
     part.query_enabled = part.enabled;
@@ -210,6 +268,8 @@ void ToolContacts::publish_candidates() {
   node_count_ = search_.node_count;
   vertex_count_ = search_.vertex_count;
   pair_count_ = search_.pair_count;
+  std::swap(node_clearance_, search_.node_clearance);
+  std::swap(vertex_clearance_, search_.vertex_clearance);
   // `penetrating` belongs to the physics step that last ran, not to the search.
   const std::int32_t penetrating = stats_.penetrating;
   stats_ = search_.stats;
@@ -256,8 +316,11 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
         const Vec3 p = to_tool_frame(pose, surface.positions[n]);
         gather_triangles(part.tree, p, search_radius, triangle_stamp_);
         keep_within_margin(first, p, part.mesh.positions, part.mesh.triangles);
-        if (out.pair_count > first) {
-          out.nodes[out.node_count++] = {n, static_cast<std::uint16_t>(pi), first, static_cast<std::uint32_t>(out.pair_count - first)};
+        const auto count = static_cast<std::uint32_t>(out.pair_count - first);
+        if (count > 0) {
+          const Closest best = nearest_tool_face(part.mesh, part.face_normals, part.triangle_spheres, p, &out.pair_triangles[first], count);
+          out.node_clearance[out.node_count] = certify(best, p, 0.0);
+          out.nodes[out.node_count++] = {n, static_cast<std::uint16_t>(pi), first, count};
         }
       }
     }
@@ -276,8 +339,11 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
         const Vec3 w = transform_point(pose, part.mesh.positions[v]);
         gather_triangles(tissue_tree, w, search_radius, tissue_triangle_stamp_);
         keep_within_margin(first, w, surface.positions, surface.triangles);
-        if (out.pair_count > first) {
-          out.vertices[out.vertex_count++] = {v, static_cast<std::uint16_t>(pi), first, static_cast<std::uint32_t>(out.pair_count - first)};
+        const auto count = static_cast<std::uint32_t>(out.pair_count - first);
+        if (count > 0) {
+          const Closest best = nearest_tissue_face(surface.positions.data(), surface.triangles, w, &out.pair_triangles[first], count);
+          out.vertex_clearance[out.vertex_count] = certify(best, w, query_tissue_travel_m_);
+          out.vertices[out.vertex_count++] = {v, static_cast<std::uint16_t>(pi), first, count};
         }
       }
     }
@@ -288,24 +354,26 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
 }
 
 ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const Vec3> v, const std::vector<Triangle>& surface_triangles,
-                                      double k, double c, double h_s, std::span<Vec3> force, std::span<double> stiffness_bound,
-                                      std::span<double> damping_bound) {
+                                      double k, double c, double h_s, double tissue_travel_m, std::span<Vec3> force,
+                                      std::span<double> stiffness_bound, std::span<double> damping_bound) {
   ToolReaction reaction;
   std::int32_t penetrating = 0;
+  std::int64_t skipped = 0;
   const double inverse_h = 1.0 / h_s;
   // Candidates in the order update_candidates stored them: the force sums are the same every run.
+  // A tissue node is tested in the tool's frame, where the tool's triangles stand still: only the
+  // node's own motion there can close its clearance.
   for (std::size_t i = 0; i < node_count_; ++i) {
     const PointCandidates& pc = node_candidates_[i];
     const Part& part = parts_[pc.part];
     const Vec3 p = to_tool_frame(part.pose, x[pc.point]);
-    Closest best;
-    for (std::uint32_t e = pc.first; e < pc.first + pc.count; ++e) {
-      const Sphere& bounds = part.triangle_spheres[pair_triangles_[e]];
-      if (best.beyond(p, bounds.center, bounds.radius)) continue;
-      const Triangle& t = part.mesh.triangles[pair_triangles_[e]];
-      const Vec3 q = closest_point_on_triangle(p, part.mesh.positions[t[0]], part.mesh.positions[t[1]], part.mesh.positions[t[2]]);
-      best.offer(p, q, part.face_normals[pair_triangles_[e]], pair_triangles_[e]);
+    Clearance& clearance = node_clearance_[i];
+    if (clearance_skipping_ && clearance.holds(p, 0.0)) {
+      ++skipped;
+      continue;
     }
+    const Closest best = nearest_tool_face(part.mesh, part.face_normals, part.triangle_spheres, p, &pair_triangles_[pc.first], pc.count);
+    clearance = certify(best, p, 0.0);
     if (!(best.side < 0.0)) continue;
     // Along the closest face's normal, by the distance behind its plane: the signed distance's
     // gradient there. (The closest-point direction would turn fast near the wire's centre line, a
@@ -330,17 +398,13 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
     const PointCandidates& pc = vertex_candidates_[i];
     const Part& part = parts_[pc.part];
     const Vec3 w = transform_point(part.pose, part.mesh.positions[pc.point]);
-    Closest best;
-    for (std::uint32_t e = pc.first; e < pc.first + pc.count; ++e) {
-      const Triangle& t = surface_triangles[pair_triangles_[e]];
-      // The tissue's faces move, so their bounds are formed here: a box, cheaper than a sphere.
-      if (best.beyond_box(w, glm::min(x[t[0]], glm::min(x[t[1]], x[t[2]])), glm::max(x[t[0]], glm::max(x[t[1]], x[t[2]])))) continue;
-      const Vec3 q = closest_point_on_triangle(w, x[t[0]], x[t[1]], x[t[2]]);
-      if (best.further(glm::dot(w - q, w - q))) continue;
-      const Vec3 n2 = glm::cross(x[t[1]] - x[t[0]], x[t[2]] - x[t[0]]);
-      const double length = glm::length(n2);
-      best.offer(w, q, length > 0.0 ? n2 / length : Vec3(0.0), pair_triangles_[e]);
+    Clearance& clearance = vertex_clearance_[i];
+    if (clearance_skipping_ && clearance.holds(w, tissue_travel_m)) {
+      ++skipped;
+      continue;
     }
+    const Closest best = nearest_tissue_face(x.data(), surface_triangles, w, &pair_triangles_[pc.first], pc.count);
+    clearance = certify(best, w, tissue_travel_m);
     if (!(best.side < 0.0)) continue;
     const Triangle& t = surface_triangles[best.triangle];
     const double depth = std::min(-best.side, margin_m_);
@@ -363,6 +427,8 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
     ++penetrating;
   }
   stats_.penetrating = penetrating;
+  points_skipped_ += skipped;
+  points_evaluated_ += static_cast<std::int64_t>(node_count_ + vertex_count_) - skipped;
   return reaction;
 }
 

@@ -41,6 +41,21 @@ struct ToolContactStats {
 /// The tool side of contact: the rigid parts, their (margin-inflated) sphere trees, their poses.
 class ToolContacts {
  public:
+  /// Proof that a point cannot touch its candidate triangles yet: at `at` (tool frame for a tissue
+  /// node, world for a tool vertex) it was outside them, at least `radius` from every one, and the
+  /// tissue had travelled `tissue_travel` by then. Distance to a set of triangles changes no faster
+  /// than the point and the triangles' corners move, so while the point has moved less than the
+  /// radius minus the tissue's travel since, no candidate can be nearer than zero: the point is
+  /// still outside and takes no force. radius 0: no proof, test the point.
+  struct Clearance {
+    Vec3 at{0.0};
+    double radius = 0.0;
+    double tissue_travel = 0.0;
+    /// Whether the proof still holds for the point now at `point`, the tissue's travel now being
+    /// `tissue_travel_now`.
+    bool holds(const Vec3& point, double tissue_travel_now) const;
+  };
+
   /// `margin_m`: how far outside the tool a point may be and still become a candidate; it must
   /// exceed what tool and tissue move in one collision step.
   explicit ToolContacts(double margin_m = 0.0015, const ToolContactCapacity& capacity = {});
@@ -58,33 +73,41 @@ class ToolContacts {
   /// How far outside the tool a point may be and still become a candidate.
   double margin_m() const { return margin_m_; }
 
-  /// The 60 Hz collision step, all at once: latch_query_poses(), search_candidates(),
-  /// publish_candidates(). Allocates nothing once the capacities are reserved.
-  void update_candidates(const SphereTree& tissue_tree, const TriangleMesh& surface);
-
-  // The same step in three parts, so the search can run on another thread while physics steps go on
-  // with the candidates already published (the core's collision pipeline):
-  /// Takes the parts' current poses and enabled flags as the ones the next search uses. Call on the
+  // The 60 Hz collision step in three parts, so the search can run on another thread while physics
+  // steps go on with the candidates already published (the core's collision pipeline):
+  /// Takes the parts' current poses and enabled flags as the ones the next search uses, and the
+  /// tissue's travel (MassSpringTissue::travel_m) at the positions it will search. Call on the
   /// thread that sets poses, while no search runs.
-  void latch_query_poses();
+  void latch_query_poses(double tissue_travel_m);
   /// Replaces a part's latched pose with where the search should look for it instead (e.g. where the
   /// part is expected to be while the candidates are in use). Same rules as latch_query_poses().
   void set_query_pose(int part, const RigidTransform& pose) { parts_[static_cast<std::size_t>(part)].query_pose = pose; }
   /// Queries each part's tree (at its latched pose) against the tissue surface tree, already refitted
   /// to `surface`'s positions, into a back buffer. Touches nothing add_forces() or set_pose() use, so
   /// it may run concurrently with them; never with latch_query_poses() or publish_candidates().
+  /// Each point it keeps comes with its clearance certificate at the searched positions.
   void search_candidates(const SphereTree& tissue_tree, const TriangleMesh& surface);
   /// Makes the last search's candidates the ones add_forces() uses (a swap: no allocation).
   void publish_candidates();
 
   /// One substep's penalty forces on the candidate pairs at positions x, velocities v: adds to
   /// `force`, and to the per-node bounds of the contact stiffness and damping the integrator needs.
-  /// Returns the reaction on the tool.
+  /// `tissue_travel_m` bounds how far any tissue node has moved since the tissue was created (a
+  /// running sum of each step's largest node displacement); it lets a point found clear of the other
+  /// surface skip its tests until the two could have met. Returns the reaction on the tool.
   ToolReaction add_forces(std::span<const Vec3> x, std::span<const Vec3> v, const std::vector<Triangle>& surface_triangles,
-                          double stiffness_n_m, double damping_ns_m, double h_s, std::span<Vec3> force,
+                          double stiffness_n_m, double damping_ns_m, double h_s, double tissue_travel_m, std::span<Vec3> force,
                           std::span<double> stiffness_bound, std::span<double> damping_bound);
 
+  /// Whether add_forces() may skip points whose clearance certificate still holds (on by default).
+  /// Off, every candidate point is tested at every step: the brute-force reference the tests and
+  /// benchmarks compare against. The forces are the same either way.
+  void set_clearance_skipping(bool enabled) { clearance_skipping_ = enabled; }
+
   const ToolContactStats& stats() const { return stats_; }
+  /// Point evaluations add_forces() ran and skipped on its certificates, since construction.
+  std::int64_t points_evaluated() const { return points_evaluated_; }
+  std::int64_t points_skipped() const { return points_skipped_; }
 
  private:
   struct Part {
@@ -110,13 +133,17 @@ class ToolContacts {
   struct CandidateSet {
     std::vector<PointCandidates> nodes, vertices;
     std::vector<std::uint32_t> pair_triangles;
+    std::vector<double> pair_distance2;  // scratch: each kept pair's distance at the search, for the order
+    std::vector<Clearance> node_clearance, vertex_clearance;  // per point, at the searched positions
     std::size_t node_count = 0, vertex_count = 0, pair_count = 0;
     ToolContactStats stats;
   };
   /// Appends the triangles of `tree` with a leaf sphere within `radius` of `point`, each once.
   void gather_triangles(const SphereTree& tree, const Vec3& point, double radius, std::vector<std::uint32_t>& seen);
   bool push_pair(std::uint32_t triangle);
-  /// Drops the pairs from `first` on whose triangle is further than the margin from `p`.
+  /// Drops the pairs from `first` on whose triangle is further than the margin from `p`, and orders
+  /// the rest nearest first (ties by triangle index), so the closest-face search's exact prune
+  /// discards most of them after the first test.
   void keep_within_margin(std::uint32_t first, const Vec3& p, const std::vector<Vec3>& positions,
                           const std::vector<Triangle>& triangles);
 
@@ -128,6 +155,11 @@ class ToolContacts {
   std::vector<PointCandidates> vertex_candidates_;  // tool vertex against tissue triangles
   std::vector<std::uint32_t> pair_triangles_;
   std::size_t node_count_ = 0, vertex_count_ = 0, pair_count_ = 0;
+  // Per published candidate point, its clearance certificate (the search's, renewed by add_forces()).
+  std::vector<Clearance> node_clearance_, vertex_clearance_;
+  double query_tissue_travel_m_ = 0.0;  // latched with the query poses
+  bool clearance_skipping_ = true;
+  std::int64_t points_evaluated_ = 0, points_skipped_ = 0;
   // The search's side: its result and its scratch (stamps, stack), never read by add_forces().
   CandidateSet search_;
   std::vector<std::uint32_t> node_stamp_, tool_vertex_stamp_, triangle_stamp_, tissue_triangle_stamp_;

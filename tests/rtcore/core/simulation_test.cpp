@@ -69,6 +69,21 @@ TEST(Simulation, TheCollisionThreadChangesNothingButWhereTheSearchRuns) {
   EXPECT_EQ(a, b);
 }
 
+TEST(Simulation, ClearanceCertificatesGiveTheBruteForceState) {
+  // Both tool parts, rolling, inserting and swinging into a lobe: skipping the points proven clear
+  // of the tool changes no bit of the state.
+  SimulationConfig brute_force = small_config();
+  brute_force.clearance_certificates = false;
+  const auto a = run_hashes(small_config(), 3 * 960);
+  const auto b = run_hashes(brute_force, 3 * 960);
+  ASSERT_EQ(a.size(), 180u);
+  EXPECT_EQ(a, b);
+  auto sim = Simulation::create(small_config());
+  ASSERT_TRUE(sim) << sim.error();
+  for (std::uint64_t tick = 0; tick < 3 * 960; ++tick) (*sim)->step(input_at(tick, (*sim)->config().tick_s()), {});
+  EXPECT_GT((*sim)->metrics().contact_time_s, 0.5) << "the hand pressed the tissue for a while";
+}
+
 TEST(Simulation, ContactWaitsForTheCandidatesOfThePreviousCollisionStep) {
   // The one-step pipeline: a tool pressed in at tick 0 finds nothing before the second collision
   // tick publishes what the first one searched.

@@ -9,23 +9,13 @@
 #include "rtcore/base/units.h"
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/tissue/indentation.h"
+#include "tests/support/tissue_models.h"
 
 namespace resecto {
 namespace {
 
-const ProstateTissueModel& prostate(int triangles) {
-  static std::map<int, ProstateTissueModel> models;
-  auto it = models.find(triangles);
-  if (it == models.end()) {
-    Result<ProstateTissueModel> model = build_prostate_tissue_model(generate_prostate(triangles), generate_resectoscope().loop);
-    EXPECT_TRUE(model) << model.error();
-    it = models.emplace(triangles, std::move(*model)).first;
-  }
-  return it->second;
-}
-
 TEST(SpringNetwork, SharesTheVolumeAndAnchorsOnlyTheOuterSurface) {
-  const ProstateTissueModel& model = prostate(1296);
+  const ProstateTissueModel& model = tissue_model(1296);
   const SpringNetwork net = build_spring_network(model.mesh);
   double volume = 0.0, node_volume = 0.0, shares = 0.0;
   for (std::size_t t = 0; t < model.mesh.tetrahedron_count(); ++t) volume += tetrahedron_volume(model.mesh, t);
@@ -79,7 +69,7 @@ TEST(TissueParameters, RefusesUnknownKeysAndOutOfRangeValuesNamingThem) {
 }
 
 TEST(MassSpringTissue, RestStateIsAnEquilibrium) {
-  MassSpringTissue tissue(prostate(1296).mesh);
+  MassSpringTissue tissue(tissue_model(1296).mesh);
   const std::uint64_t rest_hash = tissue.state_hash();
   for (int tick = 0; tick < 9600; ++tick) {  // 10 s at 960 Hz, no tool
     if (tick % 16 == 0) tissue.collision_step();
@@ -91,7 +81,7 @@ TEST(MassSpringTissue, RestStateIsAnEquilibrium) {
 }
 
 TEST(MassSpringTissue, LumpedMassIsDensityTimesVolume) {
-  const ProstateTissueModel& model = prostate(1296);
+  const ProstateTissueModel& model = tissue_model(1296);
   TissueParameters p;
   ASSERT_TRUE(p.set(TissueParameter::kDensity, 1.5));
   MassSpringTissue tissue(model.mesh, p);
@@ -113,7 +103,7 @@ IndentationOptions quick_protocol(double relax_s = 0.5) {
 }
 
 TEST(Indentation, ForceGrowsWithStiffnessAndDepth) {
-  const ProstateTissueModel& model = prostate(1296);
+  const ProstateTissueModel& model = tissue_model(1296);
   auto peak = [&](double stiffness_kpa, double depth_mm) {
     IndentationOptions o = quick_protocol(0.0);
     o.depth_m = units::mm_to_m(depth_mm);
@@ -132,7 +122,7 @@ TEST(Indentation, ForceGrowsWithStiffnessAndDepth) {
 
 TEST(Indentation, ReturnsToRestAfterWithdrawal) {
   // Documented time: every node back within 0.1 mm of rest within 1.5 s of the loop clearing.
-  const IndentationResult r = run_indentation(prostate(1296), quick_protocol(1.5));
+  const IndentationResult r = run_indentation(tissue_model(1296), quick_protocol(1.5));
   EXPECT_TRUE(r.finite);
   EXPECT_GT(r.max_displacement_m, 0.002);
   EXPECT_LT(r.residual_m, 1e-4);
@@ -145,7 +135,7 @@ TEST(Indentation, SameRunTwiceGivesTheSameHashAtEveryCollisionStep) {
     std::vector<std::uint64_t> out;
     IndentationOptions o = quick_protocol(0.1);
     o.on_collision_step = [&](std::int64_t, std::uint64_t hash) { out.push_back(hash); };
-    (void)run_indentation(prostate(1296), o);
+    (void)run_indentation(tissue_model(1296), o);
     return out;
   };
   const std::vector<std::uint64_t> a = hashes(), b = hashes();
@@ -190,7 +180,7 @@ TEST_P(StabilitySweep, StaysFiniteBoundedAndInTheScene) {
               p.set(TissueParameter::kViscousDamping, c.viscous) && p.set(TissueParameter::kDensity, c.density) &&
               p.set(TissueParameter::kAnchorStiffness, c.anchor) && p.set(TissueParameter::kPenaltyStiffness, c.penalty_k) &&
               p.set(TissueParameter::kPenaltyDamping, c.penalty_c));
-  const IndentationResult r = run_indentation(prostate(triangles), o);
+  const IndentationResult r = run_indentation(tissue_model(triangles), o);
   EXPECT_TRUE(r.finite) << c.name << ": first non-finite node " << r.faults.first_non_finite_node;
   // The loop moves at 20 mm/s; 45 g moving as a whole at ten times that would hold 1e-3 J.
   EXPECT_LT(r.max_kinetic_energy_j, 1e-3) << c.name;

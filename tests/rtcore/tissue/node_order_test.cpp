@@ -8,18 +8,13 @@
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/tissue/indentation.h"
 #include "rtcore/tissue/node_order.h"
+#include "tests/support/tissue_models.h"
 
 namespace resecto {
 namespace {
 
-ProstateTissueModel prostate_model(int triangles) {
-  Result<ProstateTissueModel> model = build_prostate_tissue_model(generate_prostate(triangles), generate_resectoscope().loop);
-  EXPECT_TRUE(model) << model.error();
-  return std::move(*model);
-}
-
 TEST(NodeOrder, IsAPermutationThatNarrowsTheSpringsSpanAndKeepsTheGeometry) {
-  const ProstateTissueModel model = prostate_model(1296);
+  const ProstateTissueModel& model = tissue_model(1296);
   const std::vector<std::uint32_t> order = locality_order(model.mesh);
   ASSERT_EQ(order.size(), model.mesh.node_count());
   std::vector<std::uint32_t> sorted = order;
@@ -58,7 +53,7 @@ TEST(NodeOrder, DisconnectedPiecesAreAllNumbered) {
 }
 
 TEST(NodeOrder, TheTissueReportsInTheMeshsNumberingAndMovesTheSameEitherWay) {
-  const ProstateTissueModel model = prostate_model(1296);
+  const ProstateTissueModel& model = tissue_model(1296);
   TissueConfig plain;
   plain.locality_order = false;
   MassSpringTissue local(model.mesh), mesh_ordered(model.mesh, {}, plain);

@@ -1,0 +1,82 @@
+// The tool contact's clearance certificates against the brute force: a point is skipped only while
+// it provably cannot touch its candidate faces, so skipping must give the same forces, bit for bit,
+// as testing every candidate point at every step, however fast the loop moves.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <vector>
+
+#include "rtcore/anatomy/resectoscope.h"
+#include "rtcore/tissue/indentation.h"
+#include "tests/support/tissue_models.h"
+
+namespace resecto {
+namespace {
+
+std::vector<std::uint64_t> collision_hashes(const ProstateTissueModel& model, IndentationOptions options, bool certificates) {
+  std::vector<std::uint64_t> hashes;
+  options.config.clearance_certificates = certificates;
+  options.on_collision_step = [&](std::int64_t, std::uint64_t hash) { hashes.push_back(hash); };
+  const IndentationResult result = run_indentation(model, options);
+  EXPECT_TRUE(result.finite);
+  EXPECT_GT(result.peak_force_n, 0.0) << "the loop pressed the tissue";
+  return hashes;
+}
+
+struct Case {
+  int triangles;
+  double depth_mm;
+  double press_s;  ///< 5 mm in 0.05 s is 100 mm/s, beyond any hand on a resectoscope
+};
+
+class ClearanceCertificates : public ::testing::TestWithParam<Case> {};
+
+TEST_P(ClearanceCertificates, GiveTheBruteForceStateAtEveryCollisionStep) {
+  const Case c = GetParam();
+  IndentationOptions options;
+  options.depth_m = c.depth_mm * 1e-3;
+  options.press_s = c.press_s;
+  options.hold_s = 0.25;
+  options.withdraw_s = c.press_s;
+  options.relax_s = 0.25;
+  const std::vector<std::uint64_t> brute = collision_hashes(tissue_model(c.triangles), options, false);
+  const std::vector<std::uint64_t> skipping = collision_hashes(tissue_model(c.triangles), options, true);
+  ASSERT_EQ(brute.size(), skipping.size());
+  for (std::size_t i = 0; i < brute.size(); ++i) ASSERT_EQ(brute[i], skipping[i]) << "collision step " << i;
+}
+
+INSTANTIATE_TEST_SUITE_P(Indentations, ClearanceCertificates,
+                         ::testing::Values(Case{1296, 5.0, 1.0}, Case{1296, 5.0, 0.05}, Case{8640, 5.0, 0.5}, Case{8640, 3.0, 0.05}),
+                         [](const auto& info) {
+                           return std::to_string(info.param.triangles) + "_" + std::to_string(static_cast<int>(info.param.depth_mm)) +
+                                  "mm_in_" + std::to_string(static_cast<int>(info.param.press_s * 1000)) + "ms";
+                         });
+
+TEST(ClearanceCertificates, SkipMostPointsOfAHeldIndentation) {
+  // Not a speed test: it shows the certificates are doing something, counted, not timed.
+  const ProstateTissueModel& model = tissue_model(1296);
+  MassSpringTissue tissue(model.mesh);
+  const int part = tissue.tool().add_part(model.loop);
+  tissue.tool().reset_pose(part, indentation_loop_pose(model.anatomy, model.loop, 0.0));
+  for (int tick = 0; tick < 960; ++tick) {
+    if (tick % 16 == 0) tissue.collision_step();
+    tissue.tool().set_pose(part, indentation_loop_pose(model.anatomy, model.loop, 0.003 * std::min(1.0, tick / 480.0)));
+    (void)tissue.physics_step(1.0 / 960.0);
+  }
+  const double evaluated = static_cast<double>(tissue.tool().points_evaluated());
+  const double skipped = static_cast<double>(tissue.tool().points_skipped());
+  EXPECT_GT(tissue.tool().stats().penetrating, 0) << "the loop is in the tissue";
+  EXPECT_GT(skipped / (evaluated + skipped), 0.5) << evaluated << " evaluated, " << skipped << " skipped";
+}
+
+TEST(ClearanceCertificate, HoldsOnlyWhileTheMotionCannotCloseTheGap) {
+  const ToolContacts::Clearance clearance{Vec3(0.0), 1e-3, 2e-4};
+  EXPECT_TRUE(clearance.holds(Vec3(0.0), 2e-4));
+  EXPECT_TRUE(clearance.holds(Vec3(0.5e-3, 0.0, 0.0), 2e-4));
+  EXPECT_FALSE(clearance.holds(Vec3(1e-3, 0.0, 0.0), 2e-4)) << "moved the whole clearance";
+  EXPECT_FALSE(clearance.holds(Vec3(0.5e-3, 0.0, 0.0), 7e-4)) << "the tissue travelled the rest";
+  EXPECT_FALSE(ToolContacts::Clearance{}.holds(Vec3(0.0), 0.0)) << "no certificate, no skip";
+}
+
+}  // namespace
+}  // namespace resecto
