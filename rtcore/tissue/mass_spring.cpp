@@ -142,7 +142,7 @@ void MassSpringTissue::accumulate_forces(double h_s) {
   // changes (update_material); what varies is added on top.
   std::copy(base_stiffness_bound_.begin(), base_stiffness_bound_.end(), stiffness_bound_.begin());
   std::copy(base_damping_bound_.begin(), base_damping_bound_.end(), damping_bound_.begin());
-  if (compressed > 0) [[unlikely]] springs_.add_compression_bounds(x_.data(), stiffness_bound_.data());
+  if (compressed > 0) [[unlikely]] springs_.add_compression_bounds(x_.data(), stiffness_bound_.data(), compressed);
   if (config_.integrator == TissueIntegrator::kImplicitEuler) springs_.linearise(x_.data(), spring_direction_.data(), spring_transverse_k_.data());
   reaction_ = tool_.add_forces(x_, v_, surface_.triangles, parameters_.si(TissueParameter::kPenaltyStiffness),
                                parameters_.si(TissueParameter::kPenaltyDamping), h_s, travel_m_, force_, stiffness_bound_, damping_bound_);

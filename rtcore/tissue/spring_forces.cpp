@@ -34,6 +34,7 @@ SpringForces::SpringForces(const SpringNetwork& network) {
   arrays_.k.assign(count, 0.0);
   arrays_.c.assign(count, 0.0);
   arrays_.f.assign(count, SpringForce{});
+  arrays_.compressed.assign(count, 0);
   // Counting sort by node, springs visited in ascending order: each node's list is ascending.
   SpringIncidence& in = incidence_;
   in.second_first.assign(nodes + 1, 0);
@@ -53,9 +54,10 @@ SpringForces::SpringForces(const SpringNetwork& network) {
   for (std::size_t s = 0; s < count; ++s) in.second_springs[fill[arrays_.j[s]]++] = static_cast<std::uint32_t>(s);
 }
 
-void SpringForces::add_compression_bounds(const Vec3* x, double* stiffness_bound) const {
+void SpringForces::add_compression_bounds(const Vec3* x, double* stiffness_bound, std::size_t count) const {
   // Spring order: each node's bound sums its springs' excesses in the same order every run.
-  for (std::size_t s = 0; s < spring_count(); ++s) {
+  for (std::size_t listed = 0; listed < count; ++listed) {
+    const std::uint32_t s = arrays_.compressed[listed];
     const SpringGeometry g = spring_geometry(x, arrays_.i[s], arrays_.j[s]);
     if (!compressed_below_half(g.length, arrays_.rest_m[s])) continue;
     const double excess = 2.0 * arrays_.k[s] * (arrays_.rest_m[s] * g.inverse_length - 2.0);

@@ -35,8 +35,9 @@ class SpringForces {
   const SpringIncidence& incidence() const { return incidence_; }
 
   /// Adds, in spring order, the Hessian-norm excess of each spring compressed below half its rest
-  /// length to both its nodes' stiffness bounds (k |1 - L0/L| exceeds the k already counted).
-  void add_compression_bounds(const Vec3* x, double* stiffness_bound) const;
+  /// length to both its nodes' stiffness bounds (k |1 - L0/L| exceeds the k already counted): the
+  /// `count` springs the last compute() listed.
+  void add_compression_bounds(const Vec3* x, double* stiffness_bound, std::size_t count) const;
 
   /// Implicit Euler's linearisation: each spring's unit direction and transverse stiffness.
   void linearise(const Vec3* x, Vec3* direction, double* transverse_k) const;

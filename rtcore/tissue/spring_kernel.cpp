@@ -48,7 +48,8 @@ __attribute__((target("avx2"), always_inline)) inline void store_rows(SpringForc
 
 }  // namespace
 
-std::size_t spring_forces_portable(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end) {
+std::size_t spring_forces_portable(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end,
+                                   std::uint32_t* compressed_out) {
   std::size_t compressed = 0;
   for (std::size_t s = begin; s < end; ++s) {
     const Vec3& xi = x[springs.i[s]];
@@ -63,13 +64,13 @@ std::size_t spring_forces_portable(SpringArrays& springs, const Vec3* x, const V
     const double along = ((vj.x - vi.x) * ux + (vj.y - vi.y) * uy) + (vj.z - vi.z) * uz;
     const double magnitude = springs.k[s] * stretch + springs.c[s] * along;
     springs.f[s] = {magnitude * ux, magnitude * uy, magnitude * uz, 0.0};
-    compressed += (length > 0.0 && 2.0 * length < springs.rest_m[s]) ? 1 : 0;
+    if (length > 0.0 && 2.0 * length < springs.rest_m[s]) [[unlikely]] compressed_out[compressed++] = static_cast<std::uint32_t>(s);
   }
   return compressed;
 }
 
 __attribute__((target("avx2"))) std::size_t spring_forces_avx2(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin,
-                                                               std::size_t end) {
+                                                               std::size_t end, std::uint32_t* compressed_out) {
   const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), two = _mm256_set1_pd(2.0);
   std::size_t compressed = 0;
   std::size_t s = begin;
@@ -93,9 +94,11 @@ __attribute__((target("avx2"))) std::size_t spring_forces_avx2(SpringArrays& spr
                                             _mm256_mul_pd(_mm256_loadu_pd(springs.c.data() + s), along));
     store_rows(springs.f.data() + s, _mm256_mul_pd(magnitude, ux), _mm256_mul_pd(magnitude, uy), _mm256_mul_pd(magnitude, uz));
     const __m256d short_spring = _mm256_and_pd(positive, _mm256_cmp_pd(_mm256_mul_pd(two, length), rest, _CMP_LT_OQ));
-    compressed += static_cast<std::size_t>(std::popcount(static_cast<unsigned>(_mm256_movemask_pd(short_spring))));
+    for (unsigned lanes = static_cast<unsigned>(_mm256_movemask_pd(short_spring)); lanes != 0; lanes &= lanes - 1) [[unlikely]] {
+      compressed_out[compressed++] = static_cast<std::uint32_t>(s + static_cast<std::size_t>(std::countr_zero(lanes)));
+    }
   }
-  return compressed + spring_forces_portable(springs, x, v, s, end);
+  return compressed + spring_forces_portable(springs, x, v, s, end, compressed_out + compressed);
 }
 
 void add_spring_sums_portable(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t begin, std::size_t end) {
@@ -130,7 +133,8 @@ bool cpu_has_avx2() {
 
 std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v) {
   const std::size_t count = springs.i.size();
-  return cpu_has_avx2() ? spring_forces_avx2(springs, x, v, 0, count) : spring_forces_portable(springs, x, v, 0, count);
+  std::uint32_t* compressed = springs.compressed.data();
+  return cpu_has_avx2() ? spring_forces_avx2(springs, x, v, 0, count, compressed) : spring_forces_portable(springs, x, v, 0, count, compressed);
 }
 
 void add_spring_sums(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t node_count) {

@@ -24,6 +24,9 @@ struct SpringArrays {
   std::vector<double> rest_m;       ///< rest length
   std::vector<double> k, c;         ///< stiffness (N/m), damping (N*s/m)
   std::vector<SpringForce> f;       ///< the spring's force on node i of the last pass (node j gets minus)
+  /// Room for every spring: the force pass lists here, ascending, the springs it found compressed
+  /// below half their rest length, so the rare bound correction visits only those.
+  std::vector<std::uint32_t> compressed;
 };
 
 /// Which springs meet at each node, in the order the node pass adds them.
@@ -37,11 +40,14 @@ struct SpringIncidence {
 };
 
 /// Writes the force of springs [begin, end) at positions x and velocities v into f:
-/// f = (k (L - L0) + c (v_j - v_i).u) u with u = (x_j - x_i) / L (u = 0 when L = 0). Returns how
-/// many of them are compressed below half their rest length.
-std::size_t spring_forces_portable(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end);
+/// f = (k (L - L0) + c (v_j - v_i).u) u with u = (x_j - x_i) / L (u = 0 when L = 0). Lists the
+/// springs compressed below half their rest length, ascending, at `compressed` (room for end - begin)
+/// and returns how many there are.
+std::size_t spring_forces_portable(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end,
+                                   std::uint32_t* compressed);
 /// The same with four springs per instruction; call only where cpu_has_avx2().
-std::size_t spring_forces_avx2(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end);
+std::size_t spring_forces_avx2(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end,
+                               std::uint32_t* compressed);
 
 /// For nodes [begin, end): force[n] = force[n] - (n's forces as node j, ascending) + (its forces as
 /// node i, ascending), component by component.
@@ -52,7 +58,8 @@ void add_spring_sums_avx2(const SpringIncidence& incidence, const SpringForce* f
 /// Whether this processor runs the AVX2 kernels (checked once).
 bool cpu_has_avx2();
 
-/// The fastest kernels this processor runs, over all springs and all nodes.
+/// The fastest kernels this processor runs, over all springs (listing the compressed ones in
+/// springs.compressed) and all nodes.
 std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v);
 void add_spring_sums(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t node_count);
 

@@ -3,6 +3,7 @@
 // non-finite springs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -43,12 +44,17 @@ TEST(SpringKernel, Avx2PathMatchesThePortablePathBitForBit) {
   const std::size_t count = forces.spring_count();
   for (auto [begin, end] : {std::pair<std::size_t, std::size_t>{0, count}, {1, count - 2}, {5, 7}}) {
     SpringArrays portable = springs, simd = springs;
-    const std::size_t compressed_portable = spring_forces_portable(portable, x.data(), v.data(), begin, end);
-    const std::size_t compressed_simd = spring_forces_avx2(simd, x.data(), v.data(), begin, end);
-    EXPECT_EQ(compressed_portable, compressed_simd);
+    const std::size_t compressed_portable = spring_forces_portable(portable, x.data(), v.data(), begin, end, portable.compressed.data());
+    const std::size_t compressed_simd = spring_forces_avx2(simd, x.data(), v.data(), begin, end, simd.compressed.data());
+    ASSERT_EQ(compressed_portable, compressed_simd);
+    for (std::size_t k = 0; k < compressed_portable; ++k) EXPECT_EQ(portable.compressed[k], simd.compressed[k]) << "listed " << k;
     EXPECT_TRUE(same_bits(portable.f, simd.f)) << begin << ".." << end;
     if (begin == 0) {
       EXPECT_GE(compressed_portable, 1u);
+      const auto listed = portable.compressed.begin();
+      EXPECT_TRUE(std::is_sorted(listed, listed + static_cast<std::ptrdiff_t>(compressed_portable)));
+      EXPECT_TRUE(std::binary_search(listed, listed + static_cast<std::ptrdiff_t>(compressed_portable), 21u))
+          << "the spring squeezed to 30% of its length is listed";
       EXPECT_EQ(portable.f[10].x, 0.0);
       EXPECT_TRUE(std::isnan(portable.f[33].y));
     }
@@ -56,7 +62,7 @@ TEST(SpringKernel, Avx2PathMatchesThePortablePathBitForBit) {
 
   // The node sums over those forces, from a non-zero start, over all nodes and over a slice.
   SpringArrays computed = springs;
-  spring_forces_portable(computed, x.data(), v.data(), 0, count);
+  spring_forces_portable(computed, x.data(), v.data(), 0, count, computed.compressed.data());
   for (auto [begin, end] : {std::pair<std::size_t, std::size_t>{0, x.size()}, {3, x.size() - 5}}) {
     std::vector<Vec3> portable = v, simd = v;
     add_spring_sums_portable(forces.incidence(), computed.f.data(), portable.data(), begin, end);
