@@ -16,4 +16,12 @@ echo
 "$bin" run --headless --realtime --procedure demo --seconds 10 --report "$out/realtime-report.json" \
   --trace "$out/realtime-trace.json"
 echo
+# The machine's own floor for that schedule: the same scheduler and priority with ticks that compute
+# nothing. Misses it shows too are the machine's (README, "Running the simulator").
+floor="$(dirname "$bin")/../benchmarks/deadline_floor_bench"
+if [ -x "$floor" ]; then
+  echo "the machine's own floor (the same schedule, each tick only 300 us of busy waiting):"
+  "$floor" --benchmark_filter='BM_DeadlineFloor/300/' 2>/dev/null | tail -3
+fi
+echo
 echo "models, reports and traces are in $out/ (open demo-trace.json or realtime-trace.json in https://ui.perfetto.dev)"
