@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "rtcore/tissue/node_order.h"
 #include "rtcore/tissue/state_hash.h"
@@ -175,7 +176,7 @@ void MassSpringTissue::step_bounded_symplectic(double h_s) {
     if (!std::isfinite(sum) && first_non_finite == n) first_non_finite = i;
   }
   if (first_non_finite < n) [[unlikely]] note_non_finite(first_non_finite);
-  travel_m_ += h_s * std::sqrt(fastest2);
+  add_travel(h_s * std::sqrt(fastest2));
   last_substeps_ = 1;
 }
 
@@ -204,7 +205,7 @@ void MassSpringTissue::step_substepped_symplectic(double h_s) {
       x_[i] += h * v_[i];
       fastest2 = std::max(fastest2, glm::dot(v_[i], v_[i]));
     }
-    travel_m_ += h * std::sqrt(fastest2);
+    add_travel(h * std::sqrt(fastest2));
   }
   reaction_.force_n = total.force_n / static_cast<double>(substeps);
   reaction_.torque_nm = total.torque_nm / static_cast<double>(substeps);
@@ -275,7 +276,7 @@ void MassSpringTissue::step_implicit_euler(double h_s) {
     x_[i] += h_s * v_[i];
     fastest2 = std::max(fastest2, glm::dot(v_[i], v_[i]));
   }
-  travel_m_ += h_s * std::sqrt(fastest2);
+  add_travel(h_s * std::sqrt(fastest2));
   last_cg_iterations_ = iteration;
   last_substeps_ = 1;
 }
@@ -305,9 +306,18 @@ void MassSpringTissue::check_finite() {
   }
 }
 
+void MassSpringTissue::add_travel(double largest_step_m) {
+  // The positions' own rounding (x += h v, ~1e-17 m a step at the gland's coordinates) can carry a
+  // node a hair further than the sum of h |v|; a femtometre a step and a relative part cover it, so
+  // the travel bounds every node's displacement outright (about 4 nm of slack after an hour).
+  travel_m_ += largest_step_m * (1.0 + 1e-9) + 1e-15;
+}
+
 void MassSpringTissue::note_non_finite(std::size_t node) {
   if (faults_.first_non_finite_node < 0) faults_.first_non_finite_node = static_cast<std::int64_t>(node);
   ++faults_.non_finite_steps;
+  // A NaN speed drops out of the steps' largest displacement; no clearance can be trusted after it.
+  travel_m_ = std::numeric_limits<double>::infinity();
 }
 
 std::uint64_t MassSpringTissue::topology_hash() const {

@@ -114,7 +114,8 @@ class MassSpringTissue {
   double max_displacement_m() const;
   const TissueFaults& faults() const { return faults_; }
   /// A bound on how far any node has moved since construction: the sum over steps of the step's
-  /// largest node displacement. The tool contact's clearance certificates measure against it.
+  /// largest node displacement (infinite once a step went non-finite). The tool contact's clearance
+  /// certificates measure against it.
   double travel_m() const { return travel_m_; }
   /// Sub-steps the last physics step took (1 except for kSubsteppedSymplectic) and CG iterations.
   int last_substeps() const { return last_substeps_; }
@@ -138,6 +139,8 @@ class MassSpringTissue {
   void check_finite();
   std::uint64_t topology_hash() const;
   void note_non_finite(std::size_t node);
+  /// Adds a step's largest node displacement to travel_m_, with room for the positions' rounding.
+  void add_travel(double largest_step_m);
 
   TissueParameters parameters_;
   TissueConfig config_;

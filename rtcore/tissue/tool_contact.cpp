@@ -360,7 +360,7 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
   std::int32_t penetrating = 0;
   std::int64_t skipped = 0;
   const double inverse_h = 1.0 / h_s;
-  // Candidates in the order update_candidates stored them: the force sums are the same every run.
+  // Candidates in the order search_candidates stored them: the force sums are the same every run.
   // A tissue node is tested in the tool's frame, where the tool's triangles stand still: only the
   // node's own motion there can close its clearance.
   for (std::size_t i = 0; i < node_count_; ++i) {

@@ -3,6 +3,7 @@
 // as testing every candidate point at every step, however fast the loop moves.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 #include <vector>
 
@@ -67,6 +68,30 @@ TEST(ClearanceCertificates, SkipMostPointsOfAHeldIndentation) {
   const double skipped = static_cast<double>(tissue.tool().points_skipped());
   EXPECT_GT(tissue.tool().stats().penetrating, 0) << "the loop is in the tissue";
   EXPECT_GT(skipped / (evaluated + skipped), 0.5) << evaluated << " evaluated, " << skipped << " skipped";
+}
+
+TEST(ClearanceCertificates, TissueTravelBoundsEveryNodesDisplacement) {
+  // The vertex certificates trust travel_m() to bound how far any face corner moved: it must never
+  // fall behind a node's actual displacement, and stays zero while nothing moves.
+  const ProstateTissueModel& model = tissue_model(1296);
+  MassSpringTissue tissue(model.mesh);
+  const int part = tissue.tool().add_part(model.loop);
+  tissue.tool().reset_pose(part, indentation_loop_pose(model.anatomy, model.loop, -0.002));
+  for (int tick = 0; tick < 64; ++tick) {
+    if (tick % 16 == 0) tissue.collision_step();
+    (void)tissue.physics_step(1.0 / 960.0);
+  }
+  EXPECT_LT(tissue.travel_m(), 1e-12) << "the loop 2 mm clear: nothing moved but the rounding allowance";
+  double pressed = 0.0;
+  for (int tick = 64; tick < 960; ++tick) {
+    if (tick % 16 == 0) tissue.collision_step();
+    const double depth = 0.004 * std::min(1.0, (tick - 64) / 300.0) - 0.002 * std::max(0.0, (tick - 600) / 180.0);
+    tissue.tool().set_pose(part, indentation_loop_pose(model.anatomy, model.loop, depth));
+    (void)tissue.physics_step(1.0 / 960.0);
+    ASSERT_GE(tissue.travel_m(), tissue.max_displacement_m()) << "tick " << tick;
+    pressed = std::max(pressed, tissue.max_displacement_m());
+  }
+  EXPECT_GT(pressed, 0.001) << "the loop pressed in";
 }
 
 TEST(ClearanceCertificate, HoldsOnlyWhileTheMotionCannotCloseTheGap) {
