@@ -124,6 +124,18 @@ BENCHMARK(BM_PhysicsStep)
     ->MinTime(1.0);
 BENCHMARK(BM_CollisionStep)->Arg(1296)->Arg(8640)->Arg(34560)->Arg(138240)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 
+/// A live parameter change at a tick boundary (an instructor dragging a slider sends one a frame): what
+/// it adds to the tick it lands in, on the pressed 8640 model.
+void BM_ParameterChange(benchmark::State& state) {
+  auto tissue = pressed_tissue(static_cast<int>(state.range(0)), {}, {});
+  double stiffness_kpa = 40.0;
+  for (auto _ : state) {
+    stiffness_kpa = stiffness_kpa == 40.0 ? 41.0 : 40.0;
+    tissue->apply({0, TissueParameter::kStiffness, stiffness_kpa});
+  }
+}
+BENCHMARK(BM_ParameterChange)->Arg(8640)->Unit(benchmark::kMicrosecond)->MinTime(0.5);
+
 /// What the locality numbering buys: the physics step with the nodes in the mesh's (TetGen's) order
 /// and in locality order, at 8640 and 34560 triangles. Run with --benchmark_repetitions and
 /// --benchmark_enable_random_interleaving so both orders see the same machine.
