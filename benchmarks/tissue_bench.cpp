@@ -61,13 +61,11 @@ struct Row {
   std::size_t nodes = 0, springs = 0, contacts = 0;
   std::vector<double> physics_us, collision_us;
 };
-std::map<int, Row>& rows() {
-  static std::map<int, Row> r;
-  return r;
-}
-std::map<int, Row>& brute_force_rows() {
-  static std::map<int, Row> r;
-  return r;
+/// The rows of the tables, by triangle count; `brute_force`: the physics step with every candidate
+/// point tested every step.
+std::map<int, Row>& rows(bool brute_force = false) {
+  static std::map<int, Row> r[2];
+  return r[brute_force ? 1 : 0];
 }
 
 /// The physics step as the core runs it: a collision step (untimed) publishes fresh candidates every
@@ -78,7 +76,7 @@ void BM_PhysicsStep(benchmark::State& state) {
   const bool skipping = state.range(1) != 0;
   auto tissue = pressed_tissue(triangles, {}, {});
   tissue->tool().set_clearance_skipping(skipping);
-  Row& row = skipping ? rows()[triangles] : brute_force_rows()[triangles];
+  Row& row = rows(!skipping)[triangles];
   row.nodes = tissue->node_count();
   row.springs = tissue->network().spring_count();
   row.contacts = static_cast<std::size_t>(tissue->tool().stats().pair_entries);
@@ -205,8 +203,8 @@ int main(int argc, char** argv) {
   std::printf("\nphysics step, contact by clearance certificates against brute force (every candidate point every step):\n");
   std::printf("%10s | %18s %18s | %8s\n", "triangles", "certificates us", "brute force us", "speed-up");
   for (const auto& [triangles, row] : resecto::rows()) {
-    const auto other = resecto::brute_force_rows().find(triangles);
-    if (other == resecto::brute_force_rows().end() || other->second.physics_us.empty() || row.physics_us.empty()) continue;
+    const auto other = resecto::rows(true).find(triangles);
+    if (other == resecto::rows(true).end() || other->second.physics_us.empty() || row.physics_us.empty()) continue;
     const double fast = resecto::quantile(row.physics_us, 0.5), slow = resecto::quantile(other->second.physics_us, 0.5);
     std::printf("%10d | %18.1f %18.1f | %7.2fx\n", triangles, fast, slow, slow / fast);
   }

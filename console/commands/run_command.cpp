@@ -27,7 +27,7 @@ struct RunOptions {
   int substeps = 16;
   bool inline_collision = false;
   bool raw_input = false;
-  std::int64_t spin_us = 250;
+  std::int64_t spin_us = kDefaultRealtimeSpinUs;
   std::uint64_t seed = 1;
   std::string calibration;
   bool json = false;

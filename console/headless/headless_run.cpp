@@ -28,11 +28,6 @@ namespace {
 
 using nlohmann::ordered_json;
 
-// Real-time priorities (1..99): above every normal thread, below the kernel's threaded interrupt
-// handlers (FIFO 50 on PREEMPT_RT kernels), which carry the device's USB reports; the core first.
-constexpr int kCoreFifoPriority = 45;
-constexpr int kCollisionFifoPriority = 40;
-
 /// Takes the core's snapshots on its own thread, as the console will; optionally slow on purpose.
 class SnapshotConsumer {
  public:

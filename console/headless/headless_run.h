@@ -12,6 +12,7 @@
 
 #include "device/calibration/calibration.h"
 #include "rtcore/base/result.h"
+#include "rtcore/core/fixed_step_scheduler.h"
 #include "rtcore/core/simulation.h"
 #include "rtcore/scenes/procedure.h"
 
@@ -25,7 +26,7 @@ struct HeadlessOptions {
   std::uint64_t seed = 1;        ///< the emulator's sensor noise
   std::string trace_path;        ///< empty: no trace
   double consumer_delay_ms = 0;  ///< makes the snapshot consumer slow on purpose (tests)
-  std::int64_t spin_us = 250;    ///< real time: spin this long before each tick instead of sleeping
+  std::int64_t spin_us = kDefaultRealtimeSpinUs;  ///< real time: spin this long before each tick instead of sleeping
   /// The device's calibration: sensor conversion and the registration that places the gimbal in the
   /// world (it replaces `simulation.gimbal`).
   device::Calibration calibration = device::default_calibration();

@@ -11,6 +11,9 @@
 
 namespace resecto {
 
+/// How long a real-time run spins before each tick unless told otherwise (`resecto run --spin-us`).
+inline constexpr std::int64_t kDefaultRealtimeSpinUs = 250;
+
 struct SchedulerConfig {
   std::int64_t period_ns = 1'041'667;  ///< one tick (960 Hz by default)
   bool realtime = false;

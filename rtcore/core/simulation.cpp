@@ -70,9 +70,7 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
   Result<TetMesh> tetra = tetrahedralize(sim->prostate_.surface, tet);
   if (!tetra) return Error{"building the tissue model: " + tetra.error()};
   sim->tetrahedra_ = tetra->tetrahedron_count();
-  TissueConfig tissue;
-  tissue.clearance_certificates = config.clearance_certificates;
-  sim->tissue_ = std::make_unique<MassSpringTissue>(*tetra, config.parameters, tissue);
+  sim->tissue_ = std::make_unique<MassSpringTissue>(*tetra, config.parameters, config.tissue);
 
   const ResectoscopeModel tool = generate_resectoscope();
   sim->sheath_part_ = sim->tissue_->tool().add_part(tool.sheath);

@@ -38,9 +38,8 @@ struct SimulationConfig {
   /// Searches for contact candidates around the tool's extrapolated pose in the middle of the
   /// window the candidates serve, rather than where it is at the search (Simulation::step).
   bool predict_search_pose = true;
-  /// Lets the tissue's contact skip points proven clear of the tool (TissueConfig); off only for the
-  /// brute-force reference, which gives the same state.
-  bool clearance_certificates = true;
+  /// The tissue's fixed choices: integrator, contact margin and capacities, clearance certificates.
+  TissueConfig tissue;
 
   double tick_s() const { return 1.0 / (static_cast<double>(collision_hz) * physics_per_collision); }
   /// The tick rates as a user would write them, or an error naming the bad value.

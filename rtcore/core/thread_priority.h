@@ -10,6 +10,12 @@
 
 namespace resecto {
 
+/// A real-time run's priorities (1..99): above every normal thread, below the kernel's threaded
+/// interrupt handlers (FIFO 50 on PREEMPT_RT kernels), which carry the device's USB reports; the
+/// core first, the collision thread (which has a whole collision period) next.
+inline constexpr int kCoreFifoPriority = 45;
+inline constexpr int kCollisionFifoPriority = 40;
+
 /// Puts `thread` under SCHED_FIFO at `priority` (1..99); false (nothing changed) if not permitted.
 bool raise_to_fifo(pthread_t thread, int priority);
 /// Back to the default time-sharing policy.

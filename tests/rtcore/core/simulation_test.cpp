@@ -73,7 +73,7 @@ TEST(Simulation, ClearanceCertificatesGiveTheBruteForceState) {
   // Both tool parts, rolling, inserting and swinging into a lobe: skipping the points proven clear
   // of the tool changes no bit of the state.
   SimulationConfig brute_force = small_config();
-  brute_force.clearance_certificates = false;
+  brute_force.tissue.clearance_certificates = false;
   const auto a = run_hashes(small_config(), 3 * 960);
   const auto b = run_hashes(brute_force, 3 * 960);
   ASSERT_EQ(a.size(), 180u);

@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <map>
 
 #include "rtcore/base/units.h"
 #include "rtcore/anatomy/resectoscope.h"

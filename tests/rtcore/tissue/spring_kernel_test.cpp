@@ -12,6 +12,7 @@
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/tissue/indentation.h"
 #include "rtcore/tissue/spring_forces.h"
+#include "tests/support/tissue_models.h"
 
 namespace resecto {
 namespace {
@@ -23,14 +24,13 @@ bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
 
 TEST(SpringKernel, Avx2PathMatchesThePortablePathBitForBit) {
   if (!cpu_has_avx2()) GTEST_SKIP() << "no AVX2 on this processor: only the portable path runs";
-  Result<ProstateTissueModel> model = build_prostate_tissue_model(generate_prostate(1296), generate_resectoscope().loop);
-  ASSERT_TRUE(model) << model.error();
-  const SpringNetwork network = build_spring_network(model->mesh);
+  const ProstateTissueModel& model = tissue_model(1296);
+  const SpringNetwork network = build_spring_network(model.mesh);
   SpringForces forces(network);
   std::mt19937_64 random(7);
   std::uniform_real_distribution<double> jitter(-1e-3, 1e-3), speed(-0.05, 0.05), stiffness(0.1, 500.0);
   for (std::size_t s = 0; s < forces.spring_count(); ++s) forces.set_material(s, stiffness(random), 1e-3 * stiffness(random));
-  std::vector<Vec3> x = model->mesh.positions, v(x.size());
+  std::vector<Vec3> x = model.mesh.positions, v(x.size());
   for (std::size_t n = 0; n < x.size(); ++n) {
     x[n] += Vec3(jitter(random), jitter(random), jitter(random));
     v[n] = Vec3(speed(random), speed(random), speed(random));
@@ -74,12 +74,11 @@ TEST(SpringKernel, Avx2PathMatchesThePortablePathBitForBit) {
 
 TEST(SpringKernel, NodeSumsAddEachSpringOnceWithOppositeSigns) {
   // A brute-force oracle: scatter every spring's force to its two nodes in spring order.
-  Result<ProstateTissueModel> model = build_prostate_tissue_model(generate_prostate(1296), generate_resectoscope().loop);
-  ASSERT_TRUE(model) << model.error();
-  const SpringNetwork network = build_spring_network(model->mesh);
+  const ProstateTissueModel& model = tissue_model(1296);
+  const SpringNetwork network = build_spring_network(model.mesh);
   SpringForces forces(network);
   for (std::size_t s = 0; s < forces.spring_count(); ++s) forces.set_material(s, 1.0 + static_cast<double>(s % 13), 1e-3);
-  std::vector<Vec3> x = model->mesh.positions, v(x.size(), Vec3(0.0));
+  std::vector<Vec3> x = model.mesh.positions, v(x.size(), Vec3(0.0));
   for (std::size_t n = 0; n < x.size(); ++n) x[n] *= 1.0 + 1e-3 * static_cast<double>(n % 5);
   forces.compute(x.data(), v.data());
   std::vector<Vec3> summed(x.size(), Vec3(0.0)), scattered(x.size(), Vec3(0.0));
