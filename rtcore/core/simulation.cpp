@@ -241,14 +241,24 @@ void Simulation::fill_snapshot(SimulationSnapshot& snapshot) const {
   snapshot.tool = placed_.poses;
   snapshot.reaction = reaction_;
   snapshot.penetrating_points = tissue_->tool().stats().penetrating;
-  // The surface's vertices are the tetrahedral mesh's first nodes (TetGen -Y keeps them in order).
-  tissue_->copy_mesh_positions(snapshot.surface_positions);
+  const std::size_t nodes = std::min(snapshot.node_positions.size(), tissue_->node_count());
+  tissue_->copy_mesh_positions(std::span<Vec3>(snapshot.node_positions.data(), nodes));
+  snapshot.node_count = static_cast<std::uint32_t>(nodes);
+  // The tissue's surface is in its own (locality) numbering; the snapshot speaks mesh ids.
+  const std::vector<Triangle>& faces = tissue_->surface().triangles;
+  const std::size_t count = std::min(snapshot.surface_triangles.size(), faces.size());
+  for (std::size_t f = 0; f < count; ++f) {
+    for (int c = 0; c < 3; ++c) snapshot.surface_triangles[f][c] = tissue_->mesh_node(faces[f][c]);
+  }
+  snapshot.surface_triangle_count = static_cast<std::uint32_t>(count);
+  snapshot.topology_version = 0;  // the surface never changes until resection
   snapshot.metrics = metrics_;
 }
 
 SimulationSnapshot Simulation::make_snapshot() const {
   SimulationSnapshot snapshot;
-  snapshot.surface_positions.resize(prostate_.surface.vertex_count());
+  snapshot.node_positions.resize(tissue_->node_count());
+  snapshot.surface_triangles.resize(tissue_->surface().triangles.size());
   fill_snapshot(snapshot);
   return snapshot;
 }

@@ -79,7 +79,17 @@ struct SimulationSnapshot {
   ToolPoses tool;
   ToolReaction reaction;
   std::int32_t penetrating_points = 0;
-  std::vector<Vec3> surface_positions;  ///< the tissue surface's vertices (sized once)
+  /// Positions of the tissue's nodes by mesh id, valid in [0, node_count): the surface's vertices
+  /// and the inner nodes resection may expose. Sized once by make_snapshot(), never reallocated.
+  std::vector<Vec3> node_positions;
+  std::uint32_t node_count = 0;
+  /// The tissue's current boundary over node ids (outward), valid in [0, surface_triangle_count).
+  /// Sized once to the surface's capacity.
+  std::vector<Triangle> surface_triangles;
+  std::uint32_t surface_triangle_count = 0;
+  /// Changes whenever surface_triangles change; equal versions mean equal connectivity, so a reader
+  /// copies or encodes the connectivity only when it moved.
+  std::uint64_t topology_version = 0;
   ProcedureMetrics metrics;
 };
 
