@@ -3,13 +3,13 @@
 
 #include <sched.h>
 
-#include <algorithm>
-
 namespace resecto {
 
 bool raise_to_fifo(pthread_t thread, int priority) {
+  // Out of range is a caller's mistake to report, not to round to the nearest priority.
+  if (priority < sched_get_priority_min(SCHED_FIFO) || priority > sched_get_priority_max(SCHED_FIFO)) return false;
   sched_param parameters{};
-  parameters.sched_priority = std::clamp(priority, sched_get_priority_min(SCHED_FIFO), sched_get_priority_max(SCHED_FIFO));
+  parameters.sched_priority = priority;
   return pthread_setschedparam(thread, SCHED_FIFO, &parameters) == 0;
 }
 
