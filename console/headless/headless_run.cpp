@@ -180,9 +180,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
         }
       }
       tool_input.latch(samples, tick_s);
-      input.joints = tool_input.joints();
-      input.pedals = tool_input.pedals();
-      input.tool_present = tool_input.state() != ToolInputState::kNoDevice;
+      input = tool_input.tick_input();
     }
     sim.step(input, {}, &profiler);
     if (sim.is_collision_tick(tick)) {
