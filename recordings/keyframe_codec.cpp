@@ -21,7 +21,7 @@ QuantisationGrid grid_for_bounds(const Vec3& lo, const Vec3& hi, int bits, doubl
 }
 
 Status encode_keyframe(std::span<const Vec3> node_positions, std::span<const Triangle> triangles, const QuantisationGrid& grid,
-                       const KeyframeCodecSettings& settings, std::vector<std::uint8_t>& out) {
+                       const KeyframeCodecSettings& settings, bool with_node_ids, std::vector<std::uint8_t>& out) {
   // Vertices: the nodes the surface uses, in increasing id order (a deterministic numbering).
   std::vector<std::uint32_t> vertex_of(node_positions.size(), UINT32_MAX);
   for (const Triangle& t : triangles) {
@@ -43,14 +43,17 @@ Status encode_keyframe(std::span<const Vec3> node_positions, std::span<const Tri
   draco::GeometryAttribute position;
   position.Init(draco::GeometryAttribute::POSITION, nullptr, 3, draco::DT_FLOAT32, false, sizeof(float) * 3, 0);
   const int position_id = mesh.AddAttribute(position, true, static_cast<std::uint32_t>(ids.size()));
-  draco::GeometryAttribute node_id;
-  node_id.Init(draco::GeometryAttribute::GENERIC, nullptr, 1, draco::DT_UINT32, false, sizeof(std::uint32_t), 0);
-  const int id_attribute = mesh.AddAttribute(node_id, true, static_cast<std::uint32_t>(ids.size()));
+  int id_attribute = -1;
+  if (with_node_ids) {
+    draco::GeometryAttribute node_id;
+    node_id.Init(draco::GeometryAttribute::GENERIC, nullptr, 1, draco::DT_UINT32, false, sizeof(std::uint32_t), 0);
+    id_attribute = mesh.AddAttribute(node_id, true, static_cast<std::uint32_t>(ids.size()));
+  }
   for (std::uint32_t v = 0; v < ids.size(); ++v) {
     const Vec3& p = node_positions[ids[v]];
     const float xyz[3] = {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)};
     mesh.attribute(position_id)->SetAttributeValue(draco::AttributeValueIndex(v), xyz);
-    mesh.attribute(id_attribute)->SetAttributeValue(draco::AttributeValueIndex(v), &ids[v]);
+    if (id_attribute >= 0) mesh.attribute(id_attribute)->SetAttributeValue(draco::AttributeValueIndex(v), &ids[v]);
   }
   mesh.SetNumFaces(triangles.size());
   for (std::size_t f = 0; f < triangles.size(); ++f) {
@@ -80,20 +83,20 @@ Result<SurfaceFrame> decode_keyframe(std::span<const std::uint8_t> draco_bytes) 
   const draco::PointAttribute* position = mesh->GetNamedAttribute(draco::GeometryAttribute::POSITION);
   const draco::PointAttribute* ids = mesh->GetNamedAttribute(draco::GeometryAttribute::GENERIC);
   if (!position || position->num_components() != 3) return Error{"keyframe: no 3D positions"};
-  if (!ids || ids->num_components() != 1) return Error{"keyframe: no node ids"};
+  if (ids && ids->num_components() != 1) return Error{"keyframe: malformed node ids"};
   SurfaceFrame frame;
   const std::uint32_t points = mesh->num_points();
   frame.positions.resize(points);
-  frame.node_ids.resize(points);
+  if (ids) frame.node_ids.resize(points);
   for (std::uint32_t i = 0; i < points; ++i) {
     float xyz[3] = {0, 0, 0};
     std::uint32_t id = 0;
     if (!position->ConvertValue<float, 3>(position->mapped_index(draco::PointIndex(i)), xyz) ||
-        !ids->ConvertValue<std::uint32_t, 1>(ids->mapped_index(draco::PointIndex(i)), &id)) {
+        (ids && !ids->ConvertValue<std::uint32_t, 1>(ids->mapped_index(draco::PointIndex(i)), &id))) {
       return Error{"keyframe: unreadable vertex " + std::to_string(i)};
     }
     frame.positions[i] = Vec3(xyz[0], xyz[1], xyz[2]);
-    frame.node_ids[i] = id;
+    if (ids) frame.node_ids[i] = id;
   }
   frame.triangles.resize(mesh->num_faces());
   for (std::uint32_t f = 0; f < mesh->num_faces(); ++f) {

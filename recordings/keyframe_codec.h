@@ -19,7 +19,7 @@ namespace resecto::rec {
 struct QuantisationGrid {
   float origin[3] = {0.0f, 0.0f, 0.0f};
   float range = 1.0f;
-  int bits = 14;
+  int bits = 11;
   double step_m() const { return static_cast<double>(range) / static_cast<double>((1u << bits) - 1u); }
 };
 
@@ -27,10 +27,11 @@ struct QuantisationGrid {
 /// resection exposes inner nodes, all inside the capsule's reach).
 QuantisationGrid grid_for_bounds(const Vec3& lo, const Vec3& hi, int bits, double margin_m);
 
-/// Draco's knobs, chosen by recording_bench (README "Recordings: codec settings").
+/// Draco's knobs, chosen by recording_bench (recordings/README.md "Codec settings"): speed 3 is
+/// within 10% of the smallest (speed 0) at half its encode and decode time.
 struct KeyframeCodecSettings {
-  int encode_speed = 5;         ///< 0 (smallest) .. 10 (fastest)
-  int decode_speed = 5;
+  int encode_speed = 3;         ///< 0 (smallest) .. 10 (fastest)
+  int decode_speed = 3;
   bool edgebreaker = true;      ///< else Draco's sequential connectivity
 };
 
@@ -42,11 +43,15 @@ struct SurfaceFrame {
 };
 
 /// Encodes the surface `triangles` (over node ids) with the positions `node_positions` (by node id)
-/// into `out`. Only the nodes the triangles use become vertices, in increasing id order.
+/// into `out`. Only the nodes the triangles use become vertices, in increasing id order. The
+/// recorder always keeps the node ids (`with_node_ids`): leaving them out saves ~7% of a keyframe,
+/// but Draco's vertex order then differs from the order with them, so they cannot be borrowed
+/// from another keyframe (measured: recordings/README.md).
 Status encode_keyframe(std::span<const Vec3> node_positions, std::span<const Triangle> triangles, const QuantisationGrid& grid,
-                       const KeyframeCodecSettings& settings, std::vector<std::uint8_t>& out);
+                       const KeyframeCodecSettings& settings, bool with_node_ids, std::vector<std::uint8_t>& out);
 
-/// Decodes a keyframe's Draco bytes; an error for anything Draco rejects or a mesh without node ids.
+/// Decodes a keyframe's Draco bytes (node_ids empty when the keyframe carries none); an error for
+/// anything Draco rejects.
 Result<SurfaceFrame> decode_keyframe(std::span<const std::uint8_t> draco_bytes);
 
 }  // namespace resecto::rec

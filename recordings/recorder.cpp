@@ -61,10 +61,12 @@ Recorder::~Recorder() {
 }
 
 void Recorder::record_tick(std::uint64_t tick, const TickInput& input, std::span<const ParameterCommand> commands) {
-  if (!ticks_.try_push(TickRecord{tick, input})) ticks_lost_.fetch_add(1, std::memory_order_relaxed);
+  // Commands first: the recorder thread then always holds a tick's commands before the tick, and
+  // writes them out first (write_ticks), so no prefix of the file has a tick without its commands.
   for (const ParameterCommand& c : commands) {
     if (!commands_.try_push(c)) commands_lost_.fetch_add(1, std::memory_order_relaxed);
   }
+  if (!ticks_.try_push(TickRecord{tick, input})) ticks_lost_.fetch_add(1, std::memory_order_relaxed);
 }
 
 void Recorder::record_step(const Simulation& sim) {
@@ -97,6 +99,7 @@ void Recorder::note_error(const Status& status) {
 
 void Recorder::write_ticks() {
   if (pending_ticks_.empty()) return;
+  write_commands();
   // A lost tick breaks the run of consecutive ticks a block holds: split there.
   std::size_t begin = 0;
   for (std::size_t i = 1; i <= pending_ticks_.size(); ++i) {
@@ -132,9 +135,12 @@ void Recorder::write_commands() {
 
 void Recorder::write_keyframe(int slot) {
   const SimulationSnapshot& s = keyframe_pool_[static_cast<std::size_t>(slot)];
+  const bool topology_changed = s.topology_version != last_topology_version_;
+  const bool with_ids = true;  // every keyframe self-contained (see encode_keyframe)
   const auto begin = std::chrono::steady_clock::now();
   const Status encoded = encode_keyframe(std::span(s.node_positions.data(), s.node_count),
-                                         std::span(s.surface_triangles.data(), s.surface_triangle_count), header_.grid, settings_.codec, draco_);
+                                         std::span(s.surface_triangles.data(), s.surface_triangle_count), header_.grid, settings_.codec,
+                                         with_ids, draco_);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin).count();
   if (!encoded) {
     note_error(encoded);
@@ -143,7 +149,8 @@ void Recorder::write_keyframe(int slot) {
   KeyframeRecord k;
   k.tick = s.tick - 1;  // the collision tick that produced it (s.tick counts the ticks run)
   k.topology_version = s.topology_version;
-  k.topology_changed = s.topology_version != last_topology_version_;
+  k.topology_changed = topology_changed;
+  k.has_node_ids = with_ids;
   last_topology_version_ = s.topology_version;
   k.triangle_count = s.surface_triangle_count;
   // The vertices are the nodes the triangles use.
@@ -164,16 +171,17 @@ void Recorder::write_keyframe(int slot) {
 
 bool Recorder::drain() {
   bool took = false;
+  // Commands before ticks: a command popped here was pushed before any tick popped below.
+  ParameterCommand command;
+  while (commands_.try_pop(command)) {
+    pending_commands_.push_back(command);
+    took = true;
+  }
   TickRecord tick;
   while (ticks_.try_pop(tick)) {
     pending_ticks_.push_back(tick);
     took = true;
     if (pending_ticks_.size() >= settings_.ticks_per_chunk) write_ticks();
-  }
-  ParameterCommand command;
-  while (commands_.try_pop(command)) {
-    pending_commands_.push_back(command);
-    took = true;
   }
   StepRecord step;
   while (steps_.try_pop(step)) {
@@ -202,9 +210,9 @@ void Recorder::run() {
     if (stopping || now - last_flush >= flush_every) {
       // Everything held so far goes out, partial blocks included: the file on disk is then at most
       // one flush interval behind the core.
+      write_commands();
       write_ticks();
       write_steps();
-      write_commands();
       note_error(writer_.flush());
       last_flush = now;
       if (now - last_sync >= std::chrono::seconds(1)) {

@@ -27,7 +27,7 @@ struct RecorderSettings {
   std::size_t command_ring = 1024;
   int keyframe_slots = 8;               ///< snapshots waiting for the encoder
   int keyframe_every_steps = 6;         ///< 60 Hz collision steps / 6 = 10 Hz keyframes
-  int quantisation_bits = 14;
+  int quantisation_bits = 11;           ///< 33 um steps over the 8640 gland's 68 mm grid
   KeyframeCodecSettings codec;
   std::uint32_t ticks_per_chunk = 480;  ///< half a second at 960 Hz
   std::uint32_t steps_per_chunk = 30;

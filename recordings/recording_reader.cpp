@@ -60,7 +60,7 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
           r.content_errors_.push_back(where + ": " + k.error());
           break;
         }
-        r.keyframes_.push_back({k->tick, 0.0, k->topology_version, k->topology_changed, k->vertex_count, k->triangle_count,
+        r.keyframes_.push_back({k->tick, 0.0, k->topology_version, k->topology_changed, k->has_node_ids, k->vertex_count, k->triangle_count,
                                 static_cast<std::uint32_t>(k->draco.size()), c});
         break;
       }
@@ -120,9 +120,11 @@ std::span<const std::uint8_t> Recording::keyframe_draco(std::size_t k) const {
 Result<SurfaceFrame> Recording::decode_keyframe(std::size_t k) const {
   if (k >= keyframes_.size()) return Error{"keyframe " + std::to_string(k) + " does not exist (" + std::to_string(keyframes_.size()) + " recorded)"};
   Result<SurfaceFrame> frame = rec::decode_keyframe(keyframe_draco(k));
-  if (frame && (frame->positions.size() != keyframes_[k].vertex_count || frame->triangles.size() != keyframes_[k].triangle_count)) {
+  if (!frame) return Error{"keyframe " + std::to_string(k) + ": " + frame.error()};
+  if (frame->positions.size() != keyframes_[k].vertex_count || frame->triangles.size() != keyframes_[k].triangle_count) {
     return Error{"keyframe " + std::to_string(k) + ": decoded counts differ from the recorded ones"};
   }
+  if (frame->node_ids.empty()) return Error{"keyframe " + std::to_string(k) + ": carries no node ids"};
   return frame;
 }
 

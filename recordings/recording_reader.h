@@ -2,7 +2,7 @@
 // uses this API; see recordings/README.md). Opening reads the file, scans every chunk (a file with
 // no index, cut or killed, reads the same way as a closed one: every whole chunk is kept, a damaged
 // chunk is lost alone), parses the header and decodes the ticks, steps and commands. Keyframes are
-// indexed at open and decoded on demand.
+// indexed at open and decoded on demand. A Recording is immutable once open.
 #pragma once
 
 #include <array>
@@ -28,6 +28,7 @@ struct KeyframeInfo {
   double time_s = 0.0;           ///< (tick + 1) * tick_s: simulated time of that state
   std::uint64_t topology_version = 0;
   bool topology_changed = false;
+  bool has_node_ids = false;     ///< always, from this recorder
   std::uint32_t vertex_count = 0;
   std::uint32_t triangle_count = 0;
   std::uint32_t draco_bytes = 0;
@@ -59,7 +60,7 @@ class Recording {
   std::span<const KeyframeInfo> keyframes() const { return keyframes_; }
   /// The keyframe nearest before or at `time_s` (none before the first).
   std::optional<std::size_t> keyframe_at_time(double time_s) const;
-  /// Decodes keyframe `k` to positions (with node ids) and triangles.
+  /// Decodes keyframe `k` to positions (with their node ids) and triangles over the positions.
   Result<SurfaceFrame> decode_keyframe(std::size_t k) const;
   /// The keyframe's Draco bytes as stored (a valid .drc file).
   std::span<const std::uint8_t> keyframe_draco(std::size_t k) const;

@@ -40,6 +40,17 @@ Result<std::vector<IndexEntry>> decode_index(std::span<const std::uint8_t> paylo
   return entries;
 }
 
+void append_index_and_trailer(std::vector<std::uint8_t>& out, std::uint64_t out_offset, std::span<const IndexEntry> entries,
+                              std::uint32_t sequence) {
+  std::vector<std::uint8_t> payload;
+  encode_index(entries, payload);
+  const std::uint64_t index_at = out_offset + out.size();
+  append_chunk(out, ChunkType::kIndex, sequence, payload);
+  ByteWriter w(out);
+  w.put(index_at);
+  w.put_bytes(kTrailerMagic);
+}
+
 RecordingWriter::~RecordingWriter() {
   if (fd_ >= 0) ::close(fd_);
 }
@@ -80,13 +91,7 @@ Status RecordingWriter::sync() {
 
 Status RecordingWriter::close() {
   if (fd_ < 0) return Ok{};
-  std::vector<std::uint8_t> payload;
-  encode_index(index_, payload);
-  const std::uint64_t index_at = bytes_written();
-  append_chunk(pending_, ChunkType::kIndex, next_sequence_++, payload);
-  ByteWriter w(pending_);
-  w.put(index_at);
-  w.put_bytes(kTrailerMagic);
+  append_index_and_trailer(pending_, file_offset_, index_, next_sequence_++);
   Status synced = sync();
   ::close(fd_);
   fd_ = -1;

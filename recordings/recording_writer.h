@@ -28,6 +28,11 @@ struct IndexEntry {
 void encode_index(std::span<const IndexEntry> entries, std::vector<std::uint8_t>& payload);
 Result<std::vector<IndexEntry>> decode_index(std::span<const std::uint8_t> payload);
 
+/// Appends the index chunk (listing `entries`) and the trailer to `out`, whose first byte is at file
+/// offset `out_offset`.
+void append_index_and_trailer(std::vector<std::uint8_t>& out, std::uint64_t out_offset, std::span<const IndexEntry> entries,
+                              std::uint32_t sequence);
+
 class RecordingWriter {
  public:
   RecordingWriter() = default;

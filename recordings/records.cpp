@@ -11,7 +11,13 @@
 namespace resecto::rec {
 namespace {
 
-/// Rows of `columns` 64-bit words -> XOR with the previous row, byte planes, deflate.
+/// A signed difference with its sign in the low bit, so small steps either way have zero high bytes.
+std::uint64_t zigzag(std::uint64_t difference) { return (difference << 1) ^ (0 - (difference >> 63)); }
+std::uint64_t unzigzag(std::uint64_t z) { return (z >> 1) ^ (0 - (z & 1)); }
+
+/// Rows of `columns` 64-bit words -> difference from the previous row (as integers: for doubles of
+/// one sign and exponent that is proportional to the value's change), zigzagged, split into byte
+/// planes, deflated.
 void put_columns(ByteWriter& w, std::span<const std::uint64_t> words, std::uint32_t rows, std::uint32_t columns) {
   std::vector<std::uint8_t> planes(words.size() * 8);
   const std::size_t n = rows;
@@ -19,14 +25,14 @@ void put_columns(ByteWriter& w, std::span<const std::uint64_t> words, std::uint3
     std::uint64_t previous = 0;
     for (std::uint32_t r = 0; r < rows; ++r) {
       const std::uint64_t word = words[static_cast<std::size_t>(r) * columns + c];
-      const std::uint64_t delta = word ^ previous;
+      const std::uint64_t delta = zigzag(word - previous);
       previous = word;
       for (int b = 0; b < 8; ++b) planes[(static_cast<std::size_t>(c) * 8 + static_cast<std::size_t>(b)) * n + r] = static_cast<std::uint8_t>(delta >> (8 * b));
     }
   }
   uLongf packed_bytes = compressBound(static_cast<uLong>(planes.size()));
   std::vector<std::uint8_t> packed(packed_bytes);
-  compress2(packed.data(), &packed_bytes, planes.data(), static_cast<uLong>(planes.size()), 6);
+  compress2(packed.data(), &packed_bytes, planes.data(), static_cast<uLong>(planes.size()), 9);
   w.put(rows);
   w.put(columns);
   w.put(static_cast<std::uint32_t>(packed_bytes));
@@ -57,7 +63,7 @@ Result<std::vector<std::uint64_t>> get_columns(ByteReader& r, std::uint32_t expe
     for (std::uint32_t row = 0; row < rows; ++row) {
       std::uint64_t delta = 0;
       for (int b = 0; b < 8; ++b) delta |= std::uint64_t{planes[(static_cast<std::size_t>(c) * 8 + static_cast<std::size_t>(b)) * n + row]} << (8 * b);
-      previous ^= delta;
+      previous += unzigzag(delta);
       words[static_cast<std::size_t>(row) * columns + c] = previous;
     }
   }
@@ -184,7 +190,7 @@ void encode_keyframe_payload(const KeyframeRecord& k, std::vector<std::uint8_t>&
   ByteWriter w(payload);
   w.put(k.tick);
   w.put(k.topology_version);
-  w.put(static_cast<std::uint8_t>(k.topology_changed ? 1 : 0));
+  w.put(static_cast<std::uint8_t>((k.topology_changed ? 1 : 0) | (k.has_node_ids ? 2 : 0)));
   w.put(k.vertex_count);
   w.put(k.triangle_count);
   w.put_bytes(k.draco);
@@ -198,8 +204,9 @@ Result<KeyframeRecord> decode_keyframe_payload(std::span<const std::uint8_t> pay
   const auto changed = r.get<std::uint8_t>();
   k.vertex_count = r.get<std::uint32_t>();
   k.triangle_count = r.get<std::uint32_t>();
-  if (!r.ok() || changed > 1) return Error{"keyframe: bad fixed fields"};
-  k.topology_changed = changed == 1;
+  if (!r.ok() || changed > 3) return Error{"keyframe: bad fixed fields"};
+  k.topology_changed = (changed & 1) != 0;
+  k.has_node_ids = (changed & 2) != 0;
   k.draco = r.get_bytes(r.remaining());
   return k;
 }

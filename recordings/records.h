@@ -1,6 +1,6 @@
 // What the core hands the recorder, one record per tick and one per collision step, and the chunk
-// payloads they are packed into. Blocks are column-major (one column per field, each value XORed
-// with the one before it, then split into byte planes) and deflated: a slowly changing double
+// payloads they are packed into. Blocks are column-major (one column per field, each value's bits
+// minus the previous value's, then split into byte planes) and deflated: a slowly changing double
 // then costs a few bytes, and the doubles come back bit-exact, which replay needs.
 #pragma once
 
@@ -50,6 +50,7 @@ struct KeyframeRecord {
   std::uint64_t tick = 0;
   std::uint64_t topology_version = 0;
   bool topology_changed = false;  ///< connectivity differs from the previous keyframe's
+  bool has_node_ids = false;      ///< the Draco mesh carries the node-id attribute
   std::uint32_t vertex_count = 0;
   std::uint32_t triangle_count = 0;
   std::span<const std::uint8_t> draco;  ///< into the payload it was parsed from

@@ -51,16 +51,20 @@ std::uint64_t first_tick_of(std::uint16_t type, std::span<const std::uint8_t> pa
   }
 }
 
-Result<RecoverReport> recover(const Recording& recording, const std::filesystem::path& out) {
-  const std::filesystem::path temporary = out.string() + ".tmp";
-  RecordingWriter writer;
-  if (Status opened = writer.open(temporary); !opened) return Error{opened.error()};
-  RecoverReport report;
+std::vector<std::uint8_t> recovered_bytes(const Recording& recording, RecoverReport& report) {
+  report = {};
+  std::vector<std::uint8_t> out(std::begin(kFileSignature), std::end(kFileSignature));
+  std::vector<IndexEntry> index;
+  auto add = [&](ChunkType type, std::span<const std::uint8_t> payload, std::uint64_t first_tick) {
+    const auto sequence = static_cast<std::uint32_t>(index.size());
+    index.push_back({out.size(), static_cast<std::uint16_t>(type), sequence, first_tick, static_cast<std::uint32_t>(payload.size())});
+    append_chunk(out, type, sequence, payload);
+    ++report.chunks_kept;
+  };
   for (const ChunkLocation& chunk : recording.chunks()) {
     if (chunk.type == static_cast<std::uint16_t>(ChunkType::kIndex) || chunk.type == static_cast<std::uint16_t>(ChunkType::kSummary)) continue;
     const std::span<const std::uint8_t> payload = recording.payload(chunk);
-    writer.add_chunk(static_cast<ChunkType>(chunk.type), payload, first_tick_of(chunk.type, payload));
-    ++report.chunks_kept;
+    add(static_cast<ChunkType>(chunk.type), payload, first_tick_of(chunk.type, payload));
   }
   nlohmann::ordered_json summary = recording.summary().is_object() ? recording.summary() : nlohmann::ordered_json::object();
   summary["recovered"] = {{"chunks_kept", report.chunks_kept},
@@ -68,14 +72,17 @@ Result<RecoverReport> recover(const Recording& recording, const std::filesystem:
                           {"replayable_ticks", recording.replayable_ticks()},
                           {"index_was_present", recording.index_present()}};
   const std::string text = summary.dump();
-  writer.add_chunk(ChunkType::kSummary, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
-  ++report.chunks_kept;
-  if (Status closed = writer.close(); !closed) return Error{closed.error()};
-  std::error_code error;
-  std::filesystem::rename(temporary, out, error);
-  if (error) return Error{out.string() + ": cannot rename the temporary file: " + error.message()};
+  add(ChunkType::kSummary, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()), 0);
+  append_index_and_trailer(out, 0, index, static_cast<std::uint32_t>(index.size()));
   report.damaged_ranges = recording.damaged().size();
   report.replayable_ticks = recording.replayable_ticks();
+  return out;
+}
+
+Result<RecoverReport> recover(const Recording& recording, const std::filesystem::path& out) {
+  RecoverReport report;
+  const std::vector<std::uint8_t> bytes = recovered_bytes(recording, report);
+  if (Status written = write_file_atomically(out, bytes); !written) return Error{written.error()};
   return report;
 }
 

@@ -17,9 +17,12 @@ struct RecoverReport {
   std::uint64_t replayable_ticks = 0;
 };
 
-/// Writes `out` (to a temporary file, then renamed) with every intact chunk of `recording` except
-/// its old index, renumbered, then a summary (the original's if it had one, noting the recovery)
-/// and a new index and trailer.
+/// A complete recording made of every intact chunk of `recording` except its old index and summary,
+/// renumbered, then a summary (the original's if it had one, noting the recovery), a new index and
+/// the trailer.
+std::vector<std::uint8_t> recovered_bytes(const Recording& recording, RecoverReport& report);
+
+/// recovered_bytes() written to `out` (through a temporary file, renamed).
 Result<RecoverReport> recover(const Recording& recording, const std::filesystem::path& out);
 
 /// Writes keyframe `k`: `.drc` as stored (Draco's own tools read it), or `.ply`, `.obj`, `.off`,
