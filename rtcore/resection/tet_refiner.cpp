@@ -36,6 +36,12 @@ constexpr int kEquators[3][4] = {{5, 6, 8, 7}, {4, 6, 9, 7}, {4, 5, 9, 8}};
 constexpr double kMinClosureDihedralDeg = 9.0;
 const double kMaxClosureDihedralCos = std::cos(kMinClosureDihedralDeg * std::numbers::pi / 180.0);
 
+constexpr std::uint32_t kNoNode = 0xffffffffu;
+/// slot_state_ bits: red, waiting in to_judge_, listed in touched_.
+constexpr std::uint8_t kRed = 1, kQueued = 2, kTouched = 4;
+/// slot_verdict_: the split-edge mask last judged (6 bits), whether it is known, and whether green.
+constexpr unsigned kVerdictMask = 0x3Fu, kVerdictKnown = 0x40u, kVerdictGreen = 0x80u;
+
 constexpr std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
   return a < b ? (std::uint64_t{a} << 32 | b) : (std::uint64_t{b} << 32 | a);
 }
@@ -52,14 +58,14 @@ constexpr std::array<int, 4> barycentric_x2(int p) {
   return w;
 }
 
-/// Sign of the child's volume relative to its parent's (the determinant of its barycentric rows).
-int orientation(const LocalTet& t) {
+/// Sign of the child's volume relative to its parent's: the sign of the determinant of its
+/// barycentric rows (child volume = det / 16 x parent volume).
+constexpr int orientation_of(const LocalTet& t) {
   std::array<std::array<long, 4>, 4> m{};
   for (int r = 0; r < 4; ++r) {
     const auto w = barycentric_x2(t[r]);
     for (int c = 0; c < 4; ++c) m[r][c] = w[c];
   }
-  // Laplace expansion along the first row over 3x3 minors.
   auto det3 = [&](int c0, int c1, int c2) {
     return m[1][c0] * (m[2][c1] * m[3][c2] - m[2][c2] * m[3][c1]) - m[1][c1] * (m[2][c0] * m[3][c2] - m[2][c2] * m[3][c0]) +
            m[1][c2] * (m[2][c0] * m[3][c1] - m[2][c1] * m[3][c0]);
@@ -68,9 +74,19 @@ int orientation(const LocalTet& t) {
   return (det > 0) - (det < 0);
 }
 
+/// orientation_of for every ordered quadruple of local points, indexed a * 1000 + b * 100 + c * 10 + d;
+/// filled once, on first use (too many steps for the compiler's constant evaluation).
+std::array<std::int8_t, 10000> make_orientation_table() {
+  std::array<std::int8_t, 10000> table{};
+  for (int i = 0; i < 10000; ++i) table[i] = static_cast<std::int8_t>(orientation_of({i / 1000, i / 100 % 10, i / 10 % 10, i % 10}));
+  return table;
+}
+
 LocalTet oriented(LocalTet t) {
-  if (orientation(t) < 0) std::swap(t[2], t[3]);
-  assert(orientation(t) > 0);
+  static const std::array<std::int8_t, 10000> kOrientation = make_orientation_table();
+  const int sign = kOrientation[t[0] * 1000 + t[1] * 100 + t[2] * 10 + t[3]];
+  assert(sign != 0);
+  if (sign < 0) std::swap(t[2], t[3]);
   return t;
 }
 
@@ -183,13 +199,23 @@ double max_dihedral_cos(const LocalGeometry& g, const LocalChildren& children) {
 
 TetRefiner::TetRefiner(std::size_t max_nodes, std::size_t max_tetrahedra) {
   slot_state_.assign(max_tetrahedra, 0);
-  node_on_split_.assign(max_nodes, 0);
-  // A typical plan touches a few hundred tetrahedra; larger plans grow these once and keep them.
+  slot_mask_.assign(max_tetrahedra, 0);
+  slot_verdict_.assign(max_tetrahedra, 0);
+  node_is_covered_.assign(max_nodes, 0);
+  node_covered_.assign(max_nodes, kNoNode);
+  // A typical plan touches a few hundred tetrahedra and looks at a few thousand; larger plans grow
+  // these once and keep them.
   constexpr std::size_t kTypicalSlots = 1024;
   red_slots_.reserve(kTypicalSlots);
   closure_slots_.reserve(kTypicalSlots);
+  touched_.reserve(4 * kTypicalSlots);
+  to_judge_.reserve(2 * kTypicalSlots);
+  candidates_.reserve(8 * kTypicalSlots);
+  covered_nodes_.reserve(2 * kTypicalSlots);
+  incidence_offsets_.reserve(2 * kTypicalSlots + 1);
+  incidence_cursor_.reserve(2 * kTypicalSlots);
+  incidence_.reserve(32 * kTypicalSlots);
   split_edges_.reserve(6 * kTypicalSlots);
-  new_edges_.reserve(6 * kTypicalSlots);
   edit_.new_node_parents.reserve(6 * kTypicalSlots);
   edit_.removed_tetrahedra.reserve(2 * kTypicalSlots);
   edit_.added_tetrahedra.reserve(8 * kTypicalSlots);
@@ -197,11 +223,86 @@ TetRefiner::TetRefiner(std::size_t max_nodes, std::size_t max_tetrahedra) {
   edit_.added_parent.reserve(8 * kTypicalSlots);
 }
 
+void TetRefiner::cover(std::uint32_t node) {
+  if (node_is_covered_[node]) return;
+  node_is_covered_[node] = 1;
+  node_covered_[node] = static_cast<std::uint32_t>(covered_nodes_.size());
+  covered_nodes_.push_back(node);
+}
+
+void TetRefiner::gather_candidates(const TetMeshView& mesh) {
+  // The one pass over every slot, kept lean (a byte per node, so the flags stay in cache): the live
+  // slots touching a covered node, ascending. Then, over those only, each covered node's slots,
+  // ascending (a counting sort).
+  candidates_.clear();
+  const std::uint8_t* covered = node_is_covered_.data();
+  for (std::uint32_t s = 0; s < mesh.tetrahedra.size(); ++s) {
+    const Tetrahedron& t = mesh.tetrahedra[s];
+    if ((covered[t[0]] | covered[t[1]] | covered[t[2]] | covered[t[3]]) && mesh.alive[s]) candidates_.push_back(s);
+  }
+  incidence_offsets_.assign(covered_nodes_.size() + 1, 0);
+  for (std::uint32_t s : candidates_) {
+    for (std::uint32_t n : mesh.tetrahedra[s]) {
+      if (covered[n]) ++incidence_offsets_[node_covered_[n] + 1];
+    }
+  }
+  for (std::size_t k = 1; k < incidence_offsets_.size(); ++k) incidence_offsets_[k] += incidence_offsets_[k - 1];
+  incidence_cursor_.assign(incidence_offsets_.begin(), incidence_offsets_.end() - 1);
+  incidence_.resize(incidence_offsets_.back());
+  for (std::uint32_t s : candidates_) {
+    for (std::uint32_t n : mesh.tetrahedra[s]) {
+      if (covered[n]) incidence_[incidence_cursor_[node_covered_[n]]++] = s;
+    }
+  }
+}
+
+void TetRefiner::split_around(const TetMeshView& mesh, std::uint32_t red_slot) {
+  const Tetrahedron& red = mesh.tetrahedra[red_slot];
+  for (const auto& edge : kTetEdges) {
+    const std::uint32_t a = red[edge[0]], b = red[edge[1]];
+    // The slots holding edge (a, b): the intersection of a's and b's ascending slot lists.
+    const std::uint32_t* x = incidence_.data() + incidence_offsets_[node_covered_[a]];
+    const std::uint32_t* x_end = incidence_.data() + incidence_offsets_[node_covered_[a] + 1];
+    const std::uint32_t* y = incidence_.data() + incidence_offsets_[node_covered_[b]];
+    const std::uint32_t* y_end = incidence_.data() + incidence_offsets_[node_covered_[b] + 1];
+    while (x != x_end && y != y_end) {
+      if (*x < *y) {
+        ++x;
+      } else if (*y < *x) {
+        ++y;
+      } else {
+        const std::uint32_t s = *x;
+        ++x, ++y;
+        if (slot_state_[s] & kRed) continue;
+        const Tetrahedron& tet = mesh.tetrahedra[s];
+        const int i = static_cast<int>(std::find(tet.begin(), tet.end(), a) - tet.begin());
+        const int j = static_cast<int>(std::find(tet.begin(), tet.end(), b) - tet.begin());
+        slot_mask_[s] |= static_cast<std::uint8_t>(1u << (kMidpoint[i][j] - 4));
+        if (!(slot_state_[s] & kTouched)) {
+          slot_state_[s] |= kTouched;
+          touched_.push_back(s);
+        }
+        if (!(slot_state_[s] & kQueued)) {
+          slot_state_[s] |= kQueued;
+          to_judge_.push_back(s);
+        }
+      }
+    }
+  }
+}
+
 const RefinementEdit& TetRefiner::plan(const TetMeshView& mesh, std::span<const std::uint32_t> marked) {
   const std::size_t slot_count = mesh.tetrahedra.size();
   const std::size_t node_count = mesh.rest_positions.size();
-  if (slot_state_.size() < slot_count) slot_state_.resize(slot_count, 0);
-  if (node_on_split_.size() < node_count) node_on_split_.resize(node_count, 0);
+  if (slot_state_.size() < slot_count) {
+    slot_state_.resize(slot_count, 0);
+    slot_mask_.resize(slot_count, 0);
+    slot_verdict_.resize(slot_count, 0);
+  }
+  if (node_covered_.size() < node_count) {
+    node_is_covered_.resize(node_count, 0);
+    node_covered_.resize(node_count, kNoNode);
+  }
 
   edit_.first_new_node = static_cast<std::uint32_t>(node_count);
   edit_.new_node_parents.clear();
@@ -209,73 +310,93 @@ const RefinementEdit& TetRefiner::plan(const TetMeshView& mesh, std::span<const 
   edit_.added_tetrahedra.clear();
   edit_.added_regions.clear();
   edit_.added_parent.clear();
+  edit_.red_tetrahedra = edit_.closure_tetrahedra = 0;
   red_slots_.clear();
   closure_slots_.clear();
+  touched_.clear();
   split_edges_.clear();
 
+  // The marked live slots.
   for (std::uint32_t s : marked) {
-    if (s < slot_count && mesh.alive[s] && slot_state_[s] == 0) {
-      slot_state_[s] = 1;
+    if (s < slot_count && mesh.alive[s] && !(slot_state_[s] & kRed)) {
+      slot_state_[s] = kRed | kTouched;
       red_slots_.push_back(s);
+      touched_.push_back(s);
     }
   }
+  if (red_slots_.empty()) return edit_;
 
-  auto split_mask = [&](const Tetrahedron& tet) {
-    unsigned mask = 0;
-    for (int e = 0; e < 6; ++e) {
-      const std::uint32_t a = tet[kTetEdges[e][0]], b = tet[kTetEdges[e][1]];
-      if (node_on_split_[a] && node_on_split_[b] && std::binary_search(split_edges_.begin(), split_edges_.end(), edge_key(a, b))) {
-        mask |= 1u << e;
-      }
-    }
-    return mask;
-  };
+  // Refinement is decided among the candidates: every live slot touching a covered node, listed
+  // under each covered node it holds. Covered at first: the marked slots' nodes (one pass over the
+  // slots). Every slot holding a split edge shares a node with a red slot, so while every red node
+  // is covered the candidates hold all that refinement can reach; a red node outside widens the
+  // cover by every candidate's nodes, one ring, with one more pass over the slots.
+  for (std::uint32_t s : red_slots_) {
+    for (std::uint32_t n : mesh.tetrahedra[s]) cover(n);
+  }
+  gather_candidates(mesh);
 
-  // Closure to a fixed point: each round splits the edges of the slots that turned red, then scans
-  // every live slot in ascending order; one whose split edges admit no good green closure turns red.
-  // The red set only grows, so this ends; the final scan (no change) leaves the closure set.
+  // Closure to a fixed point. Each round splits the edges of the slots that turned red in every slot
+  // holding them, then judges those slots in ascending slot order: one whose split edges admit no
+  // good green closure turns red. The red set only grows, so this ends.
   std::size_t processed = 0;
   while (processed < red_slots_.size()) {
-    new_edges_.clear();
-    for (; processed < red_slots_.size(); ++processed) {
-      const Tetrahedron& tet = mesh.tetrahedra[red_slots_[processed]];
-      for (const auto& e : kTetEdges) {
-        new_edges_.push_back(edge_key(tet[e[0]], tet[e[1]]));
-        node_on_split_[tet[e[0]]] = node_on_split_[tet[e[1]]] = 1;
-      }
+    bool outside = false;
+    for (std::size_t r = processed; r < red_slots_.size(); ++r) {
+      for (std::uint32_t n : mesh.tetrahedra[red_slots_[r]]) outside |= !node_is_covered_[n];
     }
-    split_edges_.insert(split_edges_.end(), new_edges_.begin(), new_edges_.end());
-    std::sort(split_edges_.begin(), split_edges_.end());
-    split_edges_.erase(std::unique(split_edges_.begin(), split_edges_.end()), split_edges_.end());
-
-    closure_slots_.clear();
-    for (std::uint32_t s = 0; s < slot_count; ++s) {
-      if (!mesh.alive[s] || slot_state_[s] == 1) continue;
-      const Tetrahedron& tet = mesh.tetrahedra[s];
-      if (!node_on_split_[tet[0]] && !node_on_split_[tet[1]] && !node_on_split_[tet[2]] && !node_on_split_[tet[3]]) continue;
-      const unsigned mask = split_mask(tet);
-      if (mask == 0) continue;
-      bool green = kGreenFace[mask] >= 0;
-      if (green) {
-        const LocalGeometry g(tet, mesh.rest_positions);
-        LocalChildren children;
-        green_children(tet, g, mask, kGreenFace[mask], children);
-        green = max_dihedral_cos(g, children) <= kMaxClosureDihedralCos;
+    to_judge_.clear();
+    if (outside) {
+      // Rare: widen, then split every red slot's edges again over the larger candidate set.
+      for (std::size_t c = 0, count = candidates_.size(); c < count; ++c) {
+        for (std::uint32_t n : mesh.tetrahedra[candidates_[c]]) cover(n);
       }
-      if (green) {
-        closure_slots_.push_back(s);
-      } else {
-        slot_state_[s] = 1;
+      for (std::uint32_t s : red_slots_) {
+        for (std::uint32_t n : mesh.tetrahedra[s]) cover(n);
+      }
+      gather_candidates(mesh);
+      processed = 0;
+    }
+    for (; processed < red_slots_.size(); ++processed) split_around(mesh, red_slots_[processed]);
+    std::sort(to_judge_.begin(), to_judge_.end());
+    for (std::uint32_t s : to_judge_) {
+      slot_state_[s] &= static_cast<std::uint8_t>(~kQueued);
+      if (slot_state_[s] & kRed) continue;
+      // The verdict for a mask is kept: a slot's mask only grows, and most stay as they were.
+      const unsigned mask = slot_mask_[s];
+      std::uint8_t& verdict = slot_verdict_[s];
+      if ((verdict & kVerdictMask) != mask || !(verdict & kVerdictKnown)) {
+        bool green = kGreenFace[mask] >= 0;
+        if (green) {
+          const Tetrahedron& tet = mesh.tetrahedra[s];
+          const LocalGeometry g(tet, mesh.rest_positions);
+          LocalChildren children;
+          green_children(tet, g, mask, kGreenFace[mask], children);
+          green = max_dihedral_cos(g, children) <= kMaxClosureDihedralCos;
+        }
+        verdict = static_cast<std::uint8_t>(mask | kVerdictKnown | (green ? kVerdictGreen : 0u));
+      }
+      if (!(verdict & kVerdictGreen)) {
+        slot_state_[s] |= kRed;
         red_slots_.push_back(s);
       }
     }
   }
 
-  // New nodes in ascending edge order; a split edge's midpoint is first_new_node + its rank.
+  // The closure: every touched slot (each has a split edge) that stayed green. Split edges: every red
+  // slot's, numbered in ascending order; a split edge's midpoint is first_new_node + its rank.
+  for (std::uint32_t s : touched_) {
+    if (!(slot_state_[s] & kRed)) closure_slots_.push_back(s);
+  }
+  for (std::uint32_t s : red_slots_) {
+    const Tetrahedron& tet = mesh.tetrahedra[s];
+    for (const auto& e : kTetEdges) split_edges_.push_back(edge_key(tet[e[0]], tet[e[1]]));
+  }
+  std::sort(split_edges_.begin(), split_edges_.end());
+  split_edges_.erase(std::unique(split_edges_.begin(), split_edges_.end()), split_edges_.end());
   for (std::uint64_t key : split_edges_) {
     edit_.new_node_parents.push_back({static_cast<std::uint32_t>(key >> 32), static_cast<std::uint32_t>(key & 0xffffffffu)});
   }
-  for (std::uint32_t s : closure_slots_) slot_state_[s] = 2;
   edit_.removed_tetrahedra.insert(edit_.removed_tetrahedra.end(), red_slots_.begin(), red_slots_.end());
   edit_.removed_tetrahedra.insert(edit_.removed_tetrahedra.end(), closure_slots_.begin(), closure_slots_.end());
   std::sort(edit_.removed_tetrahedra.begin(), edit_.removed_tetrahedra.end());
@@ -285,24 +406,24 @@ const RefinementEdit& TetRefiner::plan(const TetMeshView& mesh, std::span<const 
     const Tetrahedron& tet = mesh.tetrahedra[s];
     const LocalGeometry g(tet, mesh.rest_positions);
     LocalChildren children;
-    if (slot_state_[s] == 1) {
+    if (slot_state_[s] & kRed) {
       red_children(g, children);
     } else {
-      const unsigned mask = split_mask(tet);
-      green_children(tet, g, mask, kGreenFace[mask], children);
+      green_children(tet, g, slot_mask_[s], kGreenFace[slot_mask_[s]], children);
     }
     std::array<std::uint32_t, 10> node{};
     for (int i = 0; i < 4; ++i) node[i] = tet[i];
     for (int e = 0; e < 6; ++e) {
-      const auto it = std::lower_bound(split_edges_.begin(), split_edges_.end(), edge_key(tet[kTetEdges[e][0]], tet[kTetEdges[e][1]]));
-      const bool split = it != split_edges_.end() && *it == edge_key(tet[kTetEdges[e][0]], tet[kTetEdges[e][1]]);
-      node[4 + e] = split ? edit_.first_new_node + static_cast<std::uint32_t>(it - split_edges_.begin()) : 0xffffffffu;
+      const std::uint64_t key = edge_key(tet[kTetEdges[e][0]], tet[kTetEdges[e][1]]);
+      const auto it = std::lower_bound(split_edges_.begin(), split_edges_.end(), key);
+      const bool split = it != split_edges_.end() && *it == key;
+      node[4 + e] = split ? edit_.first_new_node + static_cast<std::uint32_t>(it - split_edges_.begin()) : kNoNode;
     }
     for (int c = 0; c < children.count; ++c) {
       Tetrahedron child{};
       for (int i = 0; i < 4; ++i) {
         child[i] = node[children.tets[c][i]];
-        assert(child[i] != 0xffffffffu);
+        assert(child[i] != kNoNode);
       }
       edit_.added_tetrahedra.push_back(child);
       edit_.added_regions.push_back(mesh.regions[s]);
@@ -312,9 +433,13 @@ const RefinementEdit& TetRefiner::plan(const TetMeshView& mesh, std::span<const 
   edit_.red_tetrahedra = static_cast<std::int32_t>(red_slots_.size());
   edit_.closure_tetrahedra = static_cast<std::int32_t>(closure_slots_.size());
 
-  // Leave the scratch flags all zero for the next plan, touching only what this one set.
-  for (std::uint32_t s : edit_.removed_tetrahedra) slot_state_[s] = 0;
-  for (std::uint64_t key : split_edges_) node_on_split_[key >> 32] = node_on_split_[key & 0xffffffffu] = 0;
+  // Leave the scratch all zero (nothing covered) for the next plan, touching only what this one set.
+  for (std::uint32_t s : touched_) slot_state_[s] = slot_mask_[s] = slot_verdict_[s] = 0;
+  for (std::uint32_t n : covered_nodes_) {
+    node_is_covered_[n] = 0;
+    node_covered_[n] = kNoNode;
+  }
+  covered_nodes_.clear();
   return edit_;
 }
 

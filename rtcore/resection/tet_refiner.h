@@ -46,13 +46,29 @@ class TetRefiner {
   const RefinementEdit& plan(const TetMeshView& mesh, std::span<const std::uint32_t> marked);
 
  private:
+  void cover(std::uint32_t node);
+  /// Lists every live slot touching a covered node (candidates_), and under each covered node the
+  /// candidates holding it (incidence_), in one pass over the slots.
+  void gather_candidates(const TetMeshView& mesh);
+  /// Marks the red slot's edges split in every candidate holding them and queues those for judging.
+  void split_around(const TetMeshView& mesh, std::uint32_t red_slot);
+
   RefinementEdit edit_;
-  std::vector<std::uint8_t> slot_state_;      // per slot: 0 untouched, 1 red, 2 closure
-  std::vector<std::uint8_t> node_on_split_;   // per node: 1 if a split edge ends here
-  std::vector<std::uint32_t> red_slots_;      // red slots in the order they turned red
-  std::vector<std::uint32_t> closure_slots_;  // slots closed by a green pattern
-  std::vector<std::uint64_t> split_edges_;    // split edge keys (smaller << 32 | larger), ascending
-  std::vector<std::uint64_t> new_edges_;      // edges of the slots that turned red this round
+  std::vector<std::uint8_t> slot_state_;          // per slot: red, queued, touched bits
+  std::vector<std::uint8_t> slot_mask_;           // per slot: which of its six edges are split
+  std::vector<std::uint8_t> slot_verdict_;        // per slot: the last green/red verdict and its mask
+  std::vector<std::uint8_t> node_is_covered_;     // per node: 1 if covered
+  std::vector<std::uint32_t> node_covered_;       // per node: its index in covered_nodes_, or ~0u
+  std::vector<std::uint32_t> covered_nodes_;      // nodes whose every live slot is a candidate
+  std::vector<std::uint32_t> candidates_;         // live slots touching a covered node, ascending
+  std::vector<std::uint32_t> incidence_offsets_;  // per covered node: where its slots start in incidence_
+  std::vector<std::uint32_t> incidence_cursor_;   // fill positions while incidence_ is built
+  std::vector<std::uint32_t> incidence_;          // candidates by covered node, ascending within each
+  std::vector<std::uint32_t> to_judge_;           // slots to judge this round, ascending
+  std::vector<std::uint32_t> touched_;            // every slot given a split edge or turned red
+  std::vector<std::uint32_t> red_slots_;          // red slots in the order they turned red
+  std::vector<std::uint32_t> closure_slots_;      // slots closed by a green pattern
+  std::vector<std::uint64_t> split_edges_;        // split edge keys (smaller << 32 | larger), ascending
 };
 
 }  // namespace resecto

@@ -376,6 +376,31 @@ TEST(TetRefiner, OppositeSplitEdgesUpgradeToRed) {
   EXPECT_GE(edit.red_tetrahedra, 3);
 }
 
+TEST(TetRefiner, FlatNeighboursGoRedAndTheClosureReachesFarNodes) {
+  // A 1 mm tetrahedron (A, B, P, D) on a flat wedge (A, B, P, E) whose far corner E lies 14 mm away,
+  // 0.3 mm below the plane: closing the wedge green would make children under the dihedral floor, so
+  // it goes red; so does the sliver (B, P, E, Q) beside it, which splits its edge E-Q, far from the
+  // marked tetrahedron. (E, Q, S, T) shares only that edge and must be closed too.
+  PlainMesh m = make_mesh({{0, 0, 0},
+                           {0.001, 0, 0},
+                           {0, 0.001, 0},
+                           {0.0003, 0.0003, 0.001},
+                           {0.01, 0.01, -0.0003},
+                           {0.008, 0.008, 0.002},
+                           {0.014, 0.006, 0.0},
+                           {0.012, 0.012, 0.006}},
+                          {{0, 1, 2, 3}, {0, 1, 2, 4}, {1, 2, 4, 5}, {4, 5, 6, 7}});
+  m.manifold_boundary = false;  // the last two touch along an edge only
+  TetRefiner refiner(64, 64);
+  const std::uint32_t marked[] = {0};
+  const RefinementEdit& edit = refine_and_check(refiner, m, marked);
+  EXPECT_EQ(edit.removed_tetrahedra, (std::vector<std::uint32_t>{0, 1, 2, 3}));
+  EXPECT_EQ(edit.red_tetrahedra, 3);
+  EXPECT_EQ(edit.closure_tetrahedra, 1);
+  const auto far_split = std::find(edit.new_node_parents.begin(), edit.new_node_parents.end(), std::array<std::uint32_t, 2>{4, 5});
+  EXPECT_NE(far_split, edit.new_node_parents.end()) << "the far edge E-Q is split";
+}
+
 TEST(TetRefiner, DeterministicForShuffledAndDuplicatedMarks) {
   const PlainMesh m = tetgen_box();
   const std::vector<std::uint32_t> marked = slots_near(m, {0.01, 0.01, 0.01}, 20);
