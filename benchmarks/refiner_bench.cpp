@@ -113,8 +113,8 @@ void print_rounds(int triangles) {
   double mesh_min = 180.0;
   for (const Tetrahedron& t : mesh.tets) mesh_min = std::min(mesh_min, mesh.min_dihedral_deg(t));
   std::printf("\n%d triangles, %zu tetrahedra, smallest dihedral in the whole mesh %.2f deg\n", triangles, mesh.tets.size(), mesh_min);
-  std::printf("%5s %5s %7s %10s %10s %9s | %14s %14s %14s %14s\n", "round", "red", "closure", "nodes/mark", "tets/mark", "plan us",
-              "marked min deg", "region before", "red child min", "closure min");
+  std::printf("%5s %5s %7s %10s %10s %9s | %14s %14s %14s %14s %14s\n", "round", "red", "closure", "nodes/mark", "tets/mark", "plan us",
+              "marked min deg", "region before", "red child min", "red child/par", "closure min");
   for (int round = 1; round <= kRounds; ++round) {
     const std::vector<std::uint32_t> marked = mesh.nearest(kMarked);
     double marked_min = 180.0;
@@ -122,19 +122,29 @@ void print_rounds(int triangles) {
     const auto start = std::chrono::steady_clock::now();
     const RefinementEdit& edit = refiner.plan(mesh.view(), marked);
     const double plan_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
-    double region_min = 180.0, red_min = 180.0, closure_min = 180.0;
-    for (std::uint32_t s : edit.removed_tetrahedra) region_min = std::min(region_min, mesh.min_dihedral_deg(mesh.tets[s]));
+    std::map<std::uint32_t, double> parent_min;  // each removed slot's smallest dihedral, before
+    double region_min = 180.0, red_min = 180.0, closure_min = 180.0, red_ratio = 1e300;
+    for (std::uint32_t s : edit.removed_tetrahedra) {
+      parent_min[s] = mesh.min_dihedral_deg(mesh.tets[s]);
+      region_min = std::min(region_min, parent_min[s]);
+    }
     mesh.apply(edit);  // the children's new corners exist from here
     std::map<std::uint32_t, int> children;
     for (std::uint32_t p : edit.added_parent) ++children[p];
     for (std::size_t c = 0; c < edit.added_tetrahedra.size(); ++c) {
-      double& worst = children[edit.added_parent[c]] == 8 ? red_min : closure_min;
-      worst = std::min(worst, mesh.min_dihedral_deg(edit.added_tetrahedra[c]));
+      const std::uint32_t parent = edit.added_parent[c];
+      const double child = mesh.min_dihedral_deg(edit.added_tetrahedra[c]);
+      if (children[parent] == 8) {
+        red_min = std::min(red_min, child);
+        red_ratio = std::min(red_ratio, child / parent_min[parent]);
+      } else {
+        closure_min = std::min(closure_min, child);
+      }
     }
-    std::printf("%5d %5d %7d %10.2f %10.2f %9.1f | %14.2f %14.2f %14.2f %14.2f\n", round, edit.red_tetrahedra, edit.closure_tetrahedra,
+    std::printf("%5d %5d %7d %10.2f %10.2f %9.1f | %14.2f %14.2f %14.2f %14.3f %14.2f\n", round, edit.red_tetrahedra, edit.closure_tetrahedra,
                 static_cast<double>(edit.new_node_parents.size()) / kMarked,
                 static_cast<double>(edit.added_tetrahedra.size() - edit.removed_tetrahedra.size()) / kMarked, plan_us, marked_min,
-                region_min, red_min, closure_min);
+                region_min, red_min, red_ratio, closure_min);
   }
   double after_min = 180.0;
   for (std::size_t s = 0; s < mesh.tets.size(); ++s) {

@@ -32,8 +32,14 @@ constexpr int kEquators[3][4] = {{5, 6, 8, 7}, {4, 6, 9, 7}, {4, 5, 9, 8}};
 
 /// Green closure needs every child's smallest dihedral angle at least this; otherwise the tetrahedron
 /// is refined red, whose children stay within a constant factor of its own shape (Bey). Without it,
-/// closing the same neighbour round after round would bisect its angles without bound.
+/// closing the same neighbour round after round would bisect its angles without bound. Just under
+/// the 10 degrees TetGen is asked for: most green closures of a mesher's tetrahedra pass.
 constexpr double kMinClosureDihedralDeg = 9.0;
+/// Quality upgrades are optional (a green closure is always conforming), so a plan makes at most this
+/// many per marked slot and closes the rest green whatever their shape: on a mesh of flat
+/// tetrahedra, where no green closure passes the floor, upgrades would otherwise spread red over the
+/// whole mesh. Pattern upgrades (no green closure exists) are never limited.
+constexpr std::size_t kQualityUpgradesPerMark = 4;
 const double kMaxClosureDihedralCos = std::cos(kMinClosureDihedralDeg * std::numbers::pi / 180.0);
 
 constexpr std::uint32_t kNoNode = 0xffffffffu;
@@ -325,6 +331,7 @@ const RefinementEdit& TetRefiner::plan(const TetMeshView& mesh, std::span<const 
     }
   }
   if (red_slots_.empty()) return edit_;
+  std::size_t quality_upgrades_left = kQualityUpgradesPerMark * red_slots_.size();
 
   // Refinement is decided among the candidates: every live slot touching a covered node, listed
   // under each covered node it holds. Covered at first: the marked slots' nodes (one pass over the
@@ -367,12 +374,15 @@ const RefinementEdit& TetRefiner::plan(const TetMeshView& mesh, std::span<const 
       std::uint8_t& verdict = slot_verdict_[s];
       if ((verdict & kVerdictMask) != mask || !(verdict & kVerdictKnown)) {
         bool green = kGreenFace[mask] >= 0;
-        if (green) {
+        if (green && quality_upgrades_left > 0) {
           const Tetrahedron& tet = mesh.tetrahedra[s];
           const LocalGeometry g(tet, mesh.rest_positions);
           LocalChildren children;
           green_children(tet, g, mask, kGreenFace[mask], children);
-          green = max_dihedral_cos(g, children) <= kMaxClosureDihedralCos;
+          if (max_dihedral_cos(g, children) > kMaxClosureDihedralCos) {
+            green = false;
+            --quality_upgrades_left;
+          }
         }
         verdict = static_cast<std::uint8_t>(mask | kVerdictKnown | (green ? kVerdictGreen : 0u));
       }
