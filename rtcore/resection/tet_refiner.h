@@ -35,6 +35,11 @@ struct RefinementEdit {
   std::int32_t closure_tetrahedra = 0;            ///< split only to close the conforming mesh
 };
 
+/// Cost: one pass over the slots (two when the closure spreads beyond the marked slots' neighbours,
+/// and one more for each further ring), the rest proportional to the refined region. Per-node and
+/// per-slot scratch is sized at construction (and grows if a mesh outgrows it); per-plan lists are
+/// sized for plans of about a thousand slots and grow once when a plan is larger, then stay: after
+/// the first plans, plan() allocates nothing. The returned edit lives until the next plan().
 class TetRefiner {
  public:
   /// Reserves scratch for meshes up to these sizes so plan() does not allocate in steady use.
