@@ -1,0 +1,321 @@
+// Red-green refinement planning. Each tetrahedron is refined through "local points": its four corners
+// (0-3) and the midpoints of its six edges (4-9, in kTetEdges order). Every child is four local points,
+// so a child's orientation is the sign of an integer determinant of barycentric coordinates, the same
+// for every geometry: children are positively oriented by construction, not by a rounding-prone test.
+#include "rtcore/resection/tet_refiner.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <numbers>
+
+#include "rtcore/geometry/vec3.h"
+
+namespace resecto {
+namespace {
+
+constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+/// The local midpoint of the edge between corners i and j.
+constexpr int kMidpoint[4][4] = {{-1, 4, 5, 6}, {4, -1, 7, 8}, {5, 7, -1, 9}, {6, 8, 9, -1}};
+/// Face opposite corner k: its corners, and the mask of its edges' bits.
+constexpr int kFaceCorners[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+constexpr unsigned kFaceEdgeMask[4] = {0x38u, 0x26u, 0x15u, 0x0Bu};
+
+/// A child or face triangle as local points.
+using LocalTet = std::array<int, 4>;
+
+/// Bey's red refinement: the four corner tetrahedra, then for each octahedron diagonal (p, q) the cycle
+/// of the four other midpoints around it.
+constexpr LocalTet kCornerChildren[4] = {{0, 4, 5, 6}, {4, 1, 7, 8}, {5, 7, 2, 9}, {6, 8, 9, 3}};
+constexpr int kDiagonals[3][2] = {{4, 9}, {5, 8}, {6, 7}};
+constexpr int kEquators[3][4] = {{5, 6, 8, 7}, {4, 6, 9, 7}, {4, 5, 9, 8}};
+
+/// Green closure needs every child's smallest dihedral angle at least this; otherwise the tetrahedron
+/// is refined red, whose children stay within a constant factor of its own shape (Bey). Without it,
+/// closing the same neighbour round after round would bisect its angles without bound.
+constexpr double kMinClosureDihedralDeg = 9.0;
+const double kMaxClosureDihedralCos = std::cos(kMinClosureDihedralDeg * std::numbers::pi / 180.0);
+
+constexpr std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
+  return a < b ? (std::uint64_t{a} << 32 | b) : (std::uint64_t{b} << 32 | a);
+}
+
+/// Twice the barycentric coordinates of local point p: small integers, so determinants are exact.
+constexpr std::array<int, 4> barycentric_x2(int p) {
+  std::array<int, 4> w{0, 0, 0, 0};
+  if (p < 4) {
+    w[p] = 2;
+  } else {
+    w[kTetEdges[p - 4][0]] = 1;
+    w[kTetEdges[p - 4][1]] = 1;
+  }
+  return w;
+}
+
+/// Sign of the child's volume relative to its parent's (the determinant of its barycentric rows).
+int orientation(const LocalTet& t) {
+  std::array<std::array<long, 4>, 4> m{};
+  for (int r = 0; r < 4; ++r) {
+    const auto w = barycentric_x2(t[r]);
+    for (int c = 0; c < 4; ++c) m[r][c] = w[c];
+  }
+  // Laplace expansion along the first row over 3x3 minors.
+  auto det3 = [&](int c0, int c1, int c2) {
+    return m[1][c0] * (m[2][c1] * m[3][c2] - m[2][c2] * m[3][c1]) - m[1][c1] * (m[2][c0] * m[3][c2] - m[2][c2] * m[3][c0]) +
+           m[1][c2] * (m[2][c0] * m[3][c1] - m[2][c1] * m[3][c0]);
+  };
+  const long det = m[0][0] * det3(1, 2, 3) - m[0][1] * det3(0, 2, 3) + m[0][2] * det3(0, 1, 3) - m[0][3] * det3(0, 1, 2);
+  return (det > 0) - (det < 0);
+}
+
+LocalTet oriented(LocalTet t) {
+  if (orientation(t) < 0) std::swap(t[2], t[3]);
+  assert(orientation(t) > 0);
+  return t;
+}
+
+/// The children of one tetrahedron as local points, at most eight.
+struct LocalChildren {
+  std::array<LocalTet, 8> tets;
+  int count = 0;
+  void add(const LocalTet& t) { tets[count++] = oriented(t); }
+};
+
+/// Which face holds every split edge of `mask` (the green closures), or -1 if none does (go red).
+constexpr std::array<int, 64> make_green_face() {
+  std::array<int, 64> face{};
+  for (unsigned mask = 0; mask < 64; ++mask) {
+    face[mask] = -1;
+    for (int f = 0; f < 4 && mask != 0; ++f) {
+      if ((mask & ~kFaceEdgeMask[f]) == 0) {
+        face[mask] = f;
+        break;
+      }
+    }
+  }
+  return face;
+}
+constexpr std::array<int, 64> kGreenFace = make_green_face();
+
+/// A tetrahedron's corners and edge midpoints at rest, computed as the caller computes new nodes.
+struct LocalGeometry {
+  std::array<Vec3, 10> p;
+  LocalGeometry(const Tetrahedron& tet, std::span<const Vec3> rest) {
+    for (int i = 0; i < 4; ++i) p[i] = rest[tet[i]];
+    for (int e = 0; e < 6; ++e) p[4 + e] = (p[kTetEdges[e][0]] + p[kTetEdges[e][1]]) * 0.5;
+  }
+};
+
+void red_children(const LocalGeometry& g, LocalChildren& out) {
+  for (const LocalTet& corner : kCornerChildren) out.add(corner);
+  // The shortest octahedron diagonal keeps repeated refinement within a bounded set of shapes.
+  int best = 0;
+  double best_length = length_squared(g.p[kDiagonals[0][1]] - g.p[kDiagonals[0][0]]);
+  for (int d = 1; d < 3; ++d) {
+    const double l = length_squared(g.p[kDiagonals[d][1]] - g.p[kDiagonals[d][0]]);
+    if (l < best_length) {
+      best = d;
+      best_length = l;
+    }
+  }
+  const int p = kDiagonals[best][0], q = kDiagonals[best][1];
+  for (int k = 0; k < 4; ++k) out.add({p, q, kEquators[best][k], kEquators[best][(k + 1) % 4]});
+}
+
+/// Green closure: the face opposite `apex` holds every split edge; triangulate it and cone the
+/// triangles to the apex. The face's triangulation depends only on the face (its nodes' ids and
+/// positions, and which edges are split), so both tetrahedra sharing it cut it the same way.
+void green_children(const Tetrahedron& tet, const LocalGeometry& g, unsigned mask, int apex, LocalChildren& out) {
+  const int* face = kFaceCorners[apex];
+  int split_count = 0;
+  std::array<bool, 3> split{};  // split[k]: edge (face[k], face[(k + 1) % 3])
+  for (int k = 0; k < 3; ++k) {
+    split[k] = (mask >> (kMidpoint[face[k]][face[(k + 1) % 3]] - 4) & 1u) != 0;
+    split_count += split[k];
+  }
+  auto cone = [&](int a, int b, int c) { out.add({apex, a, b, c}); };
+  if (split_count == 3) {
+    const int a = face[0], b = face[1], c = face[2];
+    const int ab = kMidpoint[a][b], bc = kMidpoint[b][c], ca = kMidpoint[c][a];
+    cone(a, ab, ca), cone(b, bc, ab), cone(c, ca, bc), cone(ab, bc, ca);
+  } else if (split_count == 1) {
+    const int k = split[0] ? 0 : split[1] ? 1 : 2;
+    const int a = face[k], b = face[(k + 1) % 3], c = face[(k + 2) % 3];
+    const int m = kMidpoint[a][b];
+    cone(a, m, c), cone(m, b, c);
+  } else {
+    // Edges (a, b) and (b, c) split: the corner triangle at b, then the quad a, m_ab, m_bc, c cut
+    // along its shorter diagonal, ties to the diagonal from the corner with the smaller node id.
+    const int k = !split[0] ? 1 : !split[1] ? 2 : 0;  // split[k] and split[k + 1] hold; b = face[k + 1]
+    const int a = face[k], b = face[(k + 1) % 3], c = face[(k + 2) % 3];
+    const int ab = kMidpoint[a][b], bc = kMidpoint[b][c];
+    cone(ab, b, bc);
+    const double from_a = length_squared(g.p[bc] - g.p[a]), from_c = length_squared(g.p[ab] - g.p[c]);
+    const bool diagonal_from_a = from_a < from_c || (from_a == from_c && tet[a] < tet[c]);
+    if (diagonal_from_a) {
+      cone(a, ab, bc), cone(a, bc, c);
+    } else {
+      cone(a, ab, c), cone(ab, bc, c);
+    }
+  }
+}
+
+/// The largest cosine of a dihedral angle over the children: the smallest angle's cosine.
+double max_dihedral_cos(const LocalGeometry& g, const LocalChildren& children) {
+  constexpr int kOutwardFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  double worst = -1.0;
+  for (int c = 0; c < children.count; ++c) {
+    Vec3 n[4];
+    double len[4];
+    for (int f = 0; f < 4; ++f) {
+      const Vec3& a = g.p[children.tets[c][kOutwardFaces[f][0]]];
+      n[f] = cross(g.p[children.tets[c][kOutwardFaces[f][1]]] - a, g.p[children.tets[c][kOutwardFaces[f][2]]] - a);
+      len[f] = length(n[f]);
+    }
+    for (int f = 0; f < 4; ++f) {
+      for (int h = f + 1; h < 4; ++h) worst = std::max(worst, -dot(n[f], n[h]) / (len[f] * len[h]));
+    }
+  }
+  return worst;
+}
+
+}  // namespace
+
+TetRefiner::TetRefiner(std::size_t max_nodes, std::size_t max_tetrahedra) {
+  slot_state_.assign(max_tetrahedra, 0);
+  node_on_split_.assign(max_nodes, 0);
+  // A typical plan touches a few hundred tetrahedra; larger plans grow these once and keep them.
+  constexpr std::size_t kTypicalSlots = 1024;
+  red_slots_.reserve(kTypicalSlots);
+  closure_slots_.reserve(kTypicalSlots);
+  split_edges_.reserve(6 * kTypicalSlots);
+  new_edges_.reserve(6 * kTypicalSlots);
+  edit_.new_node_parents.reserve(6 * kTypicalSlots);
+  edit_.removed_tetrahedra.reserve(2 * kTypicalSlots);
+  edit_.added_tetrahedra.reserve(8 * kTypicalSlots);
+  edit_.added_regions.reserve(8 * kTypicalSlots);
+  edit_.added_parent.reserve(8 * kTypicalSlots);
+}
+
+const RefinementEdit& TetRefiner::plan(const TetMeshView& mesh, std::span<const std::uint32_t> marked) {
+  const std::size_t slot_count = mesh.tetrahedra.size();
+  const std::size_t node_count = mesh.rest_positions.size();
+  if (slot_state_.size() < slot_count) slot_state_.resize(slot_count, 0);
+  if (node_on_split_.size() < node_count) node_on_split_.resize(node_count, 0);
+
+  edit_.first_new_node = static_cast<std::uint32_t>(node_count);
+  edit_.new_node_parents.clear();
+  edit_.removed_tetrahedra.clear();
+  edit_.added_tetrahedra.clear();
+  edit_.added_regions.clear();
+  edit_.added_parent.clear();
+  red_slots_.clear();
+  closure_slots_.clear();
+  split_edges_.clear();
+
+  for (std::uint32_t s : marked) {
+    if (s < slot_count && mesh.alive[s] && slot_state_[s] == 0) {
+      slot_state_[s] = 1;
+      red_slots_.push_back(s);
+    }
+  }
+
+  auto split_mask = [&](const Tetrahedron& tet) {
+    unsigned mask = 0;
+    for (int e = 0; e < 6; ++e) {
+      const std::uint32_t a = tet[kTetEdges[e][0]], b = tet[kTetEdges[e][1]];
+      if (node_on_split_[a] && node_on_split_[b] && std::binary_search(split_edges_.begin(), split_edges_.end(), edge_key(a, b))) {
+        mask |= 1u << e;
+      }
+    }
+    return mask;
+  };
+
+  // Closure to a fixed point: each round splits the edges of the slots that turned red, then scans
+  // every live slot in ascending order; one whose split edges admit no good green closure turns red.
+  // The red set only grows, so this ends; the final scan (no change) leaves the closure set.
+  std::size_t processed = 0;
+  while (processed < red_slots_.size()) {
+    new_edges_.clear();
+    for (; processed < red_slots_.size(); ++processed) {
+      const Tetrahedron& tet = mesh.tetrahedra[red_slots_[processed]];
+      for (const auto& e : kTetEdges) {
+        new_edges_.push_back(edge_key(tet[e[0]], tet[e[1]]));
+        node_on_split_[tet[e[0]]] = node_on_split_[tet[e[1]]] = 1;
+      }
+    }
+    split_edges_.insert(split_edges_.end(), new_edges_.begin(), new_edges_.end());
+    std::sort(split_edges_.begin(), split_edges_.end());
+    split_edges_.erase(std::unique(split_edges_.begin(), split_edges_.end()), split_edges_.end());
+
+    closure_slots_.clear();
+    for (std::uint32_t s = 0; s < slot_count; ++s) {
+      if (!mesh.alive[s] || slot_state_[s] == 1) continue;
+      const Tetrahedron& tet = mesh.tetrahedra[s];
+      if (!node_on_split_[tet[0]] && !node_on_split_[tet[1]] && !node_on_split_[tet[2]] && !node_on_split_[tet[3]]) continue;
+      const unsigned mask = split_mask(tet);
+      if (mask == 0) continue;
+      bool green = kGreenFace[mask] >= 0;
+      if (green) {
+        const LocalGeometry g(tet, mesh.rest_positions);
+        LocalChildren children;
+        green_children(tet, g, mask, kGreenFace[mask], children);
+        green = max_dihedral_cos(g, children) <= kMaxClosureDihedralCos;
+      }
+      if (green) {
+        closure_slots_.push_back(s);
+      } else {
+        slot_state_[s] = 1;
+        red_slots_.push_back(s);
+      }
+    }
+  }
+
+  // New nodes in ascending edge order; a split edge's midpoint is first_new_node + its rank.
+  for (std::uint64_t key : split_edges_) {
+    edit_.new_node_parents.push_back({static_cast<std::uint32_t>(key >> 32), static_cast<std::uint32_t>(key & 0xffffffffu)});
+  }
+  for (std::uint32_t s : closure_slots_) slot_state_[s] = 2;
+  edit_.removed_tetrahedra.insert(edit_.removed_tetrahedra.end(), red_slots_.begin(), red_slots_.end());
+  edit_.removed_tetrahedra.insert(edit_.removed_tetrahedra.end(), closure_slots_.begin(), closure_slots_.end());
+  std::sort(edit_.removed_tetrahedra.begin(), edit_.removed_tetrahedra.end());
+
+  // Children slot by ascending slot, each in its pattern's fixed order: the edit is the same every run.
+  for (std::uint32_t s : edit_.removed_tetrahedra) {
+    const Tetrahedron& tet = mesh.tetrahedra[s];
+    const LocalGeometry g(tet, mesh.rest_positions);
+    LocalChildren children;
+    if (slot_state_[s] == 1) {
+      red_children(g, children);
+    } else {
+      const unsigned mask = split_mask(tet);
+      green_children(tet, g, mask, kGreenFace[mask], children);
+    }
+    std::array<std::uint32_t, 10> node{};
+    for (int i = 0; i < 4; ++i) node[i] = tet[i];
+    for (int e = 0; e < 6; ++e) {
+      const auto it = std::lower_bound(split_edges_.begin(), split_edges_.end(), edge_key(tet[kTetEdges[e][0]], tet[kTetEdges[e][1]]));
+      const bool split = it != split_edges_.end() && *it == edge_key(tet[kTetEdges[e][0]], tet[kTetEdges[e][1]]);
+      node[4 + e] = split ? edit_.first_new_node + static_cast<std::uint32_t>(it - split_edges_.begin()) : 0xffffffffu;
+    }
+    for (int c = 0; c < children.count; ++c) {
+      Tetrahedron child{};
+      for (int i = 0; i < 4; ++i) {
+        child[i] = node[children.tets[c][i]];
+        assert(child[i] != 0xffffffffu);
+      }
+      edit_.added_tetrahedra.push_back(child);
+      edit_.added_regions.push_back(mesh.regions[s]);
+      edit_.added_parent.push_back(s);
+    }
+  }
+  edit_.red_tetrahedra = static_cast<std::int32_t>(red_slots_.size());
+  edit_.closure_tetrahedra = static_cast<std::int32_t>(closure_slots_.size());
+
+  // Leave the scratch flags all zero for the next plan, touching only what this one set.
+  for (std::uint32_t s : edit_.removed_tetrahedra) slot_state_[s] = 0;
+  for (std::uint64_t key : split_edges_) node_on_split_[key >> 32] = node_on_split_[key & 0xffffffffu] = 0;
+  return edit_;
+}
+
+}  // namespace resecto
