@@ -102,7 +102,20 @@ ordered_json metrics_json(const ProcedureMetrics& m) {
           {"non_finite_steps", m.non_finite_steps},
           {"contact_overflows", m.contact_overflows},
           {"contact_margin_exceeded_ticks", m.contact_margin_exceeded_ticks},
-          {"max_tool_travel_since_search_mm", m.max_tool_travel_since_search_mm}};
+          {"max_tool_travel_since_search_mm", m.max_tool_travel_since_search_mm},
+          {"resected_g", {{"adenoma", m.resected_adenoma_g}, {"capsule", m.resected_capsule_g}, {"total", m.resected_total_g}}},
+          {"chips", m.chips},
+          {"chips_g", m.chips_g},
+          {"cuts", m.cuts},
+          {"perforations", m.perforations},
+          {"sphincter_zone_violations", m.sphincter_zone_violations},
+          {"sphincter_zone_cut_s", m.sphincter_zone_cut_s},
+          {"loop_on_idle_s", m.loop_on_idle_s},
+          {"initial_tissue_g", m.initial_tissue_g},
+          {"remaining_tissue_g", m.remaining_tissue_g},
+          {"remaining_adenoma_fraction", m.remaining_adenoma_fraction},
+          {"refined_tetrahedra", m.refined_tetrahedra},
+          {"topology_refusals", m.topology_refusals}};
 }
 
 }  // namespace
@@ -226,7 +239,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
                 {"tetrahedra", sim.tetrahedron_count()},
                 {"nodes", sim.tissue().node_count()}};
   ordered_json stages = ordered_json::object();
-  for (Stage stage : {Stage::kInput, Stage::kKinematics, Stage::kCollisionWait, Stage::kPhysics, Stage::kRefit, Stage::kQuery,
+  for (Stage stage : {Stage::kInput, Stage::kKinematics, Stage::kCollisionWait, Stage::kTopology, Stage::kPhysics, Stage::kRefit, Stage::kQuery,
                       Stage::kResponse, Stage::kPublish, Stage::kTick}) {
     stages[stage_name(stage)] = stage_json(profiler.statistics(stage));
   }

@@ -196,6 +196,8 @@ class MassSpringTissue {
   void add_surface_face(std::uint32_t t, int f);
   void remove_surface_face(std::uint32_t t, int f);
   std::uint64_t tetrahedron_hash(std::uint32_t t) const;
+  /// How many faces an edit can add to the surface at most (removed slots stamped with stamp_).
+  std::size_t surface_growth_bound(std::span<const std::uint32_t> removed, std::span<const Tetrahedron> added);
   std::uint64_t face_hash(std::size_t s) const;
   void accumulate_forces(double h_s);
   void step_bounded_symplectic(double h_s);
@@ -249,6 +251,7 @@ class MassSpringTissue {
   std::vector<std::uint32_t> slot_stamp_, changed_faces_;
   std::vector<std::uint8_t> changed_face_, dead_node_;
   std::vector<std::int64_t> exposed_faces_;
+  std::vector<std::array<std::uint32_t, 3>> face_keys_;
   struct NewSpring {
     std::uint32_t i, j;  // i the newer node
   };

@@ -45,7 +45,10 @@ void MassSpringTissue::reserve_topology(std::size_t node_capacity, std::size_t t
   }
   surface_.positions.reserve(node_capacity);
 
-  spring_capacity_ = static_cast<std::size_t>(std::ceil(static_cast<double>(network_.spring_count()) * factor));
+  // Springs and faces in proportion to the tetrahedra's room (a tetrahedral mesh has about 1.2
+  // edges per tetrahedron; a surface a fraction of its faces).
+  spring_capacity_ = std::max(static_cast<std::size_t>(std::ceil(static_cast<double>(network_.spring_count()) * factor)),
+                              network_.spring_count() + (tetrahedron_capacity - topology_.slot_count()) * 3 / 2);
   springs_.reserve(spring_capacity_, node_capacity);
   network_.spring_nodes.reserve(2 * spring_capacity_);
   network_.rest_length_m.reserve(spring_capacity_);
@@ -62,7 +65,8 @@ void MassSpringTissue::reserve_topology(std::size_t node_capacity, std::size_t t
     insert_spring_key(network_.spring_nodes[2 * s], network_.spring_nodes[2 * s + 1], static_cast<std::uint32_t>(s));
   }
 
-  surface_face_capacity_ = static_cast<std::size_t>(std::ceil(static_cast<double>(surface_.triangle_count()) * factor)) + 64;
+  surface_face_capacity_ = std::max(static_cast<std::size_t>(std::ceil(static_cast<double>(surface_.triangle_count()) * factor)),
+                                    surface_.triangle_count() + (tetrahedron_capacity - topology_.slot_count()) / 4);
   surface_.triangles.reserve(surface_face_capacity_);
   face_owner_.reserve(surface_face_capacity_);
   free_faces_.reserve(surface_face_capacity_);
@@ -82,6 +86,7 @@ void MassSpringTissue::reserve_topology(std::size_t node_capacity, std::size_t t
   added_slots_.reserve(tetrahedron_capacity);
   slot_stamp_.assign(tetrahedron_capacity, 0);
   exposed_faces_.reserve(4 * tetrahedron_capacity);
+  face_keys_.reserve(4 * tetrahedron_capacity);
   changed_face_.assign(surface_face_capacity_, 0);
   changed_faces_.reserve(surface_face_capacity_);
   tool_.reserve_tissue(node_capacity, surface_face_capacity_);
@@ -195,9 +200,37 @@ void MassSpringTissue::remove_surface_face(std::uint32_t t, int f) {
 
 bool MassSpringTissue::can_edit(std::size_t nodes, std::size_t added, std::size_t removed) const {
   const std::size_t slots_after_removal = topology_.free_slots() + removed;
-  const std::size_t free_faces = surface_face_capacity_ - surface_faces_;
   return x_.size() + nodes <= topology_.node_capacity() && added <= slots_after_removal &&
-         springs_.spring_count() + 6 * added <= spring_capacity_ && 4 * (added + removed) <= free_faces;
+         springs_.spring_count() + 6 * added <= spring_capacity_;
+}
+
+std::size_t MassSpringTissue::surface_growth_bound(std::span<const std::uint32_t> removed, std::span<const Tetrahedron> added) {
+  // Faces the edit can add: the removed ones' faces toward tetrahedra that stay, and the added ones'
+  // faces no other added one shares (some of which an old tetrahedron covers: an upper bound).
+  std::size_t bound = 0;
+  for (std::uint32_t t : removed) {
+    for (int f = 0; f < 4; ++f) {
+      const std::int32_t n = topology_.neighbor(t, f);
+      if (n != TetTopology::kNone && slot_stamp_[static_cast<std::uint32_t>(n)] != stamp_) ++bound;
+    }
+  }
+  face_keys_.clear();
+  for (const Tetrahedron& tet : added) {
+    for (const auto& corners : kTetFaceCorners) {
+      std::array<std::uint32_t, 3> key{tet[static_cast<std::size_t>(corners[0])], tet[static_cast<std::size_t>(corners[1])],
+                                       tet[static_cast<std::size_t>(corners[2])]};
+      std::sort(key.begin(), key.end());
+      face_keys_.push_back(key);
+    }
+  }
+  std::sort(face_keys_.begin(), face_keys_.end());
+  for (std::size_t k = 0; k < face_keys_.size();) {
+    std::size_t same = k + 1;
+    while (same < face_keys_.size() && face_keys_[same] == face_keys_[k]) ++same;
+    if (same - k == 1) ++bound;
+    k = same;
+  }
+  return bound;
 }
 
 void MassSpringTissue::add_midpoint_nodes(std::span<const std::array<std::uint32_t, 2>> parents) {
@@ -242,16 +275,18 @@ TopologyChange MassSpringTissue::edit_tetrahedra(std::span<const std::uint32_t> 
       if (find_spring(a, b) < 0 && std::max(a, b) <= last_i) order_kept = false;
     }
   }
-  if (!order_kept || !can_edit(0, added.size(), removed.size())) {
-    change.refused = true;
-    ++faults_.topology_capacity_refusals;
-    return change;
-  }
   if (++stamp_ == 0) {  // wrapped: restart the stamps
     std::fill(node_stamp_.begin(), node_stamp_.end(), 0u);
     std::fill(spring_stamp_.begin(), spring_stamp_.end(), 0u);
     std::fill(slot_stamp_.begin(), slot_stamp_.end(), 0u);
     stamp_ = 1;
+  }
+  for (std::uint32_t t : removed) slot_stamp_[t] = stamp_;
+  if (!order_kept || !can_edit(0, added.size(), removed.size()) ||
+      surface_faces_ + surface_growth_bound(removed, added) > surface_face_capacity_) {
+    change.refused = true;
+    ++faults_.topology_capacity_refusals;
+    return change;
   }
   touched_nodes_.clear();
   touched_springs_.clear();
@@ -271,7 +306,6 @@ TopologyChange MassSpringTissue::edit_tetrahedra(std::span<const std::uint32_t> 
 
   // 1. The removed, in the caller's order: their boundary faces leave the surface; a face they share
   // with a tetrahedron that stays becomes that one's boundary once they are gone.
-  for (std::uint32_t t : removed) slot_stamp_[t] = stamp_;
   for (std::uint32_t t : removed) {
     assert(topology_.alive(t));
     topology_hash_ -= tetrahedron_hash(t);
