@@ -21,6 +21,7 @@
 #include "rtcore/concurrency/triple_buffer.h"
 #include "rtcore/core/fixed_step_scheduler.h"
 #include "rtcore/core/thread_priority.h"
+#include "rtcore/mesh/mesh_io.h"
 #include "rtcore/tissue/state_hash.h"
 
 namespace resecto {
@@ -269,6 +270,12 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   r["metrics"] = metrics_json(sim.metrics());
   if (profiler.trace_dropped() > 0) r["trace_dropped_events"] = profiler.trace_dropped();
 
+  if (!options.export_surface_path.empty()) {
+    // At rest: the resected shape itself, not its deformation at the last tick.
+    const TriangleMesh surface = sim.tissue().live_surface(true);
+    if (Status written = write_surface_mesh(options.export_surface_path, surface); !written) return Error{written.error()};
+    result.report["surface"] = {{"path", options.export_surface_path}, {"triangles", surface.triangle_count()}, {"vertices", surface.vertex_count()}};
+  }
   if (!options.trace_path.empty()) {
     if (Status written = profiler.write_chrome_trace(options.trace_path); !written) return Error{written.error()};
   }
@@ -309,6 +316,17 @@ std::string summarize_report(const ordered_json& r) {
                 m.at("contact_time_s").get<double>(), m.at("peak_reaction_force_n").get<double>(), m.at("cut_pedal_time_s").get<double>(),
                 m.at("cut_in_contact_time_s").get<double>(), m.at("max_tissue_displacement_mm").get<double>());
   std::string summary = text;
+  const auto& topology = r.at("stages").at("topology");
+  std::snprintf(text, sizeof text,
+                "  resection  %.2f g resected (adenoma %.2f, capsule %.2f), %.1f%% of the adenoma remains; %llu cuts, %llu chips "
+                "(%.2f g), %llu refined; perforations %llu, sphincter-zone violations %llu; topology update p99 %.0f us\n",
+                m.at("resected_g").at("total").get<double>(), m.at("resected_g").at("adenoma").get<double>(),
+                m.at("resected_g").at("capsule").get<double>(), 100.0 * m.at("remaining_adenoma_fraction").get<double>(),
+                static_cast<unsigned long long>(m.at("cuts").get<std::uint64_t>()), static_cast<unsigned long long>(m.at("chips").get<std::uint64_t>()),
+                m.at("chips_g").get<double>(), static_cast<unsigned long long>(m.at("refined_tetrahedra").get<std::uint64_t>()),
+                static_cast<unsigned long long>(m.at("perforations").get<std::uint64_t>()),
+                static_cast<unsigned long long>(m.at("sphincter_zone_violations").get<std::uint64_t>()), topology.at("p99_us").get<double>());
+  summary += text;
   if (r.at("mode") == "realtime") {
     const auto& d = r.at("deadlines");
     std::snprintf(text, sizeof text,
