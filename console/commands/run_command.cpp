@@ -1,6 +1,8 @@
 // `resecto run`: the simulator. `--headless` drives the core through the emulated device with a
 // scripted procedure and writes the JSON report of DESIGN.md's contract.
+#include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <stdexcept>
@@ -22,6 +24,7 @@ struct RunOptions {
   std::string report;
   std::string trace;
   std::string record;
+  std::string export_surface;
   std::vector<std::string> sets;
   int triangles = 8640;
   int collision_hz = 60;
@@ -46,6 +49,15 @@ void run(const RunOptions& o) {
   options.realtime = o.realtime;
   options.trace_path = o.trace;
   options.record_path = o.record;
+  if (!o.export_surface.empty()) {
+    // Checked before the run, so a typo does not cost the whole run.
+    std::string extension = std::filesystem::path(o.export_surface).extension().string();
+    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (extension != ".off" && extension != ".obj" && extension != ".ply" && extension != ".stl") {
+      throw std::runtime_error("--export-surface " + o.export_surface + ": unknown format '" + extension + "' (use .off, .obj, .ply or .stl)");
+    }
+  }
+  options.export_surface_path = o.export_surface;
   options.seed = o.seed;
   options.simulation.prostate_triangles = o.triangles;
   options.simulation.collision_hz = o.collision_hz;
@@ -78,12 +90,14 @@ void register_run(CLI::App& app) {
   auto o = std::make_shared<RunOptions>();
   CLI::App* cmd = app.add_subcommand("run", "Run the simulator (headless: a scripted procedure through the emulated device)");
   cmd->add_flag("--headless", o->headless, "No display: drive the core with a procedure and report");
-  cmd->add_option("--procedure", o->procedure, "Built-in procedure (demo) or a procedure file")->capture_default_str();
+  cmd->add_option("--procedure", o->procedure, "Built-in procedure (demo, turp) or a procedure file")->capture_default_str();
   cmd->add_option("--seconds", o->seconds, "Simulated seconds (default: the procedure's length)")->check(CLI::Range(0.0, 86400.0));
   cmd->add_flag("--realtime", o->realtime, "Real time: the device link on its own thread, ticks at their deadlines");
   cmd->add_option("--report", o->report, "Write the JSON report here");
   cmd->add_option("--trace", o->trace, "Write a Chrome trace-event JSON (opens in Perfetto)");
   cmd->add_option("--record", o->record, "Record the session to FILE (replay with `resecto replay FILE --verify`)");
+  cmd->add_option("--export-surface", o->export_surface,
+                  "At the end, write the remaining tissue's surface at rest, in millimetres (.off, .obj, .ply, .stl)");
   add_parameter_option(*cmd, o->sets);
   cmd->add_option("--triangles", o->triangles, "Prostate surface triangles")->check(CLI::Range(200, 1000000))->capture_default_str();
   cmd->add_option("--collision-hz", o->collision_hz, "Collision steps per second")->check(CLI::Range(10, 1000))->capture_default_str();

@@ -22,6 +22,7 @@
 #include "rtcore/concurrency/triple_buffer.h"
 #include "rtcore/core/fixed_step_scheduler.h"
 #include "rtcore/core/thread_priority.h"
+#include "rtcore/mesh/mesh_io.h"
 #include "rtcore/tissue/state_hash.h"
 
 namespace resecto {
@@ -103,7 +104,20 @@ ordered_json metrics_json(const ProcedureMetrics& m) {
           {"non_finite_steps", m.non_finite_steps},
           {"contact_overflows", m.contact_overflows},
           {"contact_margin_exceeded_ticks", m.contact_margin_exceeded_ticks},
-          {"max_tool_travel_since_search_mm", m.max_tool_travel_since_search_mm}};
+          {"max_tool_travel_since_search_mm", m.max_tool_travel_since_search_mm},
+          {"resected_g", {{"adenoma", m.resected_adenoma_g}, {"capsule", m.resected_capsule_g}, {"total", m.resected_total_g}}},
+          {"chips", m.chips},
+          {"chips_g", m.chips_g},
+          {"cuts", m.cuts},
+          {"perforations", m.perforations},
+          {"sphincter_zone_violations", m.sphincter_zone_violations},
+          {"sphincter_zone_cut_s", m.sphincter_zone_cut_s},
+          {"loop_on_idle_s", m.loop_on_idle_s},
+          {"initial_tissue_g", m.initial_tissue_g},
+          {"remaining_tissue_g", m.remaining_tissue_g},
+          {"remaining_adenoma_fraction", m.remaining_adenoma_fraction},
+          {"refined_tetrahedra", m.refined_tetrahedra},
+          {"topology_refusals", m.topology_refusals}};
 }
 
 }  // namespace
@@ -239,7 +253,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
                 {"tetrahedra", sim.tetrahedron_count()},
                 {"nodes", sim.tissue().node_count()}};
   ordered_json stages = ordered_json::object();
-  for (Stage stage : {Stage::kInput, Stage::kKinematics, Stage::kCollisionWait, Stage::kPhysics, Stage::kRefit, Stage::kQuery,
+  for (Stage stage : {Stage::kInput, Stage::kKinematics, Stage::kCollisionWait, Stage::kTopology, Stage::kPhysics, Stage::kRefit, Stage::kQuery,
                       Stage::kResponse, Stage::kPublish, Stage::kTick}) {
     stages[stage_name(stage)] = stage_json(profiler.statistics(stage));
   }
@@ -281,6 +295,12 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   }
   if (profiler.trace_dropped() > 0) r["trace_dropped_events"] = profiler.trace_dropped();
 
+  if (!options.export_surface_path.empty()) {
+    // At rest: the resected shape itself, not its deformation at the last tick.
+    const TriangleMesh surface = sim.tissue().live_surface(true);
+    if (Status written = write_surface_mesh(options.export_surface_path, surface); !written) return Error{written.error()};
+    result.report["surface"] = {{"path", options.export_surface_path}, {"triangles", surface.triangle_count()}, {"vertices", surface.vertex_count()}};
+  }
   if (!options.trace_path.empty()) {
     if (Status written = profiler.write_chrome_trace(options.trace_path); !written) return Error{written.error()};
   }
@@ -333,6 +353,17 @@ std::string summarize_report(const ordered_json& r) {
                                                   lost.at("commands").get<std::uint64_t>() + lost.at("keyframes").get<std::uint64_t>()));
     summary += text;
   }
+  const auto& topology = r.at("stages").at("topology");
+  std::snprintf(text, sizeof text,
+                "  resection  %.2f g resected (adenoma %.2f, capsule %.2f), %.1f%% of the adenoma remains; %llu cuts, %llu chips "
+                "(%.2f g), %llu refined; perforations %llu, sphincter-zone violations %llu; topology update p99 %.0f us\n",
+                m.at("resected_g").at("total").get<double>(), m.at("resected_g").at("adenoma").get<double>(),
+                m.at("resected_g").at("capsule").get<double>(), 100.0 * m.at("remaining_adenoma_fraction").get<double>(),
+                static_cast<unsigned long long>(m.at("cuts").get<std::uint64_t>()), static_cast<unsigned long long>(m.at("chips").get<std::uint64_t>()),
+                m.at("chips_g").get<double>(), static_cast<unsigned long long>(m.at("refined_tetrahedra").get<std::uint64_t>()),
+                static_cast<unsigned long long>(m.at("perforations").get<std::uint64_t>()),
+                static_cast<unsigned long long>(m.at("sphincter_zone_violations").get<std::uint64_t>()), topology.at("p99_us").get<double>());
+  summary += text;
   if (r.at("mode") == "realtime") {
     const auto& d = r.at("deadlines");
     std::snprintf(text, sizeof text,

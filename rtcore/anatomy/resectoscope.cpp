@@ -48,6 +48,13 @@ TriangleMesh make_sheath(const ResectoscopeShape& s) {
   return mesh;
 }
 
+/// Point i (0 .. kArcSegments) of the half-ring below the axis, from the left arm to the right.
+Vec3 arc_point(const ResectoscopeShape& s, int i) {
+  const double half_span = 0.5 * s.loop_span_m;
+  const double angle = std::numbers::pi * (1.0 + static_cast<double>(i) / kArcSegments);
+  return {half_span * std::cos(angle), kArmHeightM + half_span * std::sin(angle), s.loop_stem_length_m + s.loop_travel_m};
+}
+
 /// Centre line of the wire: left arm forward, the half-ring below the axis, right arm back.
 std::vector<Vec3> loop_path(const ResectoscopeShape& s) {
   const double half_span = 0.5 * s.loop_span_m;
@@ -56,10 +63,7 @@ std::vector<Vec3> loop_path(const ResectoscopeShape& s) {
   for (int i = 0; i <= kArmSegments; ++i) {
     path.push_back({-half_span, kArmHeightM, front - kArmLengthM * (1.0 - static_cast<double>(i) / kArmSegments)});
   }
-  for (int i = 1; i <= kArcSegments; ++i) {
-    const double angle = std::numbers::pi * (1.0 + static_cast<double>(i) / kArcSegments);
-    path.push_back({half_span * std::cos(angle), kArmHeightM + half_span * std::sin(angle), front});
-  }
+  for (int i = 1; i <= kArcSegments; ++i) path.push_back(arc_point(s, i));
   for (int i = 1; i <= kArmSegments; ++i) {
     path.push_back({half_span, kArmHeightM, front - kArmLengthM * static_cast<double>(i) / kArmSegments});
   }
@@ -111,6 +115,12 @@ TriangleMesh make_loop(const ResectoscopeShape& s) {
 
 ResectoscopeModel generate_resectoscope(const ResectoscopeShape& shape) {
   return {make_sheath(shape), make_loop(shape)};
+}
+
+std::vector<Vec3> loop_cutting_arc(const ResectoscopeShape& shape) {
+  std::vector<Vec3> arc;
+  for (int i = 0; i <= kArcSegments; ++i) arc.push_back(arc_point(shape, i));
+  return arc;
 }
 
 TriangleMesh combined_resectoscope_mesh(const ResectoscopeModel& model) {

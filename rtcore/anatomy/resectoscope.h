@@ -3,6 +3,8 @@
 // origin, the shaft extending toward -z; the loop's wire hangs below the axis (-y) in front of the tip.
 #pragma once
 
+#include <vector>
+
 #include "rtcore/mesh/triangle_mesh.h"
 
 namespace resecto {
@@ -27,6 +29,10 @@ struct ResectoscopeModel {
 };
 
 ResectoscopeModel generate_resectoscope(const ResectoscopeShape& shape = {});
+
+/// The cutting part of the loop's wire, its half-ring, as points along its centre line in the loop's
+/// frame (the frame of ResectoscopeModel::loop): what resection sweeps. The arms stay in the sheath.
+std::vector<Vec3> loop_cutting_arc(const ResectoscopeShape& shape = {});
 
 /// Sheath then loop in one mesh: faces [0, 158) are the sheath, [158, 488) the loop.
 TriangleMesh combined_resectoscope_mesh(const ResectoscopeModel& model);

@@ -20,6 +20,7 @@ const char* stage_name(Stage stage) {
     case Stage::kInput: return "input";
     case Stage::kKinematics: return "kinematics";
     case Stage::kCollisionWait: return "collision_wait";
+    case Stage::kTopology: return "topology";
     case Stage::kPhysics: return "physics";
     case Stage::kRefit: return "refit";
     case Stage::kQuery: return "query";

@@ -15,9 +15,10 @@ namespace resecto {
 
 /// The stages of a core tick, in execution order.
 /// kRefit and kQuery run on the collision thread, alongside the ticks after their own; kCollisionWait
-/// is the core's wait for them at the next collision tick.
-enum class Stage : std::uint8_t { kInput, kKinematics, kCollisionWait, kPhysics, kRefit, kQuery, kResponse, kPublish, kTick };
-inline constexpr int kStageCount = 9;
+/// is the core's wait for them at the next collision tick; kTopology is resection's edit of the
+/// tissue at a collision tick, between that wait and the next search.
+enum class Stage : std::uint8_t { kInput, kKinematics, kCollisionWait, kTopology, kPhysics, kRefit, kQuery, kResponse, kPublish, kTick };
+inline constexpr int kStageCount = 10;
 
 /// Lower-case name used in reports and traces ("physics").
 const char* stage_name(Stage stage);

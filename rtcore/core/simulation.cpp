@@ -78,6 +78,14 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
     if (l.name == "verumontanum") sim->verumontanum_z_m_ = l.position.z;
   }
   sim->loop_front_tool_ = loop_front_point(tool.loop);
+  ResectionConfig resection = config.resection;
+  resection.channel_origin = Vec3(0.0);  // the gland's channel runs along z (prostate.h)
+  resection.channel_direction = Vec3(0.0, 0.0, 1.0);
+  sim->resection_ = std::make_unique<Resection>(*sim->tissue_, resection);
+  sim->wire_loop_ = loop_cutting_arc();
+  sim->wire_from_.assign(sim->wire_loop_.size(), Vec3(0.0));
+  sim->wire_to_.assign(sim->wire_loop_.size(), Vec3(0.0));
+  sim->sweep_ = SweptVolume(sim->wire_loop_.size());
   sim->input_filter_ = JointFilter(config.input_filter);
   const RigidTransform away = to_transform(withdrawn_pose());
   sim->tissue_->tool().reset_pose(sim->sheath_part_, away);
@@ -107,6 +115,30 @@ void Simulation::place_tool(const TickInput& input) {
   }
   tissue_->tool().set_pose(sheath_part_, to_transform(placed_.poses.sheath));
   tissue_->tool().set_pose(loop_part_, to_transform(placed_.poses.loop));
+  // The energised loop cuts rather than pushes: while it cuts it takes no part in contact.
+  cut_pedal_ = input.tool_present && input.cut;
+  tissue_->tool().set_enabled(loop_part_, !loop_cutting());
+}
+
+bool Simulation::loop_cutting() const {
+  // Retracted against the sheath's insulated beak (under half a millimetre of travel) it cannot cut.
+  constexpr double kBeakTravelM = 0.0005;
+  return cut_pedal_ && placed_.present && placed_joints_.loop_travel_m >= kBeakTravelM;
+}
+
+void Simulation::update_topology() {
+  const SweptVolume* sweep = nullptr;
+  if (loop_cutting()) {
+    for (std::size_t i = 0; i < wire_loop_.size(); ++i) wire_to_[i] = placed_.poses.loop.apply_point(wire_loop_[i]);
+    sweep_.set(wire_from_valid_ ? wire_from_ : wire_to_, wire_to_, tissue_->parameters().si(TissueParameter::kCuttingRadius));
+    sweep = &sweep_;
+    std::copy(wire_to_.begin(), wire_to_.end(), wire_from_.begin());
+    wire_from_valid_ = true;
+  } else {
+    wire_from_valid_ = false;
+  }
+  const bool distal = placed_.present && placed_.poses.loop.apply_point(loop_front_tool_).z < verumontanum_z_m_;
+  last_cut_ = resection_->step(sweep, cut_pedal_, distal, config_.tick_s() * config_.physics_per_collision);
 }
 
 void Simulation::step(const TickInput& input, std::span<const ParameterCommand> commands, FrameProfiler* profiler) {
@@ -155,6 +187,11 @@ void Simulation::advance_collision_pipeline(std::uint64_t tick, FrameProfiler* p
       profiler->record(Stage::kRefit, search_timing_.tick, search_timing_.begin_ns, search_timing_.refit_end_ns);
       profiler->record(Stage::kQuery, search_timing_.tick, search_timing_.refit_end_ns, search_timing_.query_end_ns);
     }
+  }
+  {
+    // With no search in flight: the edits change the surface and tree the next search reads.
+    RESECTO_PROFILE_STAGE(profiler, Stage::kTopology, tick);
+    update_topology();
   }
   tissue_->begin_collision_step();
   // The candidates found now are used from the next collision tick to the one after it, so the search
@@ -230,6 +267,25 @@ void Simulation::update_metrics(const TickInput& input, bool collision_tick) {
     metrics_.distal_margin_mm = std::min(metrics_.distal_margin_mm, units::m_to_mm(margin_m));
     if (margin_m < 0.0) ++metrics_.verumontanum_violations;
   }
+  const ResectionStats& cut = resection_->stats();
+  const double grams_per_m3 = tissue_->parameters().si(TissueParameter::kDensity) * 1000.0;
+  constexpr auto kCapsule = static_cast<std::size_t>(TissueRegion::kCapsule), kAdenoma = static_cast<std::size_t>(TissueRegion::kAdenoma);
+  metrics_.initial_tissue_g = grams_per_m3 * (cut.initial_m3[kCapsule] + cut.initial_m3[kAdenoma]);
+  metrics_.resected_adenoma_g = grams_per_m3 * cut.removed_m3[kAdenoma];
+  metrics_.resected_capsule_g = grams_per_m3 * cut.removed_m3[kCapsule];
+  metrics_.resected_total_g = metrics_.resected_adenoma_g + metrics_.resected_capsule_g;
+  metrics_.remaining_tissue_g = metrics_.initial_tissue_g - metrics_.resected_total_g;
+  metrics_.remaining_adenoma_fraction =
+      cut.initial_m3[kAdenoma] > 0.0 ? (cut.initial_m3[kAdenoma] - cut.removed_m3[kAdenoma]) / cut.initial_m3[kAdenoma] : 1.0;
+  metrics_.chips = static_cast<std::uint64_t>(cut.chips);
+  metrics_.chips_g = grams_per_m3 * (cut.chip_m3[kCapsule] + cut.chip_m3[kAdenoma]);
+  metrics_.cuts = static_cast<std::uint64_t>(cut.cuts);
+  metrics_.perforations = static_cast<std::uint64_t>(cut.perforations);
+  metrics_.sphincter_zone_violations = static_cast<std::uint64_t>(cut.sphincter_zone_violations);
+  metrics_.sphincter_zone_cut_s = cut.sphincter_zone_cut_s;
+  metrics_.loop_on_idle_s = cut.loop_on_idle_s;
+  metrics_.refined_tetrahedra = static_cast<std::uint64_t>(cut.refined_tetrahedra);
+  metrics_.topology_refusals = static_cast<std::uint64_t>(cut.refusals + tissue_->faults().topology_capacity_refusals);
   metrics_.non_finite_steps = static_cast<std::uint64_t>(tissue_->faults().non_finite_steps);
   metrics_.contact_overflows = static_cast<std::uint64_t>(tissue_->faults().contact_overflows);
 }
@@ -243,21 +299,27 @@ void Simulation::fill_snapshot(SimulationSnapshot& snapshot) const {
   const std::size_t nodes = std::min(snapshot.node_positions.size(), tissue_->node_count());
   tissue_->copy_mesh_positions(std::span<Vec3>(snapshot.node_positions.data(), nodes));
   snapshot.node_count = static_cast<std::uint32_t>(nodes);
-  // The tissue's surface is in its own (locality) numbering; the snapshot speaks mesh ids.
+  // The tissue's surface is in its own (locality) numbering and has free slots; the snapshot speaks
+  // mesh ids and lists the live faces in slot order, each with its tetrahedron's region.
   const std::vector<Triangle>& faces = tissue_->surface().triangles;
-  const std::size_t count = std::min(snapshot.surface_triangles.size(), faces.size());
-  for (std::size_t f = 0; f < count; ++f) {
-    for (int c = 0; c < 3; ++c) snapshot.surface_triangles[f][c] = tissue_->mesh_node(faces[f][c]);
+  std::size_t count = 0;
+  for (std::size_t f = 0; f < faces.size() && count < snapshot.surface_triangles.size(); ++f) {
+    const std::int64_t owner = tissue_->surface_face_owner(f);
+    if (owner < 0) continue;
+    for (int c = 0; c < 3; ++c) snapshot.surface_triangles[count][c] = tissue_->mesh_node(faces[f][c]);
+    if (count < snapshot.surface_regions.size()) snapshot.surface_regions[count] = tissue_->topology().region(static_cast<std::uint32_t>(owner / 4));
+    ++count;
   }
   snapshot.surface_triangle_count = static_cast<std::uint32_t>(count);
-  snapshot.topology_version = 0;  // the surface never changes until resection
+  snapshot.topology_version = tissue_->topology_version();
   snapshot.metrics = metrics_;
 }
 
 SimulationSnapshot Simulation::make_snapshot() const {
   SimulationSnapshot snapshot;
-  snapshot.node_positions.resize(tissue_->node_count());
-  snapshot.surface_triangles.resize(tissue_->surface().triangles.size());
+  snapshot.node_positions.resize(tissue_->node_capacity());
+  snapshot.surface_triangles.resize(tissue_->surface_face_capacity());
+  snapshot.surface_regions.resize(tissue_->surface_face_capacity());
   fill_snapshot(snapshot);
   return snapshot;
 }
@@ -272,6 +334,8 @@ std::array<double, kStageCount> default_stage_budgets_us(const SimulationConfig&
   budgets[static_cast<int>(Stage::kInput)] = 0.05 * tick_us;
   budgets[static_cast<int>(Stage::kKinematics)] = 0.02 * tick_us;
   budgets[static_cast<int>(Stage::kCollisionWait)] = 0.02 * tick_us;
+  // Resection's edits take one tick's spare time at a collision tick while the loop cuts.
+  budgets[static_cast<int>(Stage::kTopology)] = 0.30 * tick_us;
   budgets[static_cast<int>(Stage::kPhysics)] = 0.40 * tick_us;
   budgets[static_cast<int>(Stage::kRefit)] = 0.15 * collision_period_us;
   budgets[static_cast<int>(Stage::kQuery)] = 0.45 * collision_period_us;

@@ -19,6 +19,7 @@
 #include "rtcore/core/profiler.h"
 #include "rtcore/core/tick_input.h"
 #include "rtcore/kinematics/tool_kinematics.h"
+#include "rtcore/resection/resection.h"
 #include "rtcore/tissue/mass_spring.h"
 #include "rtcore/tissue/tissue_parameters.h"
 
@@ -41,6 +42,8 @@ struct SimulationConfig {
   bool predict_search_pose = true;
   /// The tissue's fixed choices: integrator, contact margin and capacities, clearance certificates.
   TissueConfig tissue;
+  /// Resection's choices (refinement on or off, target edge); its channel axis is the gland's.
+  ResectionConfig resection;
 
   double tick_s() const { return 1.0 / (static_cast<double>(collision_hz) * physics_per_collision); }
   /// The tick rates as a user would write them, or an error naming the bad value.
@@ -64,6 +67,22 @@ struct ProcedureMetrics {
   /// use were searched: motion faster than contact can follow (margin / two collision periods).
   std::uint64_t contact_margin_exceeded_ticks = 0;
   double max_tool_travel_since_search_mm = 0.0;  ///< the largest such travel
+  // Resection (rtcore/resection): grams at the live density, from rest volumes.
+  double initial_tissue_g = 0.0;
+  double remaining_tissue_g = 0.0;
+  double resected_adenoma_g = 0.0;   ///< everything that left the gland: cut by the loop, hanging, chips
+  double resected_capsule_g = 0.0;
+  double resected_total_g = 0.0;
+  double remaining_adenoma_fraction = 1.0;
+  std::uint64_t chips = 0;
+  double chips_g = 0.0;
+  std::uint64_t cuts = 0;                       ///< strokes (pedal presses) that removed tissue
+  std::uint64_t perforations = 0;               ///< strokes that opened the gland's outer surface
+  std::uint64_t sphincter_zone_violations = 0;  ///< strokes that removed tissue distal to the verumontanum
+  double sphincter_zone_cut_s = 0.0;
+  double loop_on_idle_s = 0.0;                  ///< pedal down and nothing removed
+  std::uint64_t refined_tetrahedra = 0;
+  std::uint64_t topology_refusals = 0;          ///< edits refused for want of reserved capacity
 };
 
 /// What the core publishes for the console and recorder (taken at collision steps).
@@ -84,6 +103,8 @@ struct SimulationSnapshot {
   /// Changes whenever surface_triangles change; equal versions mean equal connectivity, so a reader
   /// copies or encodes the connectivity only when it moved.
   std::uint64_t topology_version = 0;
+  /// Region of the tetrahedron behind each surface triangle, valid in [0, surface_triangle_count).
+  std::vector<TissueRegion> surface_regions;
   ProcedureMetrics metrics;
 };
 
@@ -104,6 +125,9 @@ class Simulation {
   std::uint64_t state_hash() const { return state_hash_; }
   const ProcedureMetrics& metrics() const { return metrics_; }
   const MassSpringTissue& tissue() const { return *tissue_; }
+  const Resection& resection() const { return *resection_; }
+  /// What the last collision step's topology update removed and refined.
+  const ResectionStep& last_resection_step() const { return last_cut_; }
   const ProstateModel& prostate() const { return prostate_; }
   const SimulationConfig& config() const { return config_; }
   const ToolPoses& tool_poses() const { return placed_.poses; }
@@ -124,10 +148,21 @@ class Simulation {
   void advance_collision_pipeline(std::uint64_t tick, FrameProfiler* profiler);
   /// The collision step's refit and search, on whichever thread runs them; timed for the profiler.
   void run_collision_search();
+  /// Resection's part of a collision tick: the wire's sweep since the last one, the cut, the edits.
+  void update_topology();
+  /// Whether the loop cuts this tick: pedal down, tool placed, loop out of the sheath's beak.
+  bool loop_cutting() const;
 
   SimulationConfig config_;
   ProstateModel prostate_;
   std::unique_ptr<MassSpringTissue> tissue_;
+  std::unique_ptr<Resection> resection_;
+  SweptVolume sweep_;
+  std::vector<Vec3> wire_loop_;  // the cutting arc in the loop's frame
+  std::vector<Vec3> wire_from_, wire_to_;  // the arc in the world at the last and this collision tick
+  bool wire_from_valid_ = false;
+  bool cut_pedal_ = false;  // this tick's input: tool present and cutting pedal down
+  ResectionStep last_cut_;
   /// When the last refit and search ran (written by their thread, read after the wait).
   struct SearchTiming {
     std::uint64_t tick = 0;

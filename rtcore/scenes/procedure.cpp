@@ -36,6 +36,60 @@ constexpr const char* kDemoProcedure = R"(# Resecto procedure v1: the built-in d
 10.0    0.0   0.0     0.0   125.0   0.0   0  0
 )";
 
+// The built-in full resection (`turp`), in the standard order: the median lobe at the bladder neck,
+// then each lateral lobe, by strokes at successive roll angles and depths. A stroke: with the pedal up
+// the loop goes out to the bladder end of the stroke; with the pedal down it is drawn back toward the
+// sheath (the cut); then the pedal comes up and the loop back in. Depth comes from tilting the sheath
+// (yaw and pitch) toward the side the loop hangs to, a layer further at each pass. Every stroke stays
+// proximal to the verumontanum (9.1 mm from the apex with the default gland) and short of the
+// bladder neck, and the deepest layer stops short of the capsule.
+struct TurpPlan {
+  double insertion_mm = 157.0;    // sheath tip 7 mm past the apex
+  double far_loop_mm = 23.0;      // loop front 34 mm from the apex: short of the bladder neck's rim
+  double near_loop_mm = 1.0;      // loop front 12 mm from the apex: proximal to the verumontanum
+  double median_far_loop_mm = 24.0;
+  double median_near_loop_mm = 15.0;  // the median lobe sits at the bladder neck
+  double stroke_s = 1.2;          // the cut: loop drawn back at ~22 mm/s
+  double move_s = 0.4;            // roll, tilt and loop out, pedal up
+};
+
+std::vector<ProcedureKeyframe> turp_keyframes() {
+  const TurpPlan plan;
+  std::vector<ProcedureKeyframe> keys;
+  double t = 0.0;
+  auto add = [&](double dt, double yaw, double pitch, double roll, double insertion, double loop, bool cut) {
+    t += dt;
+    keys.push_back({t, yaw, pitch, roll, insertion, loop, cut, false});
+  };
+  keys.push_back({0.0, 0.0, 0.0, 0.0, 125.0, 0.0, false, false});
+  add(1.5, 0.0, 0.0, 0.0, plan.insertion_mm, 0.0, false);  // in through the apex
+  // Tilting by `tilt_deg` toward where the loop hangs at `roll_deg` (roll 0: posterior, +90: the
+  // patient's left): yaw swings the tip toward +x, pitch lifts it toward +y.
+  auto stroke = [&](double roll_deg, double tilt_deg, double far_mm, double near_mm) {
+    const double roll = roll_deg * 3.141592653589793 / 180.0;
+    const double yaw = tilt_deg * std::sin(roll), pitch = -tilt_deg * std::cos(roll);
+    add(plan.move_s * 0.5, yaw, pitch, roll_deg, plan.insertion_mm, 0.0, false);
+    add(plan.move_s * 0.5, yaw, pitch, roll_deg, plan.insertion_mm, far_mm, false);
+    add(0.05, yaw, pitch, roll_deg, plan.insertion_mm, far_mm, true);
+    add(plan.stroke_s, yaw, pitch, roll_deg, plan.insertion_mm, near_mm, true);
+    add(0.05, yaw, pitch, roll_deg, plan.insertion_mm, near_mm, false);
+    add(0.2, yaw, pitch, roll_deg, plan.insertion_mm, 0.0, false);
+  };
+  // Median lobe: posterior, at the bladder neck, three layers.
+  for (double tilt : {0.0, 0.6, 1.2}) {
+    for (double roll : {-25.0, 0.0, 25.0}) stroke(roll, tilt, plan.median_far_loop_mm, plan.median_near_loop_mm);
+  }
+  // Lateral lobes, left then right, layer by layer from the channel outward.
+  for (double side : {1.0, -1.0}) {
+    for (double tilt : {0.0, 1.0, 2.0, 3.0}) {
+      for (double roll : {40.0, 65.0, 90.0, 115.0}) stroke(side * roll, tilt, plan.far_loop_mm, plan.near_loop_mm);
+    }
+  }
+  add(0.5, 0.0, 0.0, 0.0, plan.insertion_mm, 0.0, false);
+  add(1.0, 0.0, 0.0, 0.0, 125.0, 0.0, false);  // out
+  return keys;
+}
+
 Error line_error(const std::string& source, int line, const std::string& what) {
   return Error{source + ":" + std::to_string(line) + ": " + what};
 }
@@ -127,7 +181,8 @@ Result<Procedure> load_procedure(const std::filesystem::path& path) {
 
 Result<Procedure> builtin_procedure(const std::string& name) {
   if (name == "demo") return parse_procedure(kDemoProcedure, "demo");
-  return Error{"no built-in procedure '" + name + "' (built-in: demo)"};
+  if (name == "turp") return Procedure{"turp", turp_keyframes()};
+  return Error{"no built-in procedure '" + name + "' (built-in: demo, turp)"};
 }
 
 Result<Procedure> find_procedure(const std::string& name_or_path) {

@@ -1,5 +1,5 @@
 // Procedures: scripted motions of the resectoscope (time-stamped 5-DOF and pedal keyframes, linearly
-// interpolated) that drive the emulator in headless runs, tests and benchmarks. One built-in, `demo`;
+// interpolated) that drive the emulator in headless runs, tests and benchmarks. Built-ins `demo` and `turp`;
 // users write their own in the text format documented in the README.
 #pragma once
 
@@ -43,7 +43,7 @@ inline constexpr double kMaxLoopMm = 36.0;
 /// Parses the text format; errors name the line and the column at fault.
 Result<Procedure> parse_procedure(const std::string& text, const std::string& source_name);
 Result<Procedure> load_procedure(const std::filesystem::path& path);
-/// The built-in procedure called `name` ("demo"), or an error listing the built-in names.
+/// The built-in procedure called `name` ("demo" or "turp"), or an error listing the built-in names.
 Result<Procedure> builtin_procedure(const std::string& name);
 /// A built-in name or a file path.
 Result<Procedure> find_procedure(const std::string& name_or_path);

@@ -11,6 +11,19 @@
 #include "rtcore/tissue/state_hash.h"
 
 namespace resecto {
+namespace {
+
+std::size_t capacity_for(std::size_t count, double factor) {
+  return static_cast<std::size_t>(std::ceil(static_cast<double>(count) * std::max(1.0, factor)));
+}
+
+// Floors of the reserved room, whatever the model's size: refinement near the loop turns a coarse
+// model's tetrahedra into many small ones (a 4 mm tetrahedron into ~20 of 1.5 mm), so a coarse
+// gland needs far more room than a multiple of its own counts. About 20 MB in all.
+constexpr std::size_t kMinTetrahedronCapacity = 160000;
+constexpr std::size_t kMinNodeCapacity = 40000;
+
+}  // namespace
 
 MassSpringTissue::OrderedMesh MassSpringTissue::ordered(const TetMesh& mesh, bool locality) {
   OrderedMesh out;
@@ -33,8 +46,10 @@ MassSpringTissue::MassSpringTissue(OrderedMesh&& ordered_mesh, const TissueParam
       config_(config),
       mesh_node_(std::move(ordered_mesh.mesh_node)),
       network_(build_spring_network(ordered_mesh.mesh)),
-      tetrahedra_(ordered_mesh.mesh.tetrahedra),
       springs_(network_),
+      topology_(ordered_mesh.mesh.tetrahedra, ordered_mesh.mesh.regions, ordered_mesh.mesh.node_count(),
+                std::max(kMinTetrahedronCapacity, capacity_for(ordered_mesh.mesh.tetrahedron_count(), config.topology_capacity_factor)),
+                std::max(kMinNodeCapacity, capacity_for(ordered_mesh.mesh.node_count(), config.topology_capacity_factor))),
       tool_(config.contact_margin_m, config.contact_capacity) {
   const TetMesh& mesh = ordered_mesh.mesh;
   const std::size_t n = mesh.node_count();
@@ -60,6 +75,8 @@ MassSpringTissue::MassSpringTissue(OrderedMesh&& ordered_mesh, const TissueParam
   tool_.set_clearance_skipping(config_.clearance_certificates);
   surface_ = boundary_surface(mesh);
   surface_tree_.build(surface_);
+  reserve_topology(topology_.node_capacity(), topology_.tetrahedron_capacity());
+  map_initial_surface();
   topology_hash_ = topology_hash();
   update_material();
 }
@@ -70,27 +87,45 @@ void MassSpringTissue::update_material() {
   const double density = parameters_.si(TissueParameter::kDensity);
   const double anchor = parameters_.si(TissueParameter::kAnchorStiffness);
   const double viscous_rate = parameters_.si(TissueParameter::kViscousDamping);
-  for (std::size_t i = 0; i < mass_.size(); ++i) {
-    mass_[i] = density * network_.node_volume_m3[i];
-    base_stiffness_bound_[i] = 0.0;
-    base_damping_bound_[i] = viscous_rate * mass_[i];
+  for (std::size_t s = 0; s < springs_.spring_count(); ++s) update_spring_material(s, modulus, viscosity);
+  for (std::size_t a = 0; a < anchor_k_.size(); ++a) {
+    const std::uint32_t node = network_.anchor_nodes[a];
+    anchor_k_[a] = topology_.valence(node) > 0 ? anchor * network_.anchor_area_m2[a] : 0.0;
   }
+  for (std::uint32_t i = 0; i < x_.size(); ++i) update_node_material(i, density, viscous_rate);
+}
+
+void MassSpringTissue::update_spring_material(std::size_t s, double modulus, double viscosity) {
+  // A spring no tetrahedron holds any more (share 0) forms no force.
+  const double share = network_.volume_share_m3[s];
+  const double k = share > 0.0 ? edge_spring_constant(modulus, share, network_.rest_length_m[s]) : 0.0;
+  const double c = share > 0.0 ? edge_spring_constant(viscosity, share, network_.rest_length_m[s]) : 0.0;
+  springs_.set_material(s, k, c);
+}
+
+void MassSpringTissue::update_node_material(std::uint32_t node, double density, double viscous_rate) {
+  // An orphan (no tetrahedron left) keeps a nominal mass so its step stays finite; it has no force
+  // and no speed, so it stays where it is, out of every sum that matters (total_mass_kg skips it).
+  const bool orphan = topology_.valence(node) == 0;
+  mass_[node] = orphan ? 1.0 : density * network_.node_volume_m3[node];
   // Gershgorin rows at rest: each spring's Hessian blocks have norm k (more only when compressed
   // below half its length, added per step) and each row holds two of them; likewise the dampers.
-  for (std::size_t s = 0; s < springs_.spring_count(); ++s) {
-    const double k = edge_spring_constant(modulus, network_.volume_share_m3[s], network_.rest_length_m[s]);
-    const double c = edge_spring_constant(viscosity, network_.volume_share_m3[s], network_.rest_length_m[s]);
-    springs_.set_material(s, k, c);
-    const std::uint32_t i = network_.spring_nodes[2 * s], j = network_.spring_nodes[2 * s + 1];
-    base_stiffness_bound_[i] += 2.0 * k;
-    base_stiffness_bound_[j] += 2.0 * k;
-    base_damping_bound_[i] += 2.0 * c;
-    base_damping_bound_[j] += 2.0 * c;
+  // Gathered through the incidence in its fixed order, so a local update forms the same sum.
+  const SpringIncidence& in = springs_.incidence();
+  const SpringArrays& arrays = springs_.arrays();
+  double stiffness = 0.0, damping = viscous_rate * mass_[node];
+  if (orphan) damping = 0.0;
+  for (std::uint32_t e = in.second_first[node]; e < in.second_first[node + 1]; ++e) {
+    stiffness += 2.0 * arrays.k[in.second_springs[e]];
+    damping += 2.0 * arrays.c[in.second_springs[e]];
   }
-  for (std::size_t a = 0; a < anchor_k_.size(); ++a) {
-    anchor_k_[a] = anchor * network_.anchor_area_m2[a];
-    base_stiffness_bound_[network_.anchor_nodes[a]] += anchor_k_[a];
+  for (std::uint32_t s = in.first_first[node]; s < in.first_first[node + 1]; ++s) {
+    stiffness += 2.0 * arrays.k[s];
+    damping += 2.0 * arrays.c[s];
   }
+  if (anchor_of_node_[node] >= 0) stiffness += anchor_k_[static_cast<std::size_t>(anchor_of_node_[node])];
+  base_stiffness_bound_[node] = stiffness;
+  base_damping_bound_[node] = damping;
 }
 
 void MassSpringTissue::apply(const ParameterCommand& command) {
@@ -321,10 +356,16 @@ void MassSpringTissue::note_non_finite(std::size_t node) {
 }
 
 std::uint64_t MassSpringTissue::topology_hash() const {
-  StateHasher hasher;
-  hasher.add(std::span<const std::uint32_t>(network_.spring_nodes));
-  hasher.add(std::span<const Triangle>(surface_.triangles));
-  return hasher.value();
+  // A sum of per-element hashes, so an edit renews it by subtracting what left and adding what came
+  // (tissue_topology.cpp): live tetrahedra by slot (they define the springs) and surface faces by slot.
+  std::uint64_t hash = 0;
+  for (std::uint32_t t = 0; t < topology_.slot_count(); ++t) {
+    if (topology_.alive(t)) hash += tetrahedron_hash(t);
+  }
+  for (std::size_t s = 0; s < surface_.triangles.size(); ++s) {
+    if (face_owner_[s] >= 0) hash += face_hash(s);
+  }
+  return hash;
 }
 
 std::uint64_t MassSpringTissue::state_hash() const {
@@ -342,7 +383,9 @@ void MassSpringTissue::copy_mesh_positions(std::span<Vec3> out) const {
 
 double MassSpringTissue::total_mass_kg() const {
   double total = 0.0;
-  for (double m : mass_) total += m;
+  for (std::uint32_t i = 0; i < mass_.size(); ++i) {
+    if (topology_.valence(i) > 0) total += mass_[i];
+  }
   return total;
 }
 

@@ -11,6 +11,7 @@
 #include "rtcore/tissue/spring_forces.h"
 #include "rtcore/tissue/springs.h"
 #include "rtcore/tissue/tet_mesh.h"
+#include "rtcore/tissue/tet_topology.h"
 #include "rtcore/tissue/tissue_parameters.h"
 #include "rtcore/tissue/tool_contact.h"
 
@@ -45,6 +46,10 @@ struct TissueConfig {
   /// Lets the contact skip points whose clearance certificate holds (ToolContacts); off only for
   /// the brute-force reference, which gives the same forces.
   bool clearance_certificates = true;
+  /// Room reserved at construction for resection's edits, as a multiple of the model's own node,
+  /// tetrahedron, spring and surface-face counts (local refinement adds all four). An edit that would
+  /// pass a capacity is refused and counted (TissueFaults::topology_capacity_refusals).
+  double topology_capacity_factor = 3.0;
 };
 
 /// Faults of the last step, counted rather than thrown (STYLE.md "Errors").
@@ -53,6 +58,19 @@ struct TissueFaults {
   std::int64_t first_non_finite_node = -1;
   std::int64_t substep_cap_hits = 0;
   std::int64_t contact_overflows = 0;
+  std::int64_t topology_capacity_refusals = 0;  ///< topology edits refused for want of reserved room
+};
+
+/// What one topology edit changed (MassSpringTissue::edit_tetrahedra).
+struct TopologyChange {
+  std::int32_t removed_tetrahedra = 0;
+  std::int32_t added_tetrahedra = 0;
+  std::int32_t surface_faces_removed = 0;
+  std::int32_t surface_faces_added = 0;
+  std::int32_t springs_removed = 0;
+  std::int32_t springs_added = 0;
+  std::int32_t nodes_orphaned = 0;
+  bool refused = false;  ///< the capacities could not take it; nothing changed
 };
 
 class MassSpringTissue {
@@ -96,6 +114,41 @@ class MassSpringTissue {
   /// hashed once (about half the bytes at 8640 triangles); whatever changes the topology must renew it.
   std::uint64_t state_hash() const;
 
+  // ---- Topology edits (resection). Call between physics steps while no refit or search runs (the
+  // core does so at a collision tick, after publishing the candidates and before the next search).
+  /// The live tetrahedra, their neighbours and each node's tetrahedra, in the tissue's numbering.
+  const TetTopology& topology() const { return topology_; }
+  /// Whether an edit adding `nodes` nodes and `added` tetrahedra, removing `removed`, fits the room
+  /// reserved at construction.
+  bool can_edit(std::size_t nodes, std::size_t added, std::size_t removed) const;
+  /// Appends one node per pair at the pair's midpoint: rest position, position and velocity are the
+  /// parents' averages. New node ids follow the existing ones in the tissue's and the mesh's
+  /// numbering alike. The nodes stay orphans (massless, still) until a tetrahedron holds them.
+  void add_midpoint_nodes(std::span<const std::array<std::uint32_t, 2>> parents);
+  /// Removes the live slots `removed`, then adds `added` (with their regions): springs whose edge no
+  /// live tetrahedron holds go, new edges get springs, masses, spring constants and bounds are
+  /// recomputed at the touched nodes and springs, faces leave and join the surface and its sphere
+  /// tree (insert/remove; rebuilt only when should_rebuild()), contact candidates on changed faces and
+  /// orphaned nodes are dropped and every clearance certificate voided, the topology hash renewed.
+  /// Refused (nothing changes) when it does not fit the capacities. The added slots are listed by
+  /// added_slots() until the next edit.
+  TopologyChange edit_tetrahedra(std::span<const std::uint32_t> removed, std::span<const Tetrahedron> added,
+                                 std::span<const TissueRegion> added_regions);
+  std::span<const std::uint32_t> added_slots() const { return added_slots_; }
+  /// Rest volume of live slot t (m^3).
+  double rest_volume_m3(std::uint32_t t) const;
+  /// Whether `node` is held by a capsule anchor spring (and still by a tetrahedron).
+  bool anchored(std::uint32_t node) const { return anchor_of_node_[node] >= 0 && topology_.valence(node) > 0; }
+  /// The tetrahedron slot and face (4 t + f) behind surface face slot s, or -1 for a free slot.
+  std::int64_t surface_face_owner(std::size_t s) const { return face_owner_[s]; }
+  std::size_t surface_face_count() const { return surface_faces_; }
+  std::size_t surface_face_capacity() const { return surface_face_capacity_; }
+  std::size_t node_capacity() const { return topology_.node_capacity(); }
+  /// Bumped by every edit that changed the surface.
+  std::uint64_t topology_version() const { return topology_version_; }
+  /// The live surface, compacted (free slots skipped, in slot order) over the tissue's nodes.
+  TriangleMesh live_surface(bool rest_positions) const;
+
   std::size_t node_count() const { return x_.size(); }
   /// The mesh's index of the tissue's node `node`.
   std::uint32_t mesh_node(std::size_t node) const { return mesh_node_[node]; }
@@ -130,6 +183,22 @@ class MassSpringTissue {
   MassSpringTissue(OrderedMesh&& ordered, const TissueParameters& parameters, const TissueConfig& config);
 
   void update_material();
+  /// A node's mass and the parameters' part of its bounds from its volume, springs and anchor.
+  void update_node_material(std::uint32_t node, double density, double viscous_rate);
+  void update_spring_material(std::size_t s, double modulus, double viscosity);
+  // Topology edit parts (tissue_topology.cpp).
+  void reserve_topology(std::size_t node_capacity, std::size_t tetrahedron_capacity);
+  void map_initial_surface();
+  std::int32_t find_spring(std::uint32_t a, std::uint32_t b) const;
+  void insert_spring_key(std::uint32_t a, std::uint32_t b, std::uint32_t s);
+  /// Recomputes a spring's volume share from the live tetrahedra holding its edge; returns how many do.
+  int recompute_spring_share(std::size_t s);
+  void add_surface_face(std::uint32_t t, int f);
+  void remove_surface_face(std::uint32_t t, int f);
+  std::uint64_t tetrahedron_hash(std::uint32_t t) const;
+  /// How many faces an edit can add to the surface at most (removed slots stamped with stamp_).
+  std::size_t surface_growth_bound(std::span<const std::uint32_t> removed, std::span<const Tetrahedron> added);
+  std::uint64_t face_hash(std::size_t s) const;
   void accumulate_forces(double h_s);
   void step_bounded_symplectic(double h_s);
   void step_substepped_symplectic(double h_s);
@@ -146,7 +215,6 @@ class MassSpringTissue {
   TissueConfig config_;
   std::vector<std::uint32_t> mesh_node_, tissue_node_;  // tissue -> mesh numbering, and back
   SpringNetwork network_;
-  std::vector<Tetrahedron> tetrahedra_;
 
   // Hot, per node.
   std::vector<Vec3> x_, v_, rest_, force_;
@@ -165,7 +233,30 @@ class MassSpringTissue {
 
   TriangleMesh surface_;
   SphereTree surface_tree_;
-  std::uint64_t topology_hash_ = 0;  // of the springs' nodes and the surface's triangles
+  std::uint64_t topology_hash_ = 0;  // of the live tetrahedra and the surface's faces, kept per edit
+  std::uint64_t topology_version_ = 0;
+  TetTopology topology_;
+  // Surface bookkeeping: per face slot, its owner 4 t + f (-1 free); per tetrahedron face, its slot.
+  std::vector<std::int64_t> face_owner_;
+  std::vector<std::int32_t> face_of_tetrahedron_;
+  std::vector<std::uint32_t> free_faces_;
+  std::size_t surface_faces_ = 0, surface_face_capacity_ = 0;
+  std::vector<std::int32_t> anchor_of_node_;  // per node: its anchor index, -1 if none
+  // Springs by edge: open addressing over (smaller << 32 | larger) -> spring index.
+  std::vector<std::uint64_t> spring_keys_;
+  std::vector<std::uint32_t> spring_values_;
+  std::size_t spring_capacity_ = 0;
+  // Edit scratch, reserved at construction.
+  std::vector<std::uint32_t> node_stamp_, spring_stamp_, touched_nodes_, touched_springs_, added_slots_;
+  std::vector<std::uint32_t> slot_stamp_, changed_faces_;
+  std::vector<std::uint8_t> changed_face_, dead_node_;
+  std::vector<std::int64_t> exposed_faces_;
+  std::vector<std::array<std::uint32_t, 3>> face_keys_;
+  struct NewSpring {
+    std::uint32_t i, j;  // i the newer node
+  };
+  std::vector<NewSpring> new_springs_;
+  std::uint32_t stamp_ = 0;
   ToolContacts tool_;
   ToolReaction reaction_;
   TissueFaults faults_;

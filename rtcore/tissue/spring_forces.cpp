@@ -35,13 +35,44 @@ SpringForces::SpringForces(const SpringNetwork& network) {
   arrays_.c.assign(count, 0.0);
   arrays_.f.assign(count, SpringForce{});
   arrays_.compressed.assign(count, 0);
+  for (std::size_t s = 0; s < count; ++s) {
+    arrays_.i[s] = network.spring_nodes[2 * s];
+    arrays_.j[s] = network.spring_nodes[2 * s + 1];
+  }
+  rebuild_incidence(nodes);
+}
+
+void SpringForces::reserve(std::size_t spring_capacity, std::size_t node_capacity) {
+  arrays_.i.reserve(spring_capacity);
+  arrays_.j.reserve(spring_capacity);
+  arrays_.rest_m.reserve(spring_capacity);
+  arrays_.k.reserve(spring_capacity);
+  arrays_.c.reserve(spring_capacity);
+  arrays_.f.reserve(spring_capacity);
+  arrays_.compressed.reserve(spring_capacity);
+  incidence_.second_springs.reserve(spring_capacity);
+  incidence_.second_first.reserve(node_capacity + 1);
+  incidence_.first_first.reserve(node_capacity + 1);
+  fill_.reserve(node_capacity + 1);
+}
+
+void SpringForces::append(std::uint32_t i, std::uint32_t j, double rest_m) {
+  arrays_.i.push_back(i);
+  arrays_.j.push_back(j);
+  arrays_.rest_m.push_back(rest_m);
+  arrays_.k.push_back(0.0);
+  arrays_.c.push_back(0.0);
+  arrays_.f.push_back(SpringForce{});
+  arrays_.compressed.push_back(0);
+}
+
+void SpringForces::rebuild_incidence(std::size_t nodes) {
   // Counting sort by node, springs visited in ascending order: each node's list is ascending.
+  const std::size_t count = arrays_.i.size();
   SpringIncidence& in = incidence_;
   in.second_first.assign(nodes + 1, 0);
   in.first_first.assign(nodes + 1, 0);
   for (std::size_t s = 0; s < count; ++s) {
-    arrays_.i[s] = network.spring_nodes[2 * s];
-    arrays_.j[s] = network.spring_nodes[2 * s + 1];
     ++in.first_first[arrays_.i[s] + 1];
     ++in.second_first[arrays_.j[s] + 1];
   }
@@ -50,8 +81,8 @@ SpringForces::SpringForces(const SpringNetwork& network) {
     in.second_first[n + 1] += in.second_first[n];
   }
   in.second_springs.resize(count);
-  std::vector<std::uint32_t> fill(in.second_first.begin(), in.second_first.end() - 1);
-  for (std::size_t s = 0; s < count; ++s) in.second_springs[fill[arrays_.j[s]]++] = static_cast<std::uint32_t>(s);
+  fill_.assign(in.second_first.begin(), in.second_first.end() - 1);
+  for (std::size_t s = 0; s < count; ++s) in.second_springs[fill_[arrays_.j[s]]++] = static_cast<std::uint32_t>(s);
 }
 
 void SpringForces::add_compression_bounds(const Vec3* x, double* stiffness_bound, std::size_t count) const {

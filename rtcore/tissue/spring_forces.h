@@ -34,6 +34,18 @@ class SpringForces {
   void add_sums(Vec3* force) const { add_spring_sums(incidence_, arrays_.f.data(), force, incidence_.first_first.size() - 1); }
   const SpringIncidence& incidence() const { return incidence_; }
 
+  // Resection's edits (between steps). A removed spring stays in place with k = c = 0 (it then
+  // forms no force), so the order the node pass relies on never breaks.
+  /// Reserves room for this many springs and nodes, so appends and recounts allocate nothing.
+  void reserve(std::size_t spring_capacity, std::size_t node_capacity);
+  /// Appends a spring with k = c = 0. Its node i must be at least every earlier spring's node i
+  /// (refinement's springs all hold a node newer than any before, so i is that node); then the
+  /// springs stay sorted by i and each node's i-range stays contiguous.
+  void append(std::uint32_t i, std::uint32_t j, double rest_m);
+  /// Recounts the incidence over `node_count` nodes after appends (counting sort, no allocation
+  /// within the reserved room).
+  void rebuild_incidence(std::size_t node_count);
+
   /// Adds, in spring order, the Hessian-norm excess of each spring compressed below half its rest
   /// length to both its nodes' stiffness bounds (k |1 - L0/L| exceeds the k already counted): the
   /// `count` springs the last compute() listed.
@@ -45,6 +57,7 @@ class SpringForces {
  private:
   SpringArrays arrays_;
   SpringIncidence incidence_;
+  std::vector<std::uint32_t> fill_;  // scratch of rebuild_incidence
 };
 
 }  // namespace resecto

@@ -432,4 +432,29 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
   return reaction;
 }
 
+void ToolContacts::invalidate_tissue(std::span<const std::uint8_t> changed_face, std::span<const std::uint8_t> dead_node) {
+  // In stored order, compacting each point's pairs in place: the survivors keep their order.
+  for (std::size_t i = 0; i < node_count_; ++i) {
+    PointCandidates& pc = node_candidates_[i];
+    if (pc.point < dead_node.size() && dead_node[pc.point]) pc.count = 0;
+    node_clearance_[i].radius = 0.0;
+  }
+  for (std::size_t i = 0; i < vertex_count_; ++i) {
+    PointCandidates& pc = vertex_candidates_[i];
+    std::uint32_t kept = 0;
+    for (std::uint32_t e = 0; e < pc.count; ++e) {
+      const std::uint32_t face = pair_triangles_[pc.first + e];
+      if (face < changed_face.size() && changed_face[face]) continue;
+      pair_triangles_[pc.first + kept++] = face;
+    }
+    pc.count = kept;
+    vertex_clearance_[i].radius = 0.0;
+  }
+}
+
+void ToolContacts::reserve_tissue(std::size_t max_nodes, std::size_t max_faces) {
+  if (node_stamp_.size() < max_nodes) node_stamp_.assign(max_nodes, 0);
+  if (tissue_triangle_stamp_.size() < max_faces) tissue_triangle_stamp_.assign(max_faces, 0);
+}
+
 }  // namespace resecto

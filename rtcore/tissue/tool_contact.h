@@ -104,6 +104,15 @@ class ToolContacts {
   /// benchmarks compare against. The forces are the same either way.
   void set_clearance_skipping(bool enabled) { clearance_skipping_ = enabled; }
 
+  /// After a topology edit of the tissue (resection), between physics steps with no search running:
+  /// drops the published pairs whose tissue face slot changed (`changed_face[s] != 0`: removed or
+  /// reused) and the candidate tissue nodes that were orphaned (`dead_node[n] != 0`), and voids every
+  /// clearance certificate, since the surface they measured against is not the one now. New faces
+  /// become candidates at the next search.
+  void invalidate_tissue(std::span<const std::uint8_t> changed_face, std::span<const std::uint8_t> dead_node);
+  /// Sizes the search's per-node and per-face stamps for a tissue that may grow to these counts, so
+  /// a growing surface does not allocate at a search.
+  void reserve_tissue(std::size_t max_nodes, std::size_t max_faces);
   const ToolContactStats& stats() const { return stats_; }
   /// Point evaluations add_forces() ran and skipped on its certificates, since construction.
   std::int64_t points_evaluated() const { return points_evaluated_; }

@@ -1,0 +1,437 @@
+// Resection at a collision-step boundary: candidates near the wire, refinement, the centroid cut,
+// hanging tetrahedra, chips, and the accounting by region and stroke. Every list is sorted by slot or
+// node before it is acted on, so the edits, and the tissue after them, are the same on every run.
+#include "rtcore/resection/resection.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace resecto {
+namespace {
+
+constexpr std::uint32_t kNoNode = 0xffffffffu;
+
+template <typename T>
+void sort_unique(std::vector<T>& values) {
+  std::sort(values.begin(), values.end());
+  values.erase(std::unique(values.begin(), values.end()), values.end());
+}
+
+bool holds(const Tetrahedron& tet, std::uint32_t n) { return std::find(tet.begin(), tet.end(), n) != tet.end(); }
+
+}  // namespace
+
+Resection::Resection(MassSpringTissue& tissue, const ResectionConfig& config)
+    : tissue_(tissue), config_(config), refiner_(tissue.node_capacity(), tissue.topology().tetrahedron_capacity()) {
+  const TetTopology& topo = tissue_.topology();
+  const std::size_t slots = topo.tetrahedron_capacity();
+  const std::size_t nodes = tissue_.node_capacity();
+  for (std::uint32_t t = 0; t < topo.slot_count(); ++t) {
+    if (!topo.alive(t)) continue;
+    stats_.initial_m3[static_cast<std::size_t>(topo.region(t))] += tissue_.rest_volume_m3(t);
+    reach_m_ = std::max(reach_m_, longest_rest_edge(t));
+  }
+  // The outer surface: initial faces not facing the channel's axis; its nodes, less the rim's.
+  outer_node_.assign(nodes, 0);
+  std::vector<std::uint8_t> on_channel(nodes, 0);
+  const Vec3 axis = glm::normalize(config_.channel_direction);
+  const TriangleMesh& surface = tissue_.surface();
+  std::span<const Vec3> rest = tissue_.rest_positions();
+  for (std::size_t s = 0; s < surface.triangles.size(); ++s) {
+    if (tissue_.surface_face_owner(s) < 0) continue;
+    const Triangle& tri = surface.triangles[s];
+    const Vec3 n = cross(rest[tri[1]] - rest[tri[0]], rest[tri[2]] - rest[tri[0]]);
+    const Vec3 c = (rest[tri[0]] + rest[tri[1]] + rest[tri[2]]) / 3.0;
+    const Vec3 radial = (c - config_.channel_origin) - dot(c - config_.channel_origin, axis) * axis;
+    const bool channel = dot(n, radial) < -0.3 * length(n) * length(radial);
+    for (std::uint32_t v : tri) (channel ? on_channel[v] : outer_node_[v]) = 1;
+  }
+  for (std::size_t v = 0; v < nodes; ++v) outer_node_[v] = outer_node_[v] && !on_channel[v];
+
+  candidates_.reserve(slots);
+  marked_.reserve(slots);
+  removing_.reserve(slots);
+  queue_.reserve(slots);
+  seeds_.reserve(4 * slots);
+  slot_stamp_.assign(slots, 0);
+  slot_level_.assign(slots, 0);
+  slot_closure_.assign(slots, 0);
+  child_count_.assign(slots, 0);
+  child_info_.reserve(slots);
+  removed_nodes_.reserve(4 * slots);
+  removed_edges_.reserve(6 * slots);
+  next_nodes_.reserve(nodes);
+  node_stamp_.assign(nodes, 0);
+  star_.reserve(4096);
+  group_.reserve(4096);
+  group_size_.reserve(4096);
+  fan_edges_.reserve(4096);
+  stats_.perforation_sites.reserve(config_.max_perforation_sites);
+}
+
+std::uint32_t Resection::next_stamp() {
+  if (++stamp_ == 0) {
+    std::fill(slot_stamp_.begin(), slot_stamp_.end(), 0u);
+    std::fill(node_stamp_.begin(), node_stamp_.end(), 0u);
+    stamp_ = 1;
+  }
+  return stamp_;
+}
+
+Vec3 Resection::centroid(std::uint32_t t) const {
+  const Tetrahedron& tet = tissue_.topology().tetrahedron(t);
+  std::span<const Vec3> x = tissue_.positions();
+  return 0.25 * (x[tet[0]] + x[tet[1]] + x[tet[2]] + x[tet[3]]);
+}
+
+double Resection::longest_rest_edge(std::uint32_t t) const {
+  const Tetrahedron& tet = tissue_.topology().tetrahedron(t);
+  std::span<const Vec3> rest = tissue_.rest_positions();
+  double longest2 = 0.0;
+  for (const auto& e : kTetEdgeCorners) {
+    longest2 = std::max(longest2, length_squared(rest[tet[static_cast<std::size_t>(e[0])]] - rest[tet[static_cast<std::size_t>(e[1])]]));
+  }
+  return std::sqrt(longest2);
+}
+
+RegionVolumes Resection::remaining_m3() const {
+  RegionVolumes out{};
+  const TetTopology& topo = tissue_.topology();
+  for (std::uint32_t t = 0; t < topo.slot_count(); ++t) {
+    if (topo.alive(t)) out[static_cast<std::size_t>(topo.region(t))] += tissue_.rest_volume_m3(t);
+  }
+  return out;
+}
+
+ResectionStep Resection::step(const SweptVolume* sweep, bool pedal_down, bool distal, double period_s) {
+  ResectionStep out;
+  if (!pedal_down) in_stroke_ = false;
+  if (pedal_down && !in_stroke_) {
+    in_stroke_ = true;
+    stroke_cut_ = stroke_perforated_ = stroke_distal_ = false;
+  }
+  if (sweep != nullptr) {
+    gather_candidates(*sweep);
+    if (config_.refine) out.refined_tetrahedra = refine_near(*sweep);
+    // The cut: live candidates whose centroid the wire's path came within the radius of, by slot.
+    removing_.clear();
+    for (std::uint32_t t : candidates_) {
+      if (tissue_.topology().alive(t) && sweep->contains(centroid(t))) removing_.push_back(t);
+    }
+    if (!removing_.empty()) {
+      // A removed tetrahedron with a face on the gland's outer surface opens it.
+      const TetTopology& topo = tissue_.topology();
+      for (std::uint32_t t : removing_) {
+        for (int f = 0; f < 4 && !out.perforated; ++f) {
+          if (topo.neighbor(t, f) != TetTopology::kNone) continue;
+          const Triangle face = topo.face(t, f);
+          if (outer_node_[face[0]] && outer_node_[face[1]] && outer_node_[face[2]]) {
+            out.perforated = true;
+            if (!stroke_perforated_ && stats_.perforation_sites.size() < config_.max_perforation_sites) {
+              std::span<const Vec3> x = tissue_.positions();
+              stats_.perforation_sites.push_back((x[face[0]] + x[face[1]] + x[face[2]]) / 3.0);
+            }
+          }
+        }
+      }
+      remove(removing_, false, out);
+      // A chip's going can split the chain of tetrahedra around one of its edges: until neither
+      // finds anything, hanging tetrahedra then chips again.
+      for (int round = 0; round < 16; ++round) {
+        remove_hanging(out);
+        if (!remove_chips(out)) break;
+      }
+    }
+  }
+  removed_nodes_.clear();
+  removed_edges_.clear();
+  seeds_.clear();
+  const bool removed = out.cut_tetrahedra + out.hanging_tetrahedra + out.chip_tetrahedra > 0;
+  if (removed && !stroke_cut_) {
+    stroke_cut_ = true;
+    ++stats_.cuts;
+  }
+  if (out.perforated && !stroke_perforated_) {
+    stroke_perforated_ = true;
+    ++stats_.perforations;
+  }
+  if (removed && distal) {
+    stats_.sphincter_zone_cut_s += period_s;
+    if (!stroke_distal_) {
+      stroke_distal_ = true;
+      ++stats_.sphincter_zone_violations;
+    }
+  }
+  if (pedal_down && !removed) stats_.loop_on_idle_s += period_s;
+  return out;
+}
+
+void Resection::gather_candidates(const SweptVolume& sweep) {
+  // Every live tetrahedron with a node within the largest edge of the volume's box: a tetrahedron
+  // whose centroid is inside the box has all its nodes that close (deformation aside, which the
+  // initial longest edge covers many times over for the loop's small region).
+  candidates_.clear();
+  const std::uint32_t stamp = next_stamp();
+  Aabb box = sweep.bounds();
+  box.min -= Vec3(reach_m_);
+  box.max += Vec3(reach_m_);
+  const TetTopology& topo = tissue_.topology();
+  std::span<const Vec3> x = tissue_.positions();
+  for (std::uint32_t n = 0; n < x.size(); ++n) {
+    const Vec3& p = x[n];
+    if (p.x < box.min.x || p.y < box.min.y || p.z < box.min.z || p.x > box.max.x || p.y > box.max.y || p.z > box.max.z) continue;
+    topo.for_each_tetrahedron_of(n, [&](std::uint32_t t) {
+      if (slot_stamp_[t] == stamp) return;
+      slot_stamp_[t] = stamp;
+      candidates_.push_back(t);
+    });
+  }
+  std::sort(candidates_.begin(), candidates_.end());
+}
+
+int Resection::refine_near(const SweptVolume& sweep) {
+  int refined = 0;
+  const double target = config_.target_edge_per_radius * sweep.radius();
+  for (int round = 0; round < config_.max_refinement_rounds; ++round) {
+    const TetTopology& topo = tissue_.topology();
+    marked_.clear();
+    for (std::uint32_t t : candidates_) {
+      // A closure's children are not refined again (their parent's split is not regular; splitting
+      // them spreads closures outward without end), nor tetrahedra already at the deepest level.
+      if (!topo.alive(t) || slot_closure_[t] || slot_level_[t] >= config_.max_refinement_levels) continue;
+      const double longest = longest_rest_edge(t);
+      if (longest <= target) continue;
+      // Only where the cut surface will run: a centroid within a quarter edge of the volume's rim.
+      if (sweep.path_distance(centroid(t)) <= sweep.radius() + 0.25 * longest) marked_.push_back(t);
+    }
+    if (marked_.empty()) break;
+    const TetMeshView view{tissue_.rest_positions(), topo.tetrahedra(), topo.alive_flags(), topo.regions()};
+    const RefinementEdit& edit = refiner_.plan(view, marked_);
+    if (!tissue_.can_edit(edit.new_node_parents.size(), edit.added_tetrahedra.size(), edit.removed_tetrahedra.size())) {
+      ++stats_.refusals;
+      break;
+    }
+    // Each child's level and whether it closes rather than refines (a red parent has 8 children),
+    // read before the children take their slots (which may be their parents').
+    for (std::uint32_t parent : edit.removed_tetrahedra) child_count_[parent] = 0;
+    for (std::uint32_t parent : edit.added_parent) ++child_count_[parent];
+    child_info_.clear();
+    for (std::uint32_t parent : edit.added_parent) {
+      const bool closure = slot_closure_[parent] || child_count_[parent] != 8;
+      child_info_.push_back(static_cast<std::uint8_t>((slot_level_[parent] + 1) | (closure ? 0x80 : 0)));
+    }
+    tissue_.add_midpoint_nodes(edit.new_node_parents);
+    for (std::size_t k = 0; k < edit.new_node_parents.size(); ++k) {
+      const auto& [a, b] = edit.new_node_parents[k];
+      outer_node_[edit.first_new_node + k] = outer_node_[a] && outer_node_[b];
+    }
+    const TopologyChange change = tissue_.edit_tetrahedra(edit.removed_tetrahedra, edit.added_tetrahedra, edit.added_regions);
+    if (change.refused) {
+      ++stats_.refusals;
+      break;
+    }
+    refined += edit.red_tetrahedra + edit.closure_tetrahedra;
+    for (std::size_t k = 0; k < tissue_.added_slots().size(); ++k) {
+      const std::uint32_t t = tissue_.added_slots()[k];
+      slot_level_[t] = static_cast<std::uint8_t>(child_info_[k] & 0x7f);
+      slot_closure_[t] = (child_info_[k] & 0x80) != 0;
+    }
+    // The candidates now: the survivors and the children, by slot.
+    std::erase_if(candidates_, [&](std::uint32_t t) { return !tissue_.topology().alive(t); });
+    for (std::uint32_t t : tissue_.added_slots()) candidates_.push_back(t);
+    sort_unique(candidates_);
+  }
+  stats_.refined_tetrahedra += refined;
+  return refined;
+}
+
+void Resection::remove(std::vector<std::uint32_t>& slots, bool chip, ResectionStep& out) {
+  sort_unique(slots);
+  const TetTopology& topo = tissue_.topology();
+  RegionVolumes volume{};
+  const std::size_t nodes_before = removed_nodes_.size(), edges_before = removed_edges_.size(), seeds_before = seeds_.size();
+  for (std::uint32_t t : slots) {
+    volume[static_cast<std::size_t>(topo.region(t))] += tissue_.rest_volume_m3(t);
+    const Tetrahedron& tet = topo.tetrahedron(t);
+    for (std::uint32_t n : tet) removed_nodes_.push_back(n);
+    for (const auto& e : kTetEdgeCorners) {
+      const std::uint32_t a = tet[static_cast<std::size_t>(e[0])], b = tet[static_cast<std::size_t>(e[1])];
+      removed_edges_.push_back(static_cast<std::uint64_t>(std::min(a, b)) << 32 | std::max(a, b));
+    }
+    for (int f = 0; f < 4; ++f) {
+      const std::int32_t n = topo.neighbor(t, f);
+      if (n != TetTopology::kNone) seeds_.push_back(static_cast<std::uint32_t>(n));
+    }
+  }
+  const TopologyChange change = tissue_.edit_tetrahedra(slots, {}, {});
+  if (change.refused) {
+    ++stats_.refusals;
+    removed_nodes_.resize(nodes_before);
+    removed_edges_.resize(edges_before);
+    seeds_.resize(seeds_before);
+    return;
+  }
+  for (std::size_t r = 1; r < volume.size(); ++r) {
+    stats_.removed_m3[r] += volume[r];
+    if (chip) stats_.chip_m3[r] += volume[r];
+    out.removed_m3 += volume[r];
+  }
+  stats_.removed_tetrahedra += static_cast<std::int64_t>(slots.size());
+  (chip ? out.chip_tetrahedra : out.cut_tetrahedra) += static_cast<std::int32_t>(slots.size());
+}
+
+int Resection::star_groups(std::uint32_t a, std::uint32_t b) {
+  // Flood through faces that hold a (and b): two tetrahedra of the star sharing a face share them.
+  const TetTopology& topo = tissue_.topology();
+  group_.assign(star_.size(), -1);
+  group_size_.clear();
+  int groups = 0;
+  for (std::size_t first = 0; first < star_.size(); ++first) {
+    if (group_[first] >= 0) continue;
+    group_[first] = groups;
+    group_size_.push_back(1);
+    queue_.clear();
+    queue_.push_back(static_cast<std::uint32_t>(first));
+    for (std::size_t q = 0; q < queue_.size(); ++q) {
+      const std::uint32_t t = star_[queue_[q]];
+      const Tetrahedron& tet = topo.tetrahedron(t);
+      for (int f = 0; f < 4; ++f) {
+        if (tet[static_cast<std::size_t>(f)] == a || tet[static_cast<std::size_t>(f)] == b) continue;  // the face opposite misses them
+        const std::int32_t n = topo.neighbor(t, f);
+        if (n == TetTopology::kNone) continue;
+        const auto it = std::lower_bound(star_.begin(), star_.end(), static_cast<std::uint32_t>(n));
+        if (it == star_.end() || *it != static_cast<std::uint32_t>(n)) continue;
+        const auto k = static_cast<std::size_t>(it - star_.begin());
+        if (group_[k] >= 0) continue;
+        group_[k] = groups;
+        ++group_size_.back();
+        queue_.push_back(static_cast<std::uint32_t>(k));
+      }
+    }
+    ++groups;
+  }
+  return groups;
+}
+
+bool Resection::vertex_fan_is_disk(std::uint32_t v) {
+  // The surface faces around v, each seen from v as an edge p -> q of its link: a closed fan when
+  // they chain into one cycle (no vertex of the link starts two of them).
+  const TetTopology& topo = tissue_.topology();
+  fan_edges_.clear();
+  for (std::uint32_t t : star_) {
+    const Tetrahedron& tet = topo.tetrahedron(t);
+    for (int f = 0; f < 4; ++f) {
+      if (tet[static_cast<std::size_t>(f)] == v || topo.neighbor(t, f) != TetTopology::kNone) continue;
+      const Triangle face = topo.face(t, f);
+      const int at = face[0] == v ? 0 : (face[1] == v ? 1 : 2);
+      fan_edges_.push_back({face[static_cast<std::size_t>((at + 1) % 3)], face[static_cast<std::size_t>((at + 2) % 3)]});
+    }
+  }
+  if (fan_edges_.empty()) return true;  // an inner node
+  std::sort(fan_edges_.begin(), fan_edges_.end());
+  for (std::size_t e = 1; e < fan_edges_.size(); ++e) {
+    if (fan_edges_[e][0] == fan_edges_[e - 1][0]) return false;
+  }
+  std::size_t steps = 0;
+  std::uint32_t at = fan_edges_[0][0];
+  do {
+    const auto it = std::lower_bound(fan_edges_.begin(), fan_edges_.end(), std::array<std::uint32_t, 2>{at, 0});
+    if (it == fan_edges_.end() || (*it)[0] != at) return false;  // an open chain: not closed
+    at = (*it)[1];
+    ++steps;
+  } while (at != fan_edges_[0][0] && steps <= fan_edges_.size());
+  return steps == fan_edges_.size();
+}
+
+void Resection::remove_hanging(ResectionStep& out) {
+  // Around every node and edge the last removals touched, in ascending order: a star in more than one
+  // face-connected group keeps its largest (ties: the one with the lowest slot) and loses the rest; a
+  // node whose star is one group but whose surface there is not one closed fan loses its star.
+  const TetTopology& topo = tissue_.topology();
+  for (int round = 0; round < 64; ++round) {
+    sort_unique(removed_nodes_);
+    sort_unique(removed_edges_);
+    removing_.clear();
+    auto drop_all_but_largest = [&](int groups) {
+      int keep = 0;
+      for (int g = 1; g < groups; ++g) {
+        if (group_size_[static_cast<std::size_t>(g)] > group_size_[static_cast<std::size_t>(keep)]) keep = g;
+      }
+      for (std::size_t k = 0; k < star_.size(); ++k) {
+        if (group_[k] != keep) removing_.push_back(star_[k]);
+      }
+      stats_.chips += groups - 1;
+    };
+    for (std::uint32_t v : removed_nodes_) {
+      if (topo.valence(v) == 0) continue;
+      star_.clear();
+      topo.for_each_tetrahedron_of(v, [&](std::uint32_t t) { star_.push_back(t); });
+      std::sort(star_.begin(), star_.end());
+      const int groups = star_groups(v, kNoNode);
+      if (groups > 1) {
+        drop_all_but_largest(groups);
+      } else if (!vertex_fan_is_disk(v)) {
+        for (std::uint32_t t : star_) removing_.push_back(t);
+        ++stats_.chips;
+      }
+    }
+    for (std::uint64_t key : removed_edges_) {
+      const auto a = static_cast<std::uint32_t>(key >> 32), b = static_cast<std::uint32_t>(key & 0xffffffffu);
+      if (topo.valence(a) == 0 || topo.valence(b) == 0) continue;
+      star_.clear();
+      topo.for_each_tetrahedron_of(a, [&](std::uint32_t t) {
+        if (holds(topo.tetrahedron(t), b)) star_.push_back(t);
+      });
+      if (star_.size() < 2) continue;
+      std::sort(star_.begin(), star_.end());
+      const int groups = star_groups(a, b);
+      if (groups > 1) drop_all_but_largest(groups);
+    }
+    removed_nodes_.clear();
+    removed_edges_.clear();
+    if (removing_.empty()) return;
+    const std::size_t before = static_cast<std::size_t>(out.chip_tetrahedra);
+    remove(removing_, true, out);
+    out.hanging_tetrahedra += out.chip_tetrahedra - static_cast<std::int32_t>(before);
+    out.chip_tetrahedra = static_cast<std::int32_t>(before);
+  }
+}
+
+bool Resection::remove_chips(ResectionStep& out) {
+  // From each live neighbour of what was removed, by slot: flood through faces until an anchored
+  // node shows the component is held; a component that runs out first is a chip.
+  const TetTopology& topo = tissue_.topology();
+  bool any = false;
+  sort_unique(seeds_);
+  const std::uint32_t stamp = next_stamp();
+  next_nodes_.clear();  // the seeds, copied: remove() appends to seeds_
+  for (std::uint32_t s : seeds_) next_nodes_.push_back(s);
+  seeds_.clear();
+  for (std::uint32_t seed : next_nodes_) {
+    if (!topo.alive(seed) || slot_stamp_[seed] == stamp) continue;
+    queue_.clear();
+    queue_.push_back(seed);
+    slot_stamp_[seed] = stamp;
+    bool held = false;
+    for (std::size_t q = 0; q < queue_.size() && !held; ++q) {
+      const std::uint32_t t = queue_[q];
+      for (std::uint32_t n : topo.tetrahedron(t)) held = held || tissue_.anchored(n);
+      if (held) break;
+      for (int f = 0; f < 4; ++f) {
+        const std::int32_t n = topo.neighbor(t, f);
+        if (n == TetTopology::kNone || slot_stamp_[static_cast<std::uint32_t>(n)] == stamp) continue;
+        slot_stamp_[static_cast<std::uint32_t>(n)] = stamp;
+        queue_.push_back(static_cast<std::uint32_t>(n));
+      }
+    }
+    if (held) continue;
+    removing_.assign(queue_.begin(), queue_.end());
+    ++stats_.chips;
+    remove(removing_, true, out);
+    any = true;
+  }
+  next_nodes_.clear();
+  return any;
+}
+
+}  // namespace resecto

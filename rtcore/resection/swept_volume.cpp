@@ -1,0 +1,57 @@
+// The loop's swept volume: ribbons of triangles between the wire's samples at two collision steps.
+#include "rtcore/resection/swept_volume.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "rtcore/geometry/closest_point.h"
+
+namespace resecto {
+
+SweptVolume::SweptVolume(std::size_t max_points) { quads_.reserve(max_points); }
+
+void SweptVolume::set(std::span<const Vec3> from, std::span<const Vec3> to, double radius_m) {
+  quads_.clear();
+  radius_m_ = radius_m;
+  const std::size_t count = std::min(from.size(), to.size());
+  bounds_.min = Vec3(std::numeric_limits<double>::infinity());
+  bounds_.max = Vec3(-std::numeric_limits<double>::infinity());
+  for (std::size_t i = 0; i < count; ++i) {
+    for (const Vec3& p : {from[i], to[i]}) {
+      bounds_.min = glm::min(bounds_.min, p);
+      bounds_.max = glm::max(bounds_.max, p);
+    }
+  }
+  bounds_.min -= Vec3(radius_m);
+  bounds_.max += Vec3(radius_m);
+  for (std::size_t i = 0; i + 1 < count && quads_.size() < quads_.capacity(); ++i) {
+    Quad q{from[i], from[i + 1], to[i + 1], to[i], Vec3(0.0), 0.0};
+    q.centre = 0.25 * (q.a0 + q.a1 + q.b1 + q.b0);
+    for (const Vec3& p : {q.a0, q.a1, q.b1, q.b0}) q.reach = std::max(q.reach, length(p - q.centre));
+    quads_.push_back(q);
+  }
+}
+
+double SweptVolume::path_distance(const Vec3& p) const {
+  // Quads in wire order; the sphere around each skips those that cannot be nearer than the best.
+  double best2 = std::numeric_limits<double>::infinity();
+  for (const Quad& q : quads_) {
+    const double far = length(p - q.centre) - q.reach;
+    if (far > 0.0 && far * far >= best2) continue;
+    for (const Vec3& c : {closest_point_on_triangle(p, q.a0, q.a1, q.b1), closest_point_on_triangle(p, q.a0, q.b1, q.b0)}) {
+      best2 = std::min(best2, length_squared(p - c));
+    }
+  }
+  return std::sqrt(best2);
+}
+
+double SweptVolume::straight_stroke_volume(double span_m, double travel_m, double radius_m) {
+  // Minkowski sum of a span x travel rectangle with a ball: the slab 2 r s t, half-cylinders along the
+  // four sides pi r^2 (s + t), and the four quarter... corners, which together make one ball 4/3 pi r^3.
+  const double r = radius_m;
+  return 2.0 * r * span_m * travel_m + std::numbers::pi * r * r * (span_m + travel_m) + 4.0 / 3.0 * std::numbers::pi * r * r * r;
+}
+
+}  // namespace resecto
