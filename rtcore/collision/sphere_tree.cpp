@@ -238,9 +238,11 @@ void SphereTree::build_over(const TriangleMesh& mesh, const std::vector<std::uin
   leaf_count_ = 0;
   live_nodes_ = 0;
   for (const std::uint32_t t : triangles) add_triangle_leaves(mesh, t, false);
+  build_mesh_ = &mesh;
   std::vector<std::int32_t> leaves(static_cast<std::size_t>(leaf_count_));
   for (std::int32_t i = 0; i < leaf_count_; ++i) leaves[i] = i;  // leaves were allocated first
   if (!leaves.empty()) root_ = build_range(leaves.data(), leaves.data() + leaves.size(), kNoNode);
+  build_mesh_ = nullptr;
   renumber_depth_first();
   order_dirty_ = true;
   built_mean_internal_radius_ = quality().mean_internal_radius;
@@ -374,8 +376,35 @@ void SphereTree::cover_leaves(std::int32_t node, const std::int32_t* first, cons
   const Sphere direct = inflated(center, radius);
   const Sphere merged = merge(spheres_[links_[node].left], spheres_[links_[node].right]);
   spheres_[node] = direct.radius < merged.radius ? direct : merged;
-  const SphereTreeLinks& l = links_[node];
-  slabs_[node] = merge_slabs(spheres_[l.left], slabs_[l.left], spheres_[l.right], slabs_[l.right]);
+  // The slab likewise from the leaves' triangles directly, along their area-weighted mean normal:
+  // exact at the build, where merging the children's slabs (as refit does) widens it at every level.
+  Vec3 normal{0.0};
+  for (const std::int32_t* n = first; n != last; ++n) {
+    const Triangle& tri = build_mesh_->triangles[pieces_[*n].triangle];
+    const Vec3& a = build_mesh_->positions[tri[0]];
+    normal += cross(build_mesh_->positions[tri[1]] - a, build_mesh_->positions[tri[2]] - a);
+  }
+  const double normal_length = length(normal);
+  if (!(normal_length > 0.0) || !std::isfinite(normal_length)) {
+    const SphereTreeLinks& l = links_[node];
+    slabs_[node] = merge_slabs(spheres_[l.left], slabs_[l.left], spheres_[l.right], slabs_[l.right]);
+    return;
+  }
+  normal /= normal_length;
+  double slab_lo = INFINITY;
+  double slab_hi = -INFINITY;
+  double magnitude = 0.0;
+  for (const std::int32_t* n = first; n != last; ++n) {
+    for (const std::uint32_t v : build_mesh_->triangles[pieces_[*n].triangle]) {
+      const Vec3& p = build_mesh_->positions[v];
+      const double along = dot(normal, p);
+      slab_lo = std::min(slab_lo, along);
+      slab_hi = std::max(slab_hi, along);
+      magnitude = std::max(magnitude, max_abs(p));
+    }
+  }
+  const double pad = 1e-12 * magnitude;
+  slabs_[node] = {normal, slab_lo - pad, slab_hi + pad};
 }
 
 // ---- Refit ------------------------------------------------------------------------------------

@@ -175,6 +175,7 @@ class SphereTree {
   std::int32_t free_list_ = kNoNode;
   std::int32_t leaf_count_ = 0;
   std::int32_t live_nodes_ = 0;
+  const TriangleMesh* build_mesh_ = nullptr;  // the mesh of the build under way
   bool order_dirty_ = true;
   bool preorder_ = false;  // every child's index is above its parent's: refit sweeps the array backwards
   std::uint64_t structure_version_ = 0;
