@@ -514,6 +514,38 @@ void BM_Query8640(benchmark::State& state) {
 }
 BENCHMARK(BM_Query8640);
 
+// The refit after a deformation (spheres and slabs of every node), ours and FCL's AABB tree.
+void BM_Refit(benchmark::State& state) {
+  ProstateModel gland = generate_prostate(static_cast<int>(state.range(0)));
+  TriangleMesh& mesh = gland.surface;
+  SphereTree tree;
+  tree.build(mesh);
+  const std::vector<Vec3> rest = mesh.positions;
+  deform(rest, mesh.positions, 0.7);
+  for (auto _ : state) {
+    tree.refit(mesh);
+    benchmark::DoNotOptimize(tree.spheres().data());
+  }
+}
+BENCHMARK(BM_Refit)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
+
+void BM_FclAabbRefit(benchmark::State& state) {
+  ProstateModel gland = generate_prostate(static_cast<int>(state.range(0)));
+  TriangleMesh& mesh = gland.surface;
+  auto model = fcl_model<fcl::AABBd>(mesh);
+  const std::vector<Vec3> rest = mesh.positions;
+  deform(rest, mesh.positions, 0.7);
+  std::vector<fcl::Vector3d> moved(rest.size());
+  for (std::size_t v = 0; v < rest.size(); ++v) moved[v] = fcl::Vector3d(mesh.positions[v].x, mesh.positions[v].y, mesh.positions[v].z);
+  for (auto _ : state) {
+    model->beginUpdateModel();
+    model->updateSubModel(moved);
+    model->endUpdateModel(true, true);
+    benchmark::DoNotOptimize(model.get());
+  }
+}
+BENCHMARK(BM_FclAabbRefit)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
+
 }  // namespace
 
 int main(int argc, char** argv) {

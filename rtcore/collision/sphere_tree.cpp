@@ -174,6 +174,7 @@ std::int32_t SphereTree::allocate_node() {
   }
   spheres_.emplace_back();
   slabs_.emplace_back();
+  leans_.emplace_back();
   links_.emplace_back();
   pieces_.emplace_back();
   next_leaf_.push_back(kNoNode);
@@ -229,6 +230,7 @@ void SphereTree::build_over(const TriangleMesh& mesh, const std::vector<std::uin
   ++structure_version_;
   spheres_.clear();
   slabs_.clear();
+  leans_.clear();
   links_.clear();
   pieces_.clear();
   next_leaf_.clear();
@@ -337,6 +339,7 @@ void SphereTree::renumber_depth_first() {
   const auto remap = [&](std::int32_t n) { return n == kNoNode ? kNoNode : new_of[static_cast<std::size_t>(n)]; };
   std::vector<Sphere> spheres(old_of.size());
   std::vector<Slab> slabs(old_of.size());
+  std::vector<Lean> leans(old_of.size());
   std::vector<SphereTreeLinks> links(old_of.size());
   std::vector<LeafPiece> pieces(old_of.size());
   std::vector<std::int32_t> next_leaf(old_of.size());
@@ -344,6 +347,7 @@ void SphereTree::renumber_depth_first() {
     const auto o = static_cast<std::size_t>(old_of[i]);
     spheres[i] = spheres_[o];
     slabs[i] = slabs_[o];
+    leans[i] = leans_[o];
     pieces[i] = pieces_[o];
     next_leaf[i] = remap(next_leaf_[o]);
     const SphereTreeLinks& l = links_[o];
@@ -352,6 +356,7 @@ void SphereTree::renumber_depth_first() {
   for (std::int32_t& leaf : first_leaf_) leaf = remap(leaf);
   spheres_ = std::move(spheres);
   slabs_ = std::move(slabs);
+  leans_ = std::move(leans);
   links_ = std::move(links);
   pieces_ = std::move(pieces);
   next_leaf_ = std::move(next_leaf);
@@ -388,6 +393,7 @@ void SphereTree::cover_leaves(std::int32_t node, const std::int32_t* first, cons
   if (!(normal_length > 0.0) || !std::isfinite(normal_length)) {
     const SphereTreeLinks& l = links_[node];
     slabs_[node] = merge_slabs(spheres_[l.left], slabs_[l.left], spheres_[l.right], slabs_[l.right]);
+    set_child_leans(node);
     return;
   }
   normal /= normal_length;
@@ -405,6 +411,15 @@ void SphereTree::cover_leaves(std::int32_t node, const std::int32_t* first, cons
   }
   const double pad = 1e-12 * magnitude;
   slabs_[node] = {normal, slab_lo - pad, slab_hi + pad};
+  set_child_leans(node);
+}
+
+// The children's leans against this node's axis, which the refit reuses: internal normals keep their
+// direction between builds, so the sines are taken once, not at every refit.
+void SphereTree::set_child_leans(std::int32_t node) {
+  const SphereTreeLinks& l = links_[node];
+  leans_[l.left] = lean_of(slabs_[node].normal, slabs_[l.left].normal);
+  leans_[l.right] = lean_of(slabs_[node].normal, slabs_[l.right].normal);
 }
 
 // ---- Refit ------------------------------------------------------------------------------------
@@ -413,6 +428,7 @@ void SphereTree::refit_node(std::int32_t node) {
   const SphereTreeLinks& l = links_[node];
   spheres_[node] = merge(spheres_[l.left], spheres_[l.right]);
   slabs_[node] = merge_slabs(spheres_[l.left], slabs_[l.left], spheres_[l.right], slabs_[l.right]);
+  set_child_leans(node);
   links_[node].height = 1 + std::max(links_[l.left].height, links_[l.right].height);
 }
 
@@ -453,13 +469,58 @@ void SphereTree::update_refit_order() {
 
 void SphereTree::refit_leaf(const TriangleMesh& mesh, std::int32_t leaf) {
   const LeafPiece& piece = pieces_[leaf];
-  if (piece.slices == 1) {
-    const Triangle& tri = mesh.triangles[piece.triangle];
-    spheres_[leaf] = centroid_sphere(mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]]);
-  } else {
-    spheres_[leaf] = piece_sphere(mesh, piece);
+  const Triangle& tri = mesh.triangles[piece.triangle];
+  const Vec3& a = mesh.positions[tri[0]];
+  const Vec3& b = mesh.positions[tri[1]];
+  const Vec3& c = mesh.positions[tri[2]];
+  const Sphere sphere = piece.slices == 1 ? centroid_sphere(a, b, c) : piece_sphere(mesh, piece);
+  spheres_[leaf] = sphere;
+  // The triangle's plane (triangle_slab, with the pad taken from the sphere: every corner is within
+  // |centre| + radius of the origin).
+  const Vec3 n = cross(b - a, c - a);
+  const double n_length = length(n);
+  if (!(n_length > 0.0) || !std::isfinite(n_length)) {
+    slabs_[leaf] = triangle_slab(mesh, piece.triangle, sphere);
+    return;
   }
-  slabs_[leaf] = triangle_slab(mesh, piece.triangle, spheres_[leaf]);
+  const Vec3 normal = n * (1.0 / n_length);
+  const double da = dot(normal, a);
+  const double db = dot(normal, b);
+  const double dc = dot(normal, c);
+  const double pad = 1e-12 * (std::abs(sphere.center.x) + std::abs(sphere.center.y) + std::abs(sphere.center.z) + sphere.radius);
+  slabs_[leaf] = {normal, std::min({da, db, dc}) - pad, std::max({da, db, dc}) + pad};
+}
+
+// An internal node after its children: the sphere holding theirs, and the slab along the node's own
+// (unchanged) axis holding theirs: a leaf's triangle corners projected exactly, an internal child's
+// region through its stored lean.
+void SphereTree::refit_internal(const TriangleMesh& mesh, std::int32_t node) {
+  const SphereTreeLinks& l = links_[node];
+  spheres_[node] = merge(spheres_[l.left], spheres_[l.right]);
+  const Vec3 axis = slabs_[node].normal;
+  double lo = INFINITY;
+  double hi = -INFINITY;
+  for (const std::int32_t child : {l.left, l.right}) {
+    if (links_[child].height == 0) {
+      const Triangle& tri = mesh.triangles[pieces_[child].triangle];
+      for (const std::uint32_t v : tri) {
+        const double along = dot(axis, mesh.positions[v]);
+        lo = std::min(lo, along);
+        hi = std::max(hi, along);
+      }
+    } else {
+      double child_lo, child_hi;
+      project_region(spheres_[child], slabs_[child], axis, leans_[child], child_lo, child_hi);
+      lo = std::min(lo, child_lo);
+      hi = std::max(hi, child_hi);
+    }
+  }
+  // Every value above is a projection of a point within |centre| + radius of the origin, off by a
+  // few ulps of that; the pad is far above it.
+  const Sphere& s = spheres_[node];
+  const double pad = 1e-11 * (std::abs(s.center.x) + std::abs(s.center.y) + std::abs(s.center.z) + s.radius);
+  slabs_[node].lo = lo - pad;
+  slabs_[node].hi = hi + pad;
 }
 
 void SphereTree::refit(const TriangleMesh& mesh) {
@@ -468,24 +529,19 @@ void SphereTree::refit(const TriangleMesh& mesh) {
     // Depth-first numbering puts every child after its parent: one backward sweep over the arrays
     // meets children first, reading memory in order.
     for (std::int32_t n = node_capacity() - 1; n >= 0; --n) {
-      const SphereTreeLinks& l = links_[n];
-      if (l.height == 0) {
+      const std::int32_t height = links_[n].height;
+      if (height == 0) {
         refit_leaf(mesh, n);
-      } else if (l.height > 0) {
-        spheres_[n] = merge(spheres_[l.left], spheres_[l.right]);
-        slabs_[n] = merge_slabs(spheres_[l.left], slabs_[l.left], spheres_[l.right], slabs_[l.right]);
+      } else if (height > 0) {
+        refit_internal(mesh, n);
       }
     }
     return;
   }
-  // Leaves from their triangles' corners, then one bottom-up pass of O(1) merges: each internal
-  // sphere is the smallest holding its two children's, so every leaf below stays covered.
+  // Leaves from their triangles' corners, then one bottom-up pass of O(1) merges by height: each
+  // internal bound holds its two children's, so every leaf below stays covered.
   for (const std::int32_t leaf : refit_leaves_) refit_leaf(mesh, leaf);
-  for (const std::int32_t node : refit_internal_) {
-    const SphereTreeLinks& l = links_[node];
-    spheres_[node] = merge(spheres_[l.left], spheres_[l.right]);
-    slabs_[node] = merge_slabs(spheres_[l.left], slabs_[l.left], spheres_[l.right], slabs_[l.right]);
-  }
+  for (const std::int32_t node : refit_internal_) refit_internal(mesh, node);
 }
 
 // ---- Insert and remove ------------------------------------------------------------------------

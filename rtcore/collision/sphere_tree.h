@@ -30,19 +30,32 @@ struct Slab {
   double hi = 0.0;
 };
 
+/// How a unit `normal` leans off a unit `axis`: their cosine k and an upper bound on their sine
+/// (rounded up).
+struct Lean {
+  double k = 1.0;
+  double sine = 0.0;
+};
+inline Lean lean_of(const Vec3& axis, const Vec3& normal) {
+  const double k = dot(axis, normal);
+  return {k, std::sqrt(std::max(0.0, 1.0 - k * k) + 1e-15)};
+}
+
 /// Bounds the projection onto unit `axis` of the region inside both `sphere` and `slab` (the
-/// region a node's triangles lie in): the slab gives the part along its normal, the sphere the rest,
-/// scaled by how far the axis leans off that normal. Intersected with the sphere's own projection.
-/// Rounding is left to the caller's slack except in the lean, which is rounded up.
-inline void project_bound(const Sphere& sphere, const Slab& slab, const Vec3& axis, double& lo, double& hi) {
-  const double k = dot(axis, slab.normal);
-  const double lean = std::sqrt(std::max(0.0, 1.0 - k * k) + 1e-15);
+/// region a node's triangles lie in), `lean` being the slab normal's against the axis: the slab
+/// gives the part along its normal, the sphere the rest, scaled by the sine. Intersected with the
+/// sphere's own projection. Rounding is left to the caller's pad.
+inline void project_region(const Sphere& sphere, const Slab& slab, const Vec3& axis, const Lean& lean, double& lo,
+                           double& hi) {
   const double along = dot(axis, sphere.center);
-  const double rest = along - k * dot(slab.normal, sphere.center);
-  const double slab_lo = k >= 0.0 ? k * slab.lo : k * slab.hi;
-  const double slab_hi = k >= 0.0 ? k * slab.hi : k * slab.lo;
-  lo = std::max(slab_lo + rest - sphere.radius * lean, along - sphere.radius);
-  hi = std::min(slab_hi + rest + sphere.radius * lean, along + sphere.radius);
+  const double rest = along - lean.k * dot(slab.normal, sphere.center);
+  const double slab_lo = lean.k >= 0.0 ? lean.k * slab.lo : lean.k * slab.hi;
+  const double slab_hi = lean.k >= 0.0 ? lean.k * slab.hi : lean.k * slab.lo;
+  lo = std::max(slab_lo + rest - sphere.radius * lean.sine, along - sphere.radius);
+  hi = std::min(slab_hi + rest + sphere.radius * lean.sine, along + sphere.radius);
+}
+inline void project_bound(const Sphere& sphere, const Slab& slab, const Vec3& axis, double& lo, double& hi) {
+  project_region(sphere, slab, axis, lean_of(axis, slab.normal), lo, hi);
 }
 
 /// Which part of a triangle a leaf covers: the triangle is cut into `slices` slabs by lines
@@ -155,6 +168,8 @@ class SphereTree {
   void cover_leaves(std::int32_t node, const std::int32_t* first, const std::int32_t* last);
   void refit_node(std::int32_t node);
   void refit_leaf(const TriangleMesh& mesh, std::int32_t leaf);
+  void refit_internal(const TriangleMesh& mesh, std::int32_t node);
+  void set_child_leans(std::int32_t node);
   void refit_upward(std::int32_t node);
   void insert_leaf(std::int32_t leaf);
   void build_over(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles);
@@ -165,6 +180,7 @@ class SphereTree {
   std::vector<Sphere> spheres_;         // hot: per node
   std::vector<SphereTreeLinks> links_;  // per node
   std::vector<Slab> slabs_;             // hot: per node
+  std::vector<Lean> leans_;             // per node: its slab normal against its parent's
   std::vector<LeafPiece> pieces_;       // per node (leaves only)
   std::vector<std::int32_t> next_leaf_;   // per node: next leaf of the same triangle
   std::vector<std::int32_t> first_leaf_;  // per triangle
