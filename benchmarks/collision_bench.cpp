@@ -514,6 +514,23 @@ void BM_Query8640(benchmark::State& state) {
 }
 BENCHMARK(BM_Query8640);
 
+// The 60 Hz trajectory as a sequence (collide_sequence), frame after frame, looping.
+void BM_Sequence8640(benchmark::State& state) {
+  const ProstateModel gland = generate_prostate(8640);
+  const BenchTool tool = make_bench_tool();
+  SphereTree tissue_tree;
+  tissue_tree.build(gland.surface);
+  const auto frames = trajectory_poses();
+  Collider collider;
+  std::size_t f = 0;
+  for (auto _ : state) {
+    if (f % frames.size() == 0) collider.reset_sequence();
+    collider.collide_sequence(tissue_tree, gland.surface, tool.tree, tool.mesh, frames[f++ % frames.size()]);
+    benchmark::DoNotOptimize(collider.pairs().data());
+  }
+}
+BENCHMARK(BM_Sequence8640);
+
 // The refit after a deformation (spheres and slabs of every node), ours and FCL's AABB tree.
 void BM_Refit(benchmark::State& state) {
   ProstateModel gland = generate_prostate(static_cast<int>(state.range(0)));

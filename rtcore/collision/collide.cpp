@@ -430,7 +430,19 @@ bool Collider::collide_sequence(const SphereTree& tissue_tree, const TriangleMes
     }
     travel_ += std::sqrt(moved2) * (1.0 + 1e-9) + slack_ + (tissue_travel_m - last_tissue_travel_) * (1.0 + 1e-9);
     const std::size_t cached = front_count_;
+    const Sphere* tissue_spheres = tissue_tree.spheres().data();
+    const Slab* tissue_slabs = tissue_tree.slabs().data();
+    const SphereTreeLinks* tissue_links = tissue_tree.links().data();
+    constexpr std::size_t kAhead = 16;  // the cached pairs lie scattered over the tissue's arrays
     for (std::size_t i = 0; i < cached; ++i) {
+      if (i + kAhead < cached) {
+        const NodePair ahead = front_pairs_[i + kAhead];
+        __builtin_prefetch(tissue_spheres + ahead.tissue);
+        __builtin_prefetch(tissue_slabs + ahead.tissue);
+        __builtin_prefetch(tissue_links + ahead.tissue);
+        __builtin_prefetch(tool_spheres_.data() + ahead.tool);
+        __builtin_prefetch(tool_slabs_.data() + ahead.tool);
+      }
       if (front_expiry_[i] > travel_) continue;
       ++stats_.front_renewed;
       // Most renewed pairs are still apart: a new certificate in place, without a walk.
