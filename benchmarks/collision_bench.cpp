@@ -46,6 +46,18 @@ void configure(SphereTree& tree, bool tool = false) {
   if (tool && g_tool_slice_aspect > 0.0) tree.set_slice_aspect(g_tool_slice_aspect);
 }
 
+// The resectoscope and its tree, as every table uses them.
+struct BenchTool {
+  TriangleMesh mesh;
+  SphereTree tree;
+};
+BenchTool make_bench_tool() {
+  BenchTool tool{combined_resectoscope_mesh(generate_resectoscope()), {}};
+  configure(tool.tree, true);
+  tool.tree.build(tool.mesh);
+  return tool;
+}
+
 double elapsed_us(double start_us) { return Clock::now() - start_us; }
 
 double median(std::vector<double> values) {
@@ -87,6 +99,37 @@ std::vector<RigidTransform> benchmark_poses() {
                                   -M_PI / 2 + 0.6 * (unit(rng) - 0.5)));
   }
   return poses;
+}
+
+// A 60 Hz trajectory of 2 s: the sheath pressed 0.8-1.6 mm into the channel wall, advancing 10 mm/s
+// along it while swinging between sides, and the loop swept through the lobe by rolling the tool.
+// Consecutive frames move the tool's points 0.2-0.4 mm (its far end included): what
+// Collider::collide_sequence() reuses.
+std::vector<RigidTransform> trajectory_poses() {
+  std::vector<RigidTransform> poses;
+  constexpr int kFrames = 120;
+  for (int f = 0; f < kFrames; ++f) {
+    const double t = f / 60.0;
+    poses.push_back(pressing_pose(0.015 + 0.010 * t, 0.6 + 0.25 * std::sin(1.5 * t), 0.0012 + 0.0004 * std::sin(2.0 * t),
+                                  0.01 * std::sin(t), -M_PI / 2 + 0.5 * std::sin(3.0 * t)));
+  }
+  return poses;
+}
+
+// Writes poses in the `resecto collide` format, in millimetres (the unit `resecto mesh` writes).
+void write_poses(const std::string& path, const std::vector<RigidTransform>& poses) {
+  std::FILE* out = std::fopen(path.c_str(), "w");
+  if (!out) {
+    std::fprintf(stderr, "%s: cannot write\n", path.c_str());
+    std::exit(1);
+  }
+  for (const RigidTransform& p : poses) {
+    for (int i = 0; i < 3; ++i) {
+      std::fprintf(out, "%.17g %.17g %.17g %.17g%s", p.rotation[i][0], p.rotation[i][1], p.rotation[i][2],
+                   1000.0 * p.translation[i], i == 2 ? "\n" : " ");
+    }
+  }
+  std::fclose(out);
 }
 
 // ---- FCL --------------------------------------------------------------------------------------
@@ -308,6 +351,101 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
   return row;
 }
 
+// The 60 Hz trajectory at one size: each frame's query alone (collide), the same frames as a sequence
+// (collide_sequence, the front of the previous frame seeding the next), and FCL OBBRSS; every frame's
+// pairs compared across the three and with brute force.
+struct SequenceRow {
+  int triangles = 0;
+  std::size_t frames = 0;
+  double fresh_us = 0, sequence_us = 0, sequence_mean_us = 0, fcl_us = 0, fcl_mean_us = 0;
+  std::size_t pairs = 0;
+  std::size_t brute_mismatch = 0, fresh_mismatch = 0, fcl_mismatch = 0;
+  double kept = 0, renewed = 0;  // front pairs per frame
+};
+
+SequenceRow measure_sequence(int target_triangles, const TriangleMesh& tool, const SphereTree& tool_tree,
+                             const std::vector<RigidTransform>& frames, int repetitions) {
+  SequenceRow row;
+  ProstateModel gland = generate_prostate(target_triangles);
+  const TriangleMesh& tissue = gland.surface;
+  row.triangles = static_cast<int>(tissue.triangle_count());
+  row.frames = frames.size();
+  SphereTree tissue_tree;
+  configure(tissue_tree);
+  tissue_tree.build(tissue);
+  Collider fresh, sequence;
+  fresh.reserve(1 << 16, 1 << 16);
+  sequence.reserve(1 << 16, 1 << 16);
+  fcl::CollisionObjectd fcl_tissue(fcl_model<fcl::OBBRSSd>(tissue));
+  fcl::CollisionObjectd fcl_tool(fcl_model<fcl::OBBRSSd>(tool));
+  std::vector<double> fresh_times, sequence_times, fcl_times;
+  std::vector<std::vector<TrianglePair>> fresh_found(frames.size());
+  // Alternated frame by frame, so the three see the same machine load.
+  for (int r = 0; r < repetitions; ++r) {
+    sequence.reset_sequence();
+    for (std::size_t f = 0; f < frames.size(); ++f) {
+      auto start = Clock::now();
+      fresh.collide(tissue_tree, tissue, tool_tree, tool, frames[f]);
+      fresh_times.push_back(elapsed_us(start));
+      start = Clock::now();
+      sequence.collide_sequence(tissue_tree, tissue, tool_tree, tool, frames[f]);
+      sequence_times.push_back(elapsed_us(start));
+      double t = 0;
+      const auto fcl_found = fcl_pairs<fcl::OBBRSSd>(fcl_tissue, fcl_tool, frames[f], &t);
+      fcl_times.push_back(t);
+      if (r > 0) continue;
+      fresh_found[f].assign(fresh.pairs().begin(), fresh.pairs().end());
+      row.pairs += fresh_found[f].size();
+      if (!std::equal(sequence.pairs().begin(), sequence.pairs().end(), fresh_found[f].begin(), fresh_found[f].end())) {
+        ++row.fresh_mismatch;
+      }
+      if (fcl_found != fresh_found[f]) ++row.fcl_mismatch;
+      row.kept += static_cast<double>(sequence.stats().front_kept);
+      row.renewed += static_cast<double>(sequence.stats().front_renewed);
+    }
+  }
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    if (collide_brute_force(tissue, tool, frames[f]) != fresh_found[f]) ++row.brute_mismatch;
+  }
+  const auto mean = [](const std::vector<double>& v) {
+    double sum = 0;
+    for (double x : v) sum += x;
+    return sum / static_cast<double>(v.size());
+  };
+  row.fresh_us = median(fresh_times);
+  row.sequence_us = median(sequence_times);
+  row.sequence_mean_us = mean(sequence_times);
+  row.fcl_us = median(fcl_times);
+  row.fcl_mean_us = mean(fcl_times);
+  row.kept /= static_cast<double>(frames.size());
+  row.renewed /= static_cast<double>(frames.size());
+  return row;
+}
+
+int run_sequence_table(int repetitions, int only_size) {
+  const BenchTool tool = make_bench_tool();
+  const auto frames = trajectory_poses();
+  std::printf("\n60 Hz trajectory: %zu consecutive frames (sheath along the wall, loop through the lobe), %d runs of the "
+              "whole trajectory, medians and means over every frame of every run (the first frame of a run starts afresh)\n",
+              frames.size(), repetitions);
+  std::printf("%8s | %9s | %9s %9s | %9s %9s | %7s %7s | %7s | %5s %5s %5s | %8s %8s\n", "tissue", "ours", "ours seq",
+              "ours seq", "FCL", "FCL", "FCL/", "FCL/", "pairs", "brute", "fresh", "FCL", "front", "front");
+  std::printf("%8s | %9s | %9s %9s | %9s %9s | %7s %7s | %7s | %5s %5s %5s | %8s %8s\n", "tris", "fresh us", "median",
+              "mean", "median", "mean", "seq med", "seq mean", "", "diff", "diff", "diff", "kept", "renewed");
+  for (const int size : {1296, 8640, 34560, 138240}) {
+    if (only_size > 0 && size != only_size) continue;
+    const SequenceRow row = measure_sequence(size, tool.mesh, tool.tree, frames, size > 40000 ? 3 : repetitions);
+    std::printf("%8d | %9.1f | %9.1f %9.1f | %9.1f %9.1f | %7.1f %7.1f | %7zu | %5zu %5zu %5zu | %8.0f %8.0f\n", row.triangles,
+                row.fresh_us, row.sequence_us, row.sequence_mean_us, row.fcl_us, row.fcl_mean_us, row.fcl_us / row.sequence_us,
+                row.fcl_mean_us / row.sequence_mean_us, row.pairs, row.brute_mismatch, row.fresh_mismatch, row.fcl_mismatch,
+                row.kept, row.renewed);
+    std::fflush(stdout);
+  }
+  std::printf("diff: frames whose sequence pairs differ from brute force / from the fresh query / FCL's (must be 0, 0, 0); "
+              "front kept/renewed: cached node pairs per frame whose certificate held / that were walked again.\n");
+  return 0;
+}
+
 // The paper's Figure 13 (../shared/reference/paper-figure13-collision-rates.csv): prostate
 // triangles and the mean collision rate in Hz with the 488-triangle tool, 3 GHz PC, 2006.
 const std::vector<std::pair<int, double>> kFigure13 = {
@@ -318,10 +456,9 @@ int run_table(int repetitions, int only_size) {
   auto sizes = kFigure13;
   sizes.emplace_back(34560, 0.0);
   sizes.emplace_back(138240, 0.0);
-  const TriangleMesh tool = combined_resectoscope_mesh(generate_resectoscope());
-  SphereTree tool_tree;
-  configure(tool_tree, true);
-  tool_tree.build(tool);
+  const BenchTool bench_tool = make_bench_tool();
+  const TriangleMesh& tool = bench_tool.mesh;
+  const SphereTree& tool_tree = bench_tool.tree;
   const auto poses = benchmark_poses();
   std::printf("collision benchmark: resectoscope %zu triangles (%d leaf spheres), %zu poses pressing into the wall, "
               "median of %d repetitions of every pose\n",
@@ -377,11 +514,61 @@ void BM_Query8640(benchmark::State& state) {
 }
 BENCHMARK(BM_Query8640);
 
+// The 60 Hz trajectory as a sequence (collide_sequence), frame after frame, looping.
+void BM_Sequence8640(benchmark::State& state) {
+  const ProstateModel gland = generate_prostate(8640);
+  const BenchTool tool = make_bench_tool();
+  SphereTree tissue_tree;
+  tissue_tree.build(gland.surface);
+  const auto frames = trajectory_poses();
+  Collider collider;
+  std::size_t f = 0;
+  for (auto _ : state) {
+    if (f % frames.size() == 0) collider.reset_sequence();
+    collider.collide_sequence(tissue_tree, gland.surface, tool.tree, tool.mesh, frames[f++ % frames.size()]);
+    benchmark::DoNotOptimize(collider.pairs().data());
+  }
+}
+BENCHMARK(BM_Sequence8640);
+
+// The refit after a deformation (spheres and slabs of every node), ours and FCL's AABB tree.
+void BM_Refit(benchmark::State& state) {
+  ProstateModel gland = generate_prostate(static_cast<int>(state.range(0)));
+  TriangleMesh& mesh = gland.surface;
+  SphereTree tree;
+  tree.build(mesh);
+  const std::vector<Vec3> rest = mesh.positions;
+  deform(rest, mesh.positions, 0.7);
+  for (auto _ : state) {
+    tree.refit(mesh);
+    benchmark::DoNotOptimize(tree.spheres().data());
+  }
+}
+BENCHMARK(BM_Refit)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
+
+void BM_FclAabbRefit(benchmark::State& state) {
+  ProstateModel gland = generate_prostate(static_cast<int>(state.range(0)));
+  TriangleMesh& mesh = gland.surface;
+  auto model = fcl_model<fcl::AABBd>(mesh);
+  const std::vector<Vec3> rest = mesh.positions;
+  deform(rest, mesh.positions, 0.7);
+  std::vector<fcl::Vector3d> moved(rest.size());
+  for (std::size_t v = 0; v < rest.size(); ++v) moved[v] = fcl::Vector3d(mesh.positions[v].x, mesh.positions[v].y, mesh.positions[v].z);
+  for (auto _ : state) {
+    model->beginUpdateModel();
+    model->updateSubModel(moved);
+    model->endUpdateModel(true, true);
+    benchmark::DoNotOptimize(model.get());
+  }
+}
+BENCHMARK(BM_FclAabbRefit)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int repetitions = 7;
   int only_size = 0;  // --size N: one row only
+  bool sequence_only = false;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--gbench") == 0) {
       benchmark::Initialize(&argc, argv);
@@ -392,6 +579,15 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--slice-aspect") == 0 && i + 1 < argc) g_slice_aspect = std::atof(argv[++i]);
     if (std::strcmp(argv[i], "--size") == 0 && i + 1 < argc) only_size = std::atoi(argv[++i]);
     if (std::strcmp(argv[i], "--repetitions") == 0 && i + 1 < argc) repetitions = std::max(1, std::atoi(argv[++i]));
+    if (std::strcmp(argv[i], "--sequence-only") == 0) sequence_only = true;
+    if (std::strcmp(argv[i], "--write-poses") == 0 && i + 1 < argc) {
+      // The bench's poses for `resecto collide`: PREFIX-independent.txt and PREFIX-trajectory.txt (mm).
+      const std::string prefix = argv[++i];
+      write_poses(prefix + "-independent.txt", benchmark_poses());
+      write_poses(prefix + "-trajectory.txt", trajectory_poses());
+      return 0;
+    }
   }
-  return run_table(repetitions, only_size);
+  if (!sequence_only) run_table(repetitions, only_size);
+  return run_sequence_table(repetitions, only_size);
 }

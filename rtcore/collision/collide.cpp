@@ -48,8 +48,6 @@ bool first_meeting_leaf(const SphereTree& tree, const Sphere* spheres, std::uint
   return true;
 }
 
-constexpr bool kTableForSlices = false;
-
 }  // namespace
 
 void Collider::reserve(std::int32_t max_pairs, std::int32_t max_tested_pairs) {
@@ -72,6 +70,7 @@ void Collider::prepare(const SphereTree& tissue_tree, const SphereTree& tool_tre
   const auto tissue_nodes = static_cast<std::size_t>(tissue_tree.node_capacity());
   const auto tool_nodes = static_cast<std::size_t>(tool_tree.node_capacity());
   tool_spheres_.resize(tool_nodes);
+  tool_slabs_.resize(tool_nodes);
   tool_vertices_.resize(tool.vertex_count());
   tool_boxes_.resize(tool.triangle_count());
   tool_chain_begin_.resize(tool.triangle_count() + 1);
@@ -99,11 +98,14 @@ void Collider::prepare(const SphereTree& tissue_tree, const SphereTree& tool_tre
 
 bool Collider::first_test_of(std::uint32_t tissue_triangle, std::uint32_t tool_triangle) {
   const std::uint64_t key = (static_cast<std::uint64_t>(tissue_triangle) << 32) | tool_triangle;
-  const std::size_t mask = tested_.size() - 1;
-  if (2 * (tested_count_ + 1) > tested_.size()) {
-    overflowed_ = true;  // table too full to probe: test again rather than risk a lost pair
-    return true;
+  if (2 * (tested_count_ + 1) > tested_window_) {
+    // The window in use is full: widen it (slots of this query in the old window may now be missed,
+    // so a pair may be tested twice; finish_query() drops repeats). At the table's size, test again.
+    if (tested_window_ == tested_.size()) return true;
+    tested_window_ *= 2;
   }
+  // Only the window's first slots are probed: a few thousand pairs stay in cache.
+  const std::size_t mask = tested_window_ - 1;
   std::size_t slot = static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask;
   while (tested_[slot].stamp == stamp_) {
     if (tested_[slot].key == key) return false;
@@ -139,17 +141,67 @@ void Collider::test_triangles(const TriangleMesh& tissue, std::uint32_t a, std::
   pairs_[pair_count_++] = {a, b};
 }
 
-bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
-                       const TriangleMesh& tool, const RigidTransform& tool_pose) {
+// ---- Bounds tests ------------------------------------------------------------------------------
+
+namespace {
+
+// The separating-axis test of two nodes' regions (sphere inside slab) along each slab's normal.
+// Returns the larger of the two axes' gaps; > 0 is a lower bound on the distance between the regions.
+// One lean (the sine between the normals) serves both axes.
+[[gnu::always_inline]] inline double slab_gap(const Sphere& a, const Slab& sa, const Sphere& b, const Slab& sb, double slack) {
+  const double k = dot(sa.normal, sb.normal);
+  const double lean = std::sqrt(std::max(0.0, 1.0 - k * k) + 1e-15);
+  // b projected onto a's normal (see project_bound), then a onto b's.
+  const double b_along = dot(sa.normal, b.center);
+  const double b_rest = b_along - k * dot(sb.normal, b.center);
+  const double b_lo = std::max((k >= 0.0 ? k * sb.lo : k * sb.hi) + b_rest - b.radius * lean, b_along - b.radius);
+  const double b_hi = std::min((k >= 0.0 ? k * sb.hi : k * sb.lo) + b_rest + b.radius * lean, b_along + b.radius);
+  const double a_along = dot(sb.normal, a.center);
+  const double a_rest = a_along - k * dot(sa.normal, a.center);
+  const double a_lo = std::max((k >= 0.0 ? k * sa.lo : k * sa.hi) + a_rest - a.radius * lean, a_along - a.radius);
+  const double a_hi = std::min((k >= 0.0 ? k * sa.hi : k * sa.lo) + a_rest + a.radius * lean, a_along + a.radius);
+  return std::max({sa.lo - b_hi, b_lo - sa.hi, sb.lo - a_hi, a_lo - sb.hi}) - slack;
+}
+
+}  // namespace
+
+double Collider::gap(std::int32_t tissue_node, std::int32_t tool_node) const {
+  const Sphere& a = tissue_tree_->spheres()[static_cast<std::size_t>(tissue_node)];
+  const Sphere& b = tool_spheres_[static_cast<std::size_t>(tool_node)];
+  const double sphere_gap = length(a.center - b.center) - a.radius - b.radius - slack_;
+  if (!slabs_) return sphere_gap;
+  return std::max(sphere_gap, slab_gap(a, tissue_tree_->slabs()[static_cast<std::size_t>(tissue_node)], b,
+                                       tool_slabs_[static_cast<std::size_t>(tool_node)], slab_slack_));
+}
+
+// The descent's test, without the square root of the sphere distance when the spheres decide.
+[[gnu::always_inline]] inline bool Collider::bounds_meet(std::int32_t tissue_node, std::int32_t tool_node, double distance2) const {
+  const Sphere& a = tissue_tree_->spheres()[static_cast<std::size_t>(tissue_node)];
+  const Sphere& b = tool_spheres_[static_cast<std::size_t>(tool_node)];
+  if (!within_reach(distance2, a.radius, b.radius, slack_)) return false;
+  return !slabs_ || slab_gap(a, tissue_tree_->slabs()[static_cast<std::size_t>(tissue_node)], b,
+                             tool_slabs_[static_cast<std::size_t>(tool_node)], slab_slack_) <= 0.0;
+}
+
+// ---- The descent --------------------------------------------------------------------------------
+
+bool Collider::begin_query(const SphereTree& tissue_tree, const SphereTree& tool_tree, const TriangleMesh& tool,
+                           const RigidTransform& tool_pose) {
   pair_count_ = 0;
   l1_count_ = 0;
   l2_count_ = 0;
+  // The table's window: four times the last query's count of tested pairs.
+  tested_window_ = 256;
+  while (tested_window_ < 4 * tested_count_ && tested_window_ < tested_.size()) tested_window_ *= 2;
+  tested_window_ = std::min(tested_window_, tested_.size());
   tested_count_ = 0;
   overflowed_ = false;
   stats_ = {};
-  if (tissue_tree.empty() || tool_tree.empty()) return true;
+  if (tissue_tree.empty() || tool_tree.empty()) return false;
   prepare(tissue_tree, tool_tree, tool);
   next_stamp();
+  tissue_tree_ = &tissue_tree;
+  tool_tree_ = &tool_tree;
   pose_ = tool_pose;
   radius_scale_ = stretch_bound(tool_pose);
   tool_mesh_ = &tool;
@@ -167,31 +219,119 @@ bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue
     tool_boxes_[u] = {glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
   }
   // Rounding of transformed centres and of distances is far below this slack; it only ever lets
-  // a few more sphere pairs through to the exact test.
+  // a few more pairs through to the exact test.
   const Sphere& tool_root = tool_rest[tool_tree.root()];
-  const double slack = 1e-12 * (max_abs(tool_pose.translation) + max_abs(tool_root.center) + tool_root.radius +
-                                max_abs(tissue_tree.spheres()[tissue_tree.root()].center));
-
-  const Sphere* tissue_spheres = tissue_tree.spheres().data();
-  const SphereTreeLinks* tissue_links = tissue_tree.links().data();
-  const LeafPiece* tissue_pieces = tissue_tree.pieces().data();
-  const Sphere* tool_spheres = tool_spheres_.data();
-  const SphereTreeLinks* tool_links = tool_tree.links().data();
-  const LeafPiece* tool_pieces = tool_tree.pieces().data();
-
-  // Depth-first with an explicit stack of pairs whose spheres are known to meet: a node opened
-  // has both children tested at once, and those that meet are pushed farther first, so the
-  // closer is walked first (Figure 11); the distance that orders them is the one that tests them.
-  // The walk order depends only on the trees and the pose: deterministic.
-  std::int64_t sphere_tests = 1;
-  std::int64_t leaf_pairs = 0;
-  if (!spheres_meet(tissue_spheres[tissue_tree.root()], tool_spheres[tool_tree.root()], slack)) {
-    stats_.sphere_tests = sphere_tests;
-    return true;
+  const double magnitude = max_abs(tool_pose.translation) + max_abs(tool_root.center) + tool_root.radius +
+                           max_abs(tissue_tree.spheres()[tissue_tree.root()].center) +
+                           tissue_tree.spheres()[tissue_tree.root()].radius;
+  slack_ = 1e-12 * magnitude;
+  // A slab keeps its meaning under a rotation only: the pose's deviation from one (R^T R - I) is
+  // measured, and beyond rounding the query falls back to the spheres, which allow any stretch.
+  const auto& r = tool_pose.rotation;
+  double defect = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const double rtr = r[0][i] * r[0][j] + r[1][i] * r[1][j] + r[2][i] * r[2][j];
+      defect = std::max(defect, std::abs(rtr - (i == j ? 1.0 : 0.0)));
+    }
   }
+  slabs_ = slabs_wanted_ && defect <= 1e-12;
+  slab_slack_ = 4.0 * slack_ + 4.0 * defect * magnitude;
+  if (slabs_) {
+    const std::vector<Slab>& rest_slabs = tool_tree.slabs();
+    for (std::size_t n = 0; n < rest_slabs.size(); ++n) {
+      const Vec3& m = rest_slabs[n].normal;
+      const Vec3 normal{r[0][0] * m.x + r[0][1] * m.y + r[0][2] * m.z, r[1][0] * m.x + r[1][1] * m.y + r[1][2] * m.z,
+                        r[2][0] * m.x + r[2][1] * m.y + r[2][2] * m.z};
+      const double offset = dot(normal, tool_pose.translation);
+      tool_slabs_[n] = {normal, rest_slabs[n].lo + offset, rest_slabs[n].hi + offset};
+    }
+  }
+  return true;
+}
+
+void Collider::visit_leaves(const NodePair& pair) {
+  // Steps 4-9: both leaves. Each goes into its list once (the flags make that O(1)).
+  if (l1_stamp_[pair.tissue] != stamp_) {
+    l1_stamp_[pair.tissue] = stamp_;
+    l1_[l1_count_++] = pair.tissue;
+  }
+  if (l2_stamp_[pair.tool] != stamp_) {
+    l2_stamp_[pair.tool] = stamp_;
+    l2_[l2_count_++] = pair.tool;
+  }
+  if (!pairs_wanted_) return;
+  const LeafPiece& a = tissue_tree_->pieces()[static_cast<std::size_t>(pair.tissue)];
+  const LeafPiece& b = tool_tree_->pieces()[static_cast<std::size_t>(pair.tool)];
+  const TriangleMesh& tissue = *tissue_mesh_;
+  // A triangle pair can meet through several leaf pairs only when a triangle has several leaves.
+  // With the slabs, or with both sides sliced, the table of tested pairs decides. With spheres
+  // alone and one side sliced, the pair is tested at that side's first leaf (chain order) whose
+  // sphere meets the other's: the descent reaches every leaf pair whose spheres meet.
+  if (slabs_ ? (a.slices > 1 || b.slices > 1) : (a.slices > 1 && b.slices > 1)) {
+    test_triangles(tissue, a.triangle, b.triangle, true);
+    return;
+  }
+  const Sphere* tissue_spheres = tissue_tree_->spheres().data();
+  const Sphere& s1 = tissue_spheres[pair.tissue];
+  const Sphere& s2 = tool_spheres_[static_cast<std::size_t>(pair.tool)];
+  if (b.slices > 1) {
+    // Scanning the earlier slabs nearest first finds a meeting neighbour at once when there is one.
+    const std::int32_t* chain = tool_chain_.data() + tool_chain_begin_[b.triangle];
+    std::int32_t k = tool_leaf_rank_[static_cast<std::size_t>(pair.tool)] - 1;
+    while (k >= 0 && !spheres_meet(s1, tool_spheres_[static_cast<std::size_t>(chain[k])], slack_)) --k;
+    if (k < 0) test_triangles(tissue, a.triangle, b.triangle, false);
+  } else if (a.slices > 1) {
+    if (first_meeting_leaf(*tissue_tree_, tissue_spheres, a.triangle, pair.tissue, s2, slack_)) {
+      test_triangles(tissue, a.triangle, b.triangle, false);
+    }
+  } else {
+    test_triangles(tissue, a.triangle, b.triangle, false);
+  }
+}
+
+void Collider::record(const NodePair& pair, double expiry) {
+  if (has_pending_slot_) {
+    front_pairs_[pending_slot_] = pair;
+    front_expiry_[pending_slot_] = expiry;
+    has_pending_slot_ = false;
+    return;
+  }
+  if (front_count_ == front_pairs_.size()) {
+    front_overflowed_ = true;  // the walk goes on; the front is rebuilt next call
+    return;
+  }
+  front_pairs_[front_count_] = pair;
+  front_expiry_[front_count_++] = expiry;
+}
+
+template <bool kRecord>
+void Collider::descend(NodePair start) {
+  const Sphere* tissue_spheres = tissue_tree_->spheres().data();
+  const SphereTreeLinks* tissue_links = tissue_tree_->links().data();
+  const Sphere* tool_spheres = tool_spheres_.data();
+  const SphereTreeLinks* tool_links = tool_tree_->links().data();
+  std::int64_t tests = 1;
+  if constexpr (kRecord) {
+    const double g = gap(start.tissue, start.tool);
+    if (g > 0.0) {
+      record(start, travel_ + g);
+      stats_.sphere_tests += tests;
+      return;
+    }
+  } else {
+    if (!bounds_meet(start.tissue, start.tool,
+                     length_squared(tissue_spheres[start.tissue].center - tool_spheres[start.tool].center))) {
+      stats_.sphere_tests += tests;
+      return;
+    }
+  }
+  // Depth-first with an explicit stack of pairs whose bounds are known to meet: a node opened has
+  // both children tested at once, and those that meet are pushed farther first, so the closer is
+  // walked first (Figure 11). The walk order depends only on the trees and the pose: deterministic.
   NodePair* const stack = stack_.data();
   std::size_t top = 0;
-  stack[top++] = {tissue_tree.root(), tool_tree.root()};
+  stack[top++] = start;
   while (top > 0) {
     const NodePair pair = stack[--top];
     const Sphere& s1 = tissue_spheres[pair.tissue];
@@ -201,77 +341,146 @@ bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue
     const bool leaf1 = links1.left == SphereTree::kNoNode;
     const bool leaf2 = links2.left == SphereTree::kNoNode;
     if (leaf1 && leaf2) {
-      ++leaf_pairs;
-      // Steps 4-9: both leaves. Each goes into its list once (the flags make that O(1)).
-      if (l1_stamp_[pair.tissue] != stamp_) {
-        l1_stamp_[pair.tissue] = stamp_;
-        l1_[l1_count_++] = pair.tissue;
-      }
-      if (l2_stamp_[pair.tool] != stamp_) {
-        l2_stamp_[pair.tool] = stamp_;
-        l2_[l2_count_++] = pair.tool;
-      }
-      if (!pairs_wanted_) continue;
-      const LeafPiece& a = tissue_pieces[pair.tissue];
-      const LeafPiece& b = tool_pieces[pair.tool];
-      // A triangle pair can meet through several leaf pairs only when a triangle has several
-      // leaves; with one side sliced it is tested at that side's first meeting leaf, and only
-      // when both are sliced does the table of tested pairs decide.
-      if (kTableForSlices ? (a.slices > 1 || b.slices > 1) : (a.slices > 1 && b.slices > 1)) {
-        test_triangles(tissue, a.triangle, b.triangle, true);
-      } else if (b.slices > 1) {
-        // Tested at the first slab (chain order) whose sphere meets s1: scanning the earlier slabs
-        // nearest first finds a meeting neighbour at once when there is one.
-        const std::int32_t* chain = tool_chain_.data() + tool_chain_begin_[b.triangle];
-        std::int32_t k = tool_leaf_rank_[static_cast<std::size_t>(pair.tool)] - 1;
-        while (k >= 0 && !spheres_meet(s1, tool_spheres[chain[k]], slack)) --k;
-        if (k < 0) test_triangles(tissue, a.triangle, b.triangle, false);
-      } else if (a.slices > 1) {
-        if (first_meeting_leaf(tissue_tree, tissue_spheres, a.triangle, pair.tissue, s2, slack)) {
-          test_triangles(tissue, a.triangle, b.triangle, false);
-        }
-      } else {
-        test_triangles(tissue, a.triangle, b.triangle, false);
-      }
+      ++stats_.leaf_pairs;
+      visit_leaves(pair);
+      if constexpr (kRecord) record(pair, -1.0);  // leaves that may meet are walked again every call
       continue;
     }
-    sphere_tests += 2;
+    tests += 2;
     // Steps 11-17: open the non-leaf sphere, or the larger when neither is a leaf.
+    NodePair first, second;
+    double d_first, d_second;
     if (!leaf1 && (leaf2 || s1.radius >= s2.radius)) {
-      const std::int32_t near = links1.left;
-      const std::int32_t far = links1.right;
-      const double d_near = length_squared(tissue_spheres[near].center - s2.center);
-      const double d_far = length_squared(tissue_spheres[far].center - s2.center);
-      const bool swap = d_far < d_near;
-      const std::int32_t first = swap ? far : near;
-      const std::int32_t second = swap ? near : far;
-      const bool meets_near = within_reach(swap ? d_far : d_near, tissue_spheres[first].radius, s2.radius, slack);
-      const bool meets_far = within_reach(swap ? d_near : d_far, tissue_spheres[second].radius, s2.radius, slack);
-      // Written always, kept only when they meet: no branch on an unpredictable outcome.
-      stack[top] = {second, pair.tool};
-      top += meets_far;
-      stack[top] = {first, pair.tool};
-      top += meets_near;
+      const double d_left = length_squared(tissue_spheres[links1.left].center - s2.center);
+      const double d_right = length_squared(tissue_spheres[links1.right].center - s2.center);
+      const bool swap = d_right < d_left;
+      first = {swap ? links1.right : links1.left, pair.tool};
+      second = {swap ? links1.left : links1.right, pair.tool};
+      d_first = swap ? d_right : d_left;
+      d_second = swap ? d_left : d_right;
     } else {
-      const std::int32_t near = links2.left;
-      const std::int32_t far = links2.right;
-      const double d_near = length_squared(s1.center - tool_spheres[near].center);
-      const double d_far = length_squared(s1.center - tool_spheres[far].center);
-      const bool swap = d_far < d_near;
-      const std::int32_t first = swap ? far : near;
-      const std::int32_t second = swap ? near : far;
-      const bool meets_near = within_reach(swap ? d_far : d_near, s1.radius, tool_spheres[first].radius, slack);
-      const bool meets_far = within_reach(swap ? d_near : d_far, s1.radius, tool_spheres[second].radius, slack);
-      stack[top] = {pair.tissue, second};
-      top += meets_far;
-      stack[top] = {pair.tissue, first};
-      top += meets_near;
+      const double d_left = length_squared(s1.center - tool_spheres[links2.left].center);
+      const double d_right = length_squared(s1.center - tool_spheres[links2.right].center);
+      const bool swap = d_right < d_left;
+      first = {pair.tissue, swap ? links2.right : links2.left};
+      second = {pair.tissue, swap ? links2.left : links2.right};
+      d_first = swap ? d_right : d_left;
+      d_second = swap ? d_left : d_right;
+    }
+    if constexpr (kRecord) {
+      // Separated pairs end the walk here, with their certificates.
+      const double g_second = gap(second.tissue, second.tool);
+      const double g_first = gap(first.tissue, first.tool);
+      if (g_second > 0.0) record(second, travel_ + g_second); else stack[top++] = second;
+      if (g_first > 0.0) record(first, travel_ + g_first); else stack[top++] = first;
+    } else {
+      const bool meets_first = bounds_meet(first.tissue, first.tool, d_first);
+      const bool meets_second = bounds_meet(second.tissue, second.tool, d_second);
+      // Written always, kept only when they meet: no branch on an unpredictable outcome.
+      stack[top] = second;
+      top += meets_second;
+      stack[top] = first;
+      top += meets_first;
     }
   }
-  stats_.sphere_tests = sphere_tests;
-  stats_.leaf_pairs = leaf_pairs;
-  // Sorted on the unique (tissue, tool) key: the same output whatever the walk order.
-  std::sort(pairs_.begin(), pairs_.begin() + static_cast<std::ptrdiff_t>(pair_count_));
+  stats_.sphere_tests += tests;
+}
+
+void Collider::finish_query() {
+  // Sorted on the (tissue, tool) key, each once: the same output whatever the walk order.
+  const auto end = pairs_.begin() + static_cast<std::ptrdiff_t>(pair_count_);
+  std::sort(pairs_.begin(), end);
+  pair_count_ = static_cast<std::size_t>(std::unique(pairs_.begin(), end) - pairs_.begin());
+}
+
+bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
+                       const TriangleMesh& tool, const RigidTransform& tool_pose) {
+  if (!begin_query(tissue_tree, tool_tree, tool, tool_pose)) return true;
+  tissue_mesh_ = &tissue;
+  descend<false>({tissue_tree.root(), tool_tree.root()});
+  finish_query();
+  return !overflowed_;
+}
+
+void Collider::reserve_front(std::int32_t max_front) {
+  front_pairs_.resize(static_cast<std::size_t>(std::max(max_front, 1)));
+  front_expiry_.resize(front_pairs_.size());
+  front_valid_ = false;
+}
+
+bool Collider::collide_sequence(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
+                                const TriangleMesh& tool, const RigidTransform& tool_pose, double tissue_travel_m) {
+  if (!begin_query(tissue_tree, tool_tree, tool, tool_pose)) {
+    front_valid_ = false;
+    return true;
+  }
+  tissue_mesh_ = &tissue;
+  const bool same_trees = front_tissue_tree_ == &tissue_tree && front_tool_tree_ == &tool_tree &&
+                          front_tissue_version_ == tissue_tree.structure_version() &&
+                          front_tool_version_ == tool_tree.structure_version() &&
+                          previous_tool_vertices_.size() == tool_vertices_.size();
+  bool fresh = !front_valid_ || !same_trees || !slabs_ || tissue_travel_m < last_tissue_travel_ ||
+               front_count_ > 2 * fresh_front_count_ + 1024;
+  if (!fresh) {
+    // How far the tool moved since the last call: its largest vertex displacement (a point of a
+    // triangle moves by an affine mix of its corners' moves), rounded up.
+    double moved2 = 0.0;
+    for (std::size_t v = 0; v < tool_vertices_.size(); ++v) {
+      moved2 = std::max(moved2, length_squared(tool_vertices_[v] - previous_tool_vertices_[v]));
+    }
+    travel_ += std::sqrt(moved2) * (1.0 + 1e-9) + slack_ + (tissue_travel_m - last_tissue_travel_) * (1.0 + 1e-9);
+    const std::size_t cached = front_count_;
+    const Sphere* tissue_spheres = tissue_tree.spheres().data();
+    const Slab* tissue_slabs = tissue_tree.slabs().data();
+    const SphereTreeLinks* tissue_links = tissue_tree.links().data();
+    constexpr std::size_t kAhead = 16;  // the cached pairs lie scattered over the tissue's arrays
+    for (std::size_t i = 0; i < cached; ++i) {
+      if (i + kAhead < cached) {
+        const NodePair ahead = front_pairs_[i + kAhead];
+        __builtin_prefetch(tissue_spheres + ahead.tissue);
+        __builtin_prefetch(tissue_slabs + ahead.tissue);
+        __builtin_prefetch(tissue_links + ahead.tissue);
+        __builtin_prefetch(tool_spheres_.data() + ahead.tool);
+        __builtin_prefetch(tool_slabs_.data() + ahead.tool);
+      }
+      if (front_expiry_[i] > travel_) continue;
+      ++stats_.front_renewed;
+      // Most renewed pairs are still apart: a new certificate in place, without a walk.
+      const NodePair pair = front_pairs_[i];
+      const bool leaves = tissue_tree.is_leaf(pair.tissue) && tool_tree.is_leaf(pair.tool);
+      if (!leaves) {
+        ++stats_.sphere_tests;
+        const double g = gap(pair.tissue, pair.tool);
+        if (g > 0.0) {
+          front_expiry_[i] = travel_ + g;
+          continue;
+        }
+      }
+      pending_slot_ = i;
+      has_pending_slot_ = true;
+      descend<true>(front_pairs_[i]);
+      has_pending_slot_ = false;
+    }
+    stats_.front_kept = static_cast<std::int64_t>(cached) - stats_.front_renewed;
+  } else {
+    if (front_pairs_.empty() || front_overflowed_) {
+      // Grown only here, off the steady state: a front that did not fit gets twice the room.
+      reserve_front(static_cast<std::int32_t>(std::max<std::size_t>(1 << 14, 2 * front_pairs_.size())));
+    }
+    front_count_ = 0;
+    front_overflowed_ = false;
+    travel_ = 0.0;
+    descend<true>({tissue_tree.root(), tool_tree.root()});
+    fresh_front_count_ = front_count_;
+  }
+  front_valid_ = !front_overflowed_ && slabs_;
+  front_tissue_tree_ = &tissue_tree;
+  front_tool_tree_ = &tool_tree;
+  front_tissue_version_ = tissue_tree.structure_version();
+  front_tool_version_ = tool_tree.structure_version();
+  last_tissue_travel_ = tissue_travel_m;
+  previous_tool_vertices_.assign(tool_vertices_.begin(), tool_vertices_.end());
+  finish_query();
   return !overflowed_;
 }
 

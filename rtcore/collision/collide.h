@@ -35,7 +35,9 @@ struct TrianglePair {
 
 /// Work counters of the last query.
 struct CollisionStats {
-  std::int64_t sphere_tests = 0;
+  std::int64_t sphere_tests = 0;    ///< node-pair bound tests (sphere, then the slabs)
+  std::int64_t front_kept = 0;      ///< sequence: cached node pairs whose certificate still held
+  std::int64_t front_renewed = 0;   ///< sequence: cached node pairs walked again
   std::int64_t leaf_pairs = 0;      ///< leaf pairs whose spheres met
   std::int64_t triangle_tests = 0;  ///< exact triangle tests (after the box prefilter)
 };
@@ -56,6 +58,26 @@ class Collider {
   bool collide(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
                const TriangleMesh& tool, const RigidTransform& tool_pose);
 
+  /// The same pairs as collide() for consecutive poses of one tool against one tissue tree, reusing
+  /// the previous call's work (temporal coherence). Every node pair where the last descent stopped
+  /// is kept with a certificate: the pair's bounds were `gap` apart, so its triangles cannot meet
+  /// until the tool and the tissue together have moved `gap`. The tool's motion is bounded exactly
+  /// (its vertices' largest displacement between calls, summed), the tissue's by `tissue_travel_m`,
+  /// a running bound on how far any tissue point has moved (0 for a static tissue); only pairs whose
+  /// certificate ran out, and leaf pairs whose bounds met, are walked again. Starts afresh when
+  /// either tree's structure changed or the cached pairs grew past twice a fresh descent's. The
+  /// leaf lists are those of the walked pairs (a subset of collide()'s); the pairs are the same.
+  bool collide_sequence(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
+                        const TriangleMesh& tool, const RigidTransform& tool_pose, double tissue_travel_m = 0.0);
+  /// Forgets the cached front: the next collide_sequence() descends from the roots.
+  void reset_sequence() { front_valid_ = false; }
+  /// Room for this many cached node pairs (a sequence that needs more starts afresh each call).
+  void reserve_front(std::int32_t max_front);
+
+  /// Whether the descent also tests each node's slab (the default), or spheres alone as the paper
+  /// does. The pairs are the same either way; the leaf lists are shorter with the slabs.
+  void set_slabs(bool enabled) { slabs_wanted_ = enabled; }
+
   /// Whether queries find the intersecting triangle pairs (the default) or only the leaf lists, as
   /// the contact response needs: that skips every exact triangle test.
   void set_pairs_wanted(bool wanted) { pairs_wanted_ = wanted; }
@@ -73,17 +95,40 @@ class Collider {
     std::int32_t tool;
   };
   void prepare(const SphereTree& tissue_tree, const SphereTree& tool_tree, const TriangleMesh& tool);
+  /// Resets the per-query state and places the tool; false when either tree is empty.
+  bool begin_query(const SphereTree& tissue_tree, const SphereTree& tool_tree, const TriangleMesh& tool,
+                   const RigidTransform& tool_pose);
+  /// The bounds test of one node pair: > 0 is a lower bound on the distance between their
+  /// triangles (separated), <= 0 means they may meet.
+  double gap(std::int32_t tissue_node, std::int32_t tool_node) const;
+  bool bounds_meet(std::int32_t tissue_node, std::int32_t tool_node, double distance2) const;
+  /// Walks every node pair under `start` whose bounds meet; with kRecord, each pair where the walk
+  /// stops goes to the front with its certificate.
+  template <bool kRecord>
+  void descend(NodePair start);
+  void visit_leaves(const NodePair& pair);
+  void record(const NodePair& pair, double expiry);
+  void finish_query();
   bool first_test_of(std::uint32_t tissue_triangle, std::uint32_t tool_triangle);
   void test_triangles(const TriangleMesh& tissue, std::uint32_t a, std::uint32_t b, bool may_repeat);
   void next_stamp();
 
   RigidTransform pose_;
+  // The trees and meshes of the running query.
+  const SphereTree* tissue_tree_ = nullptr;
+  const SphereTree* tool_tree_ = nullptr;
+  const TriangleMesh* tissue_mesh_ = nullptr;
+  double slack_ = 0.0;
+  double slab_slack_ = 0.0;
+  bool slabs_wanted_ = true;
+  bool slabs_ = true;  // this query: the pose is rigid enough for the tool's slabs to be moved by it
   double radius_scale_ = 1.0;  // bounds how much the pose's matrix can stretch a tool sphere
   std::uint32_t stamp_ = 0;    // per-query mark: an entry is set for this query when it equals stamp_
 
   // The tool placed in the world once per query (its tree is small): node spheres, vertices, and
   // each triangle's box for the exact prefilter ahead of the triangle test.
   std::vector<Sphere> tool_spheres_;
+  std::vector<Slab> tool_slabs_;
   std::vector<Vec3> tool_vertices_;
   std::vector<Aabb> tool_boxes_;
   const TriangleMesh* tool_mesh_ = nullptr;
@@ -105,12 +150,31 @@ class Collider {
   };
   std::vector<TestedSlot> tested_;  // open addressing: triangle pairs tested this query
   std::size_t tested_count_ = 0;
+  std::size_t tested_window_ = 256;  // power of two, at most tested_.size()
   std::vector<TrianglePair> pairs_;
   bool pairs_wanted_ = true;
   std::size_t pair_count_ = 0;
   std::vector<NodePair> stack_;
   bool overflowed_ = false;
   CollisionStats stats_;
+
+  // The sequence's front: node pairs where the last walk stopped, each with the travel at which
+  // its certificate runs out (structure of arrays: the per-call scan reads only the expiries).
+  std::vector<NodePair> front_pairs_;
+  std::vector<double> front_expiry_;
+  std::size_t front_count_ = 0;
+  std::size_t fresh_front_count_ = 0;  // the front's size after the last fresh descent
+  std::size_t pending_slot_ = 0;       // a renewed pair's slot, reused by its first successor
+  bool has_pending_slot_ = false;
+  bool front_overflowed_ = false;
+  bool front_valid_ = false;
+  double travel_ = 0.0;  // bound on the tool's and the tissue's motion since the front began
+  double last_tissue_travel_ = 0.0;
+  const SphereTree* front_tissue_tree_ = nullptr;
+  const SphereTree* front_tool_tree_ = nullptr;
+  std::uint64_t front_tissue_version_ = 0;
+  std::uint64_t front_tool_version_ = 0;
+  std::vector<Vec3> previous_tool_vertices_;
 };
 
 /// Every intersecting pair by testing every tissue triangle against every tool triangle (with a

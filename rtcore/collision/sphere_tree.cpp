@@ -86,7 +86,46 @@ Sphere triangle_sphere(const Vec3& a, const Vec3& b, const Vec3& c) {
   return inflated(center, std::sqrt(r2));
 }
 
+double max_abs(const Vec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
+
 }  // namespace
+
+Slab SphereTree::triangle_slab(const TriangleMesh& mesh, std::uint32_t t, const Sphere& sphere) {
+  const Triangle& tri = mesh.triangles[t];
+  const Vec3& a = mesh.positions[tri[0]];
+  const Vec3& b = mesh.positions[tri[1]];
+  const Vec3& c = mesh.positions[tri[2]];
+  const Vec3 n = cross(b - a, c - a);
+  const double n_length = length(n);
+  Slab slab;
+  if (!(n_length > 0.0) || !std::isfinite(n_length)) {  // no plane: the sphere's extent along z
+    slab.lo = sphere.center.z - sphere.radius;
+    slab.hi = sphere.center.z + sphere.radius;
+    return slab;
+  }
+  slab.normal = n / n_length;
+  const double da = dot(slab.normal, a);
+  const double db = dot(slab.normal, b);
+  const double dc = dot(slab.normal, c);
+  // Each dot is off by a few ulps of the coordinates' size; the pad is far above that.
+  const double pad = 1e-12 * std::max({max_abs(a), max_abs(b), max_abs(c)});
+  slab.lo = std::min({da, db, dc}) - pad;
+  slab.hi = std::max({da, db, dc}) + pad;
+  return slab;
+}
+
+Slab SphereTree::merge_slabs(const Sphere& a, const Slab& sa, const Sphere& b, const Slab& sb) {
+  Vec3 axis = sa.normal + sb.normal;
+  const double axis_length = length(axis);
+  // Children facing opposite ways have no useful common slab; any unit axis stays correct.
+  axis = axis_length > 1e-3 ? axis / axis_length : sa.normal;
+  double lo_a, hi_a, lo_b, hi_b;
+  project_bound(a, sa, axis, lo_a, hi_a);
+  project_bound(b, sb, axis, lo_b, hi_b);
+  const double pad = 1e-12 * (max_abs(a.center) + a.radius + max_abs(b.center) + b.radius + std::abs(sa.lo) +
+                              std::abs(sa.hi) + std::abs(sb.lo) + std::abs(sb.hi));
+  return {axis, std::min(lo_a, lo_b) - pad, std::max(hi_a, hi_b) + pad};
+}
 
 int SphereTree::slice_count(const TriangleMesh& mesh, std::uint32_t t, std::uint8_t& apex) {
   return slice_count(mesh, t, apex, kSliceAspect);
@@ -134,6 +173,8 @@ std::int32_t SphereTree::allocate_node() {
     return node;
   }
   spheres_.emplace_back();
+  slabs_.emplace_back();
+  leans_.emplace_back();
   links_.emplace_back();
   pieces_.emplace_back();
   next_leaf_.push_back(kNoNode);
@@ -161,6 +202,7 @@ void SphereTree::add_triangle_leaves(const TriangleMesh& mesh, std::uint32_t t, 
     const std::int32_t leaf = allocate_node();
     pieces_[leaf] = {t, static_cast<std::uint16_t>(s), static_cast<std::uint16_t>(slices), apex};
     spheres_[leaf] = piece_sphere(mesh, pieces_[leaf]);
+    slabs_[leaf] = triangle_slab(mesh, t, spheres_[leaf]);
     next_leaf_[leaf] = first_leaf_[t];
     first_leaf_[t] = leaf;
     ++leaf_count_;
@@ -185,7 +227,10 @@ void SphereTree::rebuild(const TriangleMesh& mesh) {
 }
 
 void SphereTree::build_over(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles) {
+  ++structure_version_;
   spheres_.clear();
+  slabs_.clear();
+  leans_.clear();
   links_.clear();
   pieces_.clear();
   next_leaf_.clear();
@@ -195,9 +240,11 @@ void SphereTree::build_over(const TriangleMesh& mesh, const std::vector<std::uin
   leaf_count_ = 0;
   live_nodes_ = 0;
   for (const std::uint32_t t : triangles) add_triangle_leaves(mesh, t, false);
+  build_mesh_ = &mesh;
   std::vector<std::int32_t> leaves(static_cast<std::size_t>(leaf_count_));
   for (std::int32_t i = 0; i < leaf_count_; ++i) leaves[i] = i;  // leaves were allocated first
   if (!leaves.empty()) root_ = build_range(leaves.data(), leaves.data() + leaves.size(), kNoNode);
+  build_mesh_ = nullptr;
   renumber_depth_first();
   order_dirty_ = true;
   built_mean_internal_radius_ = quality().mean_internal_radius;
@@ -291,12 +338,16 @@ void SphereTree::renumber_depth_first() {
   for (std::size_t i = 0; i < old_of.size(); ++i) new_of[static_cast<std::size_t>(old_of[i])] = static_cast<std::int32_t>(i);
   const auto remap = [&](std::int32_t n) { return n == kNoNode ? kNoNode : new_of[static_cast<std::size_t>(n)]; };
   std::vector<Sphere> spheres(old_of.size());
+  std::vector<Slab> slabs(old_of.size());
+  std::vector<Lean> leans(old_of.size());
   std::vector<SphereTreeLinks> links(old_of.size());
   std::vector<LeafPiece> pieces(old_of.size());
   std::vector<std::int32_t> next_leaf(old_of.size());
   for (std::size_t i = 0; i < old_of.size(); ++i) {
     const auto o = static_cast<std::size_t>(old_of[i]);
     spheres[i] = spheres_[o];
+    slabs[i] = slabs_[o];
+    leans[i] = leans_[o];
     pieces[i] = pieces_[o];
     next_leaf[i] = remap(next_leaf_[o]);
     const SphereTreeLinks& l = links_[o];
@@ -304,6 +355,8 @@ void SphereTree::renumber_depth_first() {
   }
   for (std::int32_t& leaf : first_leaf_) leaf = remap(leaf);
   spheres_ = std::move(spheres);
+  slabs_ = std::move(slabs);
+  leans_ = std::move(leans);
   links_ = std::move(links);
   pieces_ = std::move(pieces);
   next_leaf_ = std::move(next_leaf);
@@ -328,6 +381,45 @@ void SphereTree::cover_leaves(std::int32_t node, const std::int32_t* first, cons
   const Sphere direct = inflated(center, radius);
   const Sphere merged = merge(spheres_[links_[node].left], spheres_[links_[node].right]);
   spheres_[node] = direct.radius < merged.radius ? direct : merged;
+  // The slab likewise from the leaves' triangles directly, along their area-weighted mean normal:
+  // exact at the build, where merging the children's slabs (as refit does) widens it at every level.
+  Vec3 normal{0.0};
+  for (const std::int32_t* n = first; n != last; ++n) {
+    const Triangle& tri = build_mesh_->triangles[pieces_[*n].triangle];
+    const Vec3& a = build_mesh_->positions[tri[0]];
+    normal += cross(build_mesh_->positions[tri[1]] - a, build_mesh_->positions[tri[2]] - a);
+  }
+  const double normal_length = length(normal);
+  if (!(normal_length > 0.0) || !std::isfinite(normal_length)) {
+    const SphereTreeLinks& l = links_[node];
+    slabs_[node] = merge_slabs(spheres_[l.left], slabs_[l.left], spheres_[l.right], slabs_[l.right]);
+    set_child_leans(node);
+    return;
+  }
+  normal /= normal_length;
+  double slab_lo = INFINITY;
+  double slab_hi = -INFINITY;
+  double magnitude = 0.0;
+  for (const std::int32_t* n = first; n != last; ++n) {
+    for (const std::uint32_t v : build_mesh_->triangles[pieces_[*n].triangle]) {
+      const Vec3& p = build_mesh_->positions[v];
+      const double along = dot(normal, p);
+      slab_lo = std::min(slab_lo, along);
+      slab_hi = std::max(slab_hi, along);
+      magnitude = std::max(magnitude, max_abs(p));
+    }
+  }
+  const double pad = 1e-12 * magnitude;
+  slabs_[node] = {normal, slab_lo - pad, slab_hi + pad};
+  set_child_leans(node);
+}
+
+// The children's leans against this node's axis, which the refit reuses: internal normals keep their
+// direction between builds, so the sines are taken once, not at every refit.
+void SphereTree::set_child_leans(std::int32_t node) {
+  const SphereTreeLinks& l = links_[node];
+  leans_[l.left] = lean_of(slabs_[node].normal, slabs_[l.left].normal);
+  leans_[l.right] = lean_of(slabs_[node].normal, slabs_[l.right].normal);
 }
 
 // ---- Refit ------------------------------------------------------------------------------------
@@ -335,6 +427,8 @@ void SphereTree::cover_leaves(std::int32_t node, const std::int32_t* first, cons
 void SphereTree::refit_node(std::int32_t node) {
   const SphereTreeLinks& l = links_[node];
   spheres_[node] = merge(spheres_[l.left], spheres_[l.right]);
+  slabs_[node] = merge_slabs(spheres_[l.left], slabs_[l.left], spheres_[l.right], slabs_[l.right]);
+  set_child_leans(node);
   links_[node].height = 1 + std::max(links_[l.left].height, links_[l.right].height);
 }
 
@@ -364,26 +458,90 @@ void SphereTree::update_refit_order() {
     const std::int32_t h = links_[n].height;
     if (h > 0) refit_internal_[static_cast<std::size_t>(stack_[static_cast<std::size_t>(h)]++)] = n;
   }
+  // The backward sweep needs every child numbered after its parent (true after a build; an
+  // insertion or removal may reuse a lower slot).
+  preorder_ = true;
+  for (std::int32_t n = 0; n < node_capacity() && preorder_; ++n) {
+    if (links_[n].height > 0) preorder_ = links_[n].left > n && links_[n].right > n;
+  }
   order_dirty_ = false;
+}
+
+void SphereTree::refit_leaf(const TriangleMesh& mesh, std::int32_t leaf) {
+  const LeafPiece& piece = pieces_[leaf];
+  const Triangle& tri = mesh.triangles[piece.triangle];
+  const Vec3& a = mesh.positions[tri[0]];
+  const Vec3& b = mesh.positions[tri[1]];
+  const Vec3& c = mesh.positions[tri[2]];
+  const Sphere sphere = piece.slices == 1 ? centroid_sphere(a, b, c) : piece_sphere(mesh, piece);
+  spheres_[leaf] = sphere;
+  // The triangle's plane (triangle_slab, with the pad taken from the sphere: every corner is within
+  // |centre| + radius of the origin).
+  const Vec3 n = cross(b - a, c - a);
+  const double n_length = length(n);
+  if (!(n_length > 0.0) || !std::isfinite(n_length)) {
+    slabs_[leaf] = triangle_slab(mesh, piece.triangle, sphere);
+    return;
+  }
+  const Vec3 normal = n * (1.0 / n_length);
+  const double da = dot(normal, a);
+  const double db = dot(normal, b);
+  const double dc = dot(normal, c);
+  const double pad = 1e-12 * (std::abs(sphere.center.x) + std::abs(sphere.center.y) + std::abs(sphere.center.z) + sphere.radius);
+  slabs_[leaf] = {normal, std::min({da, db, dc}) - pad, std::max({da, db, dc}) + pad};
+}
+
+// An internal node after its children: the sphere holding theirs, and the slab along the node's own
+// (unchanged) axis holding theirs: a leaf's triangle corners projected exactly, an internal child's
+// region through its stored lean.
+void SphereTree::refit_internal(const TriangleMesh& mesh, std::int32_t node) {
+  const SphereTreeLinks& l = links_[node];
+  spheres_[node] = merge(spheres_[l.left], spheres_[l.right]);
+  const Vec3 axis = slabs_[node].normal;
+  double lo = INFINITY;
+  double hi = -INFINITY;
+  for (const std::int32_t child : {l.left, l.right}) {
+    if (links_[child].height == 0) {
+      const Triangle& tri = mesh.triangles[pieces_[child].triangle];
+      for (const std::uint32_t v : tri) {
+        const double along = dot(axis, mesh.positions[v]);
+        lo = std::min(lo, along);
+        hi = std::max(hi, along);
+      }
+    } else {
+      double child_lo, child_hi;
+      project_region(spheres_[child], slabs_[child], axis, leans_[child], child_lo, child_hi);
+      lo = std::min(lo, child_lo);
+      hi = std::max(hi, child_hi);
+    }
+  }
+  // Every value above is a projection of a point within |centre| + radius of the origin, off by a
+  // few ulps of that; the pad is far above it.
+  const Sphere& s = spheres_[node];
+  const double pad = 1e-11 * (std::abs(s.center.x) + std::abs(s.center.y) + std::abs(s.center.z) + s.radius);
+  slabs_[node].lo = lo - pad;
+  slabs_[node].hi = hi + pad;
 }
 
 void SphereTree::refit(const TriangleMesh& mesh) {
   if (order_dirty_) update_refit_order();
-  // Leaves from their triangles' corners, then one bottom-up pass of O(1) merges: each internal
-  // sphere is the smallest holding its two children's, so every leaf below stays covered.
-  for (const std::int32_t leaf : refit_leaves_) {
-    const LeafPiece& piece = pieces_[leaf];
-    if (piece.slices == 1) {
-      const Triangle& tri = mesh.triangles[piece.triangle];
-      spheres_[leaf] = centroid_sphere(mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]]);
-    } else {
-      spheres_[leaf] = piece_sphere(mesh, piece);
+  if (preorder_) {
+    // Depth-first numbering puts every child after its parent: one backward sweep over the arrays
+    // meets children first, reading memory in order.
+    for (std::int32_t n = node_capacity() - 1; n >= 0; --n) {
+      const std::int32_t height = links_[n].height;
+      if (height == 0) {
+        refit_leaf(mesh, n);
+      } else if (height > 0) {
+        refit_internal(mesh, n);
+      }
     }
+    return;
   }
-  for (const std::int32_t node : refit_internal_) {
-    const SphereTreeLinks& l = links_[node];
-    spheres_[node] = merge(spheres_[l.left], spheres_[l.right]);
-  }
+  // Leaves from their triangles' corners, then one bottom-up pass of O(1) merges by height: each
+  // internal bound holds its two children's, so every leaf below stays covered.
+  for (const std::int32_t leaf : refit_leaves_) refit_leaf(mesh, leaf);
+  for (const std::int32_t node : refit_internal_) refit_internal(mesh, node);
 }
 
 // ---- Insert and remove ------------------------------------------------------------------------
@@ -420,10 +578,14 @@ void SphereTree::insert_leaf(std::int32_t leaf) {
   refit_upward(parent);
 }
 
-void SphereTree::insert_triangle(const TriangleMesh& mesh, std::uint32_t t) { add_triangle_leaves(mesh, t, true); }
+void SphereTree::insert_triangle(const TriangleMesh& mesh, std::uint32_t t) {
+  ++structure_version_;
+  add_triangle_leaves(mesh, t, true);
+}
 
 void SphereTree::remove_triangle(std::uint32_t t) {
   if (t >= first_leaf_.size()) return;
+  ++structure_version_;
   std::int32_t leaf = first_leaf_[t];
   first_leaf_[t] = kNoNode;
   while (leaf != kNoNode) {

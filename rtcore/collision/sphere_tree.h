@@ -4,6 +4,8 @@
 // removals of triangles for cutting, each O(log n).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -16,6 +18,45 @@ struct Sphere {
   Vec3 center{0.0};
   double radius = 0.0;
 };
+
+/// A second bound per node, intersected with its sphere: every point of the node's triangles lies
+/// between the planes normal . x = lo and normal . x = hi (normal unit). A leaf's slab is its
+/// triangle's plane (lo == hi up to rounding), an internal node's is as thin as its children allow
+/// along the mean of their normals. Two nearly parallel surfaces a fraction of a millimetre apart,
+/// which spheres cannot tell apart, are separated by it (Collider's leaf and node tests).
+struct Slab {
+  Vec3 normal{0.0, 0.0, 1.0};
+  double lo = 0.0;
+  double hi = 0.0;
+};
+
+/// How a unit `normal` leans off a unit `axis`: their cosine k and an upper bound on their sine
+/// (rounded up).
+struct Lean {
+  double k = 1.0;
+  double sine = 0.0;
+};
+inline Lean lean_of(const Vec3& axis, const Vec3& normal) {
+  const double k = dot(axis, normal);
+  return {k, std::sqrt(std::max(0.0, 1.0 - k * k) + 1e-15)};
+}
+
+/// Bounds the projection onto unit `axis` of the region inside both `sphere` and `slab` (the
+/// region a node's triangles lie in), `lean` being the slab normal's against the axis: the slab
+/// gives the part along its normal, the sphere the rest, scaled by the sine. Intersected with the
+/// sphere's own projection. Rounding is left to the caller's pad.
+inline void project_region(const Sphere& sphere, const Slab& slab, const Vec3& axis, const Lean& lean, double& lo,
+                           double& hi) {
+  const double along = dot(axis, sphere.center);
+  const double rest = along - lean.k * dot(slab.normal, sphere.center);
+  const double slab_lo = lean.k >= 0.0 ? lean.k * slab.lo : lean.k * slab.hi;
+  const double slab_hi = lean.k >= 0.0 ? lean.k * slab.hi : lean.k * slab.lo;
+  lo = std::max(slab_lo + rest - sphere.radius * lean.sine, along - sphere.radius);
+  hi = std::min(slab_hi + rest + sphere.radius * lean.sine, along + sphere.radius);
+}
+inline void project_bound(const Sphere& sphere, const Slab& slab, const Vec3& axis, double& lo, double& hi) {
+  project_region(sphere, slab, axis, lean_of(axis, slab.normal), lo, hi);
+}
 
 /// Which part of a triangle a leaf covers: the triangle is cut into `slices` slabs by lines
 /// parallel to its shortest edge; the leaf covers slab `slice` (0 .. slices-1). `apex` is the local
@@ -95,6 +136,11 @@ class SphereTree {
 
   const std::vector<Sphere>& spheres() const { return spheres_; }
   const std::vector<SphereTreeLinks>& links() const { return links_; }
+  /// Per node, the slab bound beside the sphere (kept by build, refit, insert and remove).
+  const std::vector<Slab>& slabs() const { return slabs_; }
+  /// Changes whenever the node structure changes (build, rebuild, insert, remove), never on refit:
+  /// what a query caching node pairs between calls checks.
+  std::uint64_t structure_version() const { return structure_version_; }
   const std::vector<LeafPiece>& pieces() const { return pieces_; }
   /// First leaf of triangle t (kNoNode if none); the rest follow through next_leaf_of_triangle().
   std::int32_t first_leaf_of_triangle(std::uint32_t t) const {
@@ -105,6 +151,11 @@ class SphereTree {
   /// The sphere of one leaf piece of the mesh's current geometry (inflated a hair so rounding can
   /// never leave a point of the piece outside it).
   static Sphere piece_sphere(const TriangleMesh& mesh, const LeafPiece& piece);
+  /// The slab of a triangle: its plane, widened by rounding (a degenerate triangle gets the slab of
+  /// its sphere along z).
+  static Slab triangle_slab(const TriangleMesh& mesh, std::uint32_t t, const Sphere& sphere);
+  /// The slab of a node along the mean normal of two children's bounds (sphere and slab each).
+  static Slab merge_slabs(const Sphere& a, const Slab& sa, const Sphere& b, const Slab& sb);
   /// The pieces a triangle is covered by.
   static int slice_count(const TriangleMesh& mesh, std::uint32_t t, std::uint8_t& apex);
   /// The same for slabs of a given aspect (kSliceAspect above).
@@ -116,6 +167,9 @@ class SphereTree {
   std::int32_t build_range(std::int32_t* first, std::int32_t* last, std::int32_t parent);
   void cover_leaves(std::int32_t node, const std::int32_t* first, const std::int32_t* last);
   void refit_node(std::int32_t node);
+  void refit_leaf(const TriangleMesh& mesh, std::int32_t leaf);
+  void refit_internal(const TriangleMesh& mesh, std::int32_t node);
+  void set_child_leans(std::int32_t node);
   void refit_upward(std::int32_t node);
   void insert_leaf(std::int32_t leaf);
   void build_over(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles);
@@ -125,6 +179,8 @@ class SphereTree {
 
   std::vector<Sphere> spheres_;         // hot: per node
   std::vector<SphereTreeLinks> links_;  // per node
+  std::vector<Slab> slabs_;             // hot: per node
+  std::vector<Lean> leans_;             // per node: its slab normal against its parent's
   std::vector<LeafPiece> pieces_;       // per node (leaves only)
   std::vector<std::int32_t> next_leaf_;   // per node: next leaf of the same triangle
   std::vector<std::int32_t> first_leaf_;  // per triangle
@@ -135,7 +191,10 @@ class SphereTree {
   std::int32_t free_list_ = kNoNode;
   std::int32_t leaf_count_ = 0;
   std::int32_t live_nodes_ = 0;
+  const TriangleMesh* build_mesh_ = nullptr;  // the mesh of the build under way
   bool order_dirty_ = true;
+  bool preorder_ = false;  // every child's index is above its parent's: refit sweeps the array backwards
+  std::uint64_t structure_version_ = 0;
   double slice_aspect_ = kSliceAspect;
   double built_mean_internal_radius_ = 0.0;
 };

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "rtcore/anatomy/prostate.h"
 #include "rtcore/anatomy/resectoscope.h"
@@ -79,6 +80,38 @@ inline void expect_tree_invariants(const SphereTree& tree) {
   EXPECT_EQ(leaves, tree.leaf_count());
   EXPECT_EQ(reachable, tree.live_node_count());
   EXPECT_EQ(reachable + tree.free_node_count(), tree.node_capacity()) << "nodes lost or leaked";
+}
+
+/// The corners of the part of its triangle a leaf covers (the triangle, or a slab across it).
+inline std::vector<Vec3> piece_corners(const TriangleMesh& mesh, const LeafPiece& piece) {
+  const Triangle& tri = mesh.triangles[piece.triangle];
+  if (piece.slices == 1) return {mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]]};
+  const Vec3& b = mesh.positions[tri[piece.apex]];
+  const Vec3& x = mesh.positions[tri[(piece.apex + 1) % 3]];
+  const Vec3& y = mesh.positions[tri[(piece.apex + 2) % 3]];
+  const double t0 = static_cast<double>(piece.slice) / piece.slices;
+  const double t1 = static_cast<double>(piece.slice + 1) / piece.slices;
+  return {x * (1.0 - t0) + b * t0, y * (1.0 - t0) + b * t0, x * (1.0 - t1) + b * t1, y * (1.0 - t1) + b * t1};
+}
+
+/// Checks the slab bounds against the mesh: every corner of what every live leaf covers lies inside
+/// the leaf's slab and inside every ancestor's, to rounding.
+inline void expect_slabs_cover(const SphereTree& tree, const TriangleMesh& mesh) {
+  const auto& links = tree.links();
+  for (std::int32_t leaf = 0; leaf < tree.node_capacity(); ++leaf) {
+    if (links[leaf].height != 0) continue;  // internal or free
+    const std::vector<Vec3> corners = piece_corners(mesh, tree.pieces()[leaf]);
+    for (std::int32_t n = leaf; n != SphereTree::kNoNode; n = links[n].parent) {
+      const Slab& slab = tree.slabs()[n];
+      ASSERT_NEAR(length(slab.normal), 1.0, 1e-12) << "node " << n;
+      for (const Vec3& p : corners) {
+        const double along = dot(slab.normal, p);
+        const double eps = 1e-9 * (std::abs(along) + 1e-3);
+        ASSERT_GE(along, slab.lo - eps) << "corner of leaf " << leaf << " below the slab of node " << n;
+        ASSERT_LE(along, slab.hi + eps) << "corner of leaf " << leaf << " above the slab of node " << n;
+      }
+    }
+  }
 }
 
 }  // namespace resecto::testing

@@ -135,6 +135,7 @@ TEST(SphereTree, InvariantsHoldOverTenThousandRandomOperations) {
     }
     if (op % 250 == 0 || op == 9999) {
       testing::expect_tree_invariants(tree);
+      testing::expect_slabs_cover(tree, mesh);
       if (HasFatalFailure() || HasNonfatalFailure()) FAIL() << "op " << op;
       std::int32_t leaves = 0;
       for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
