@@ -5,6 +5,7 @@
 #include <charconv>
 #include <sstream>
 
+#include "rtcore/base/checked_number.h"
 #include "rtcore/base/text_file.h"
 
 namespace resecto::device {
@@ -56,14 +57,9 @@ Result<NumericCsv> parse_numeric_csv(const std::string& text, const std::string&
     }
     std::vector<double> values;
     for (size_t c = 0; c < cells.size(); ++c) {
-      double value = 0.0;
-      const char* begin = cells[c].data();
-      const char* end = begin + cells[c].size();
-      const auto [ptr, ec] = std::from_chars(begin, end, value);
-      if (ec != std::errc{} || ptr != end || cells[c].empty()) {
-        return Error{where + ": column " + table.columns[c] + ": not a number: '" + cells[c] + "'"};
-      }
-      values.push_back(value);
+      const std::optional<double> value = parse_finite(cells[c]);
+      if (!value) return Error{where + ": column " + table.columns[c] + ": not a finite number: '" + cells[c] + "'"};
+      values.push_back(*value);
     }
     table.rows.push_back(std::move(values));
     table.lines.push_back(number);

@@ -1,6 +1,8 @@
 // Measures, boundary extraction and VTK files of the tetrahedral tissue model.
 #include "rtcore/tissue/tet_mesh.h"
 
+#include "rtcore/base/atomic_file.h"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -99,33 +101,20 @@ TriangleMesh boundary_surface(const TetMesh& mesh) {
 }
 
 Status write_vtk(const std::filesystem::path& path, const TetMesh& mesh) {
-  std::filesystem::path temporary = path;
-  temporary += ".partial";
-  {
-    std::ofstream out(temporary, std::ios::binary);
-    if (!out) return Error{path.string() + ": cannot open for writing"};
-    out.precision(10);
-    out << "# vtk DataFile Version 3.0\nResecto tetrahedral tissue model (millimetres)\nASCII\nDATASET UNSTRUCTURED_GRID\n";
-    out << "POINTS " << mesh.node_count() << " double\n";
-    for (const Vec3& p : mesh.positions) {
-      out << units::m_to_mm(p.x) << ' ' << units::m_to_mm(p.y) << ' ' << units::m_to_mm(p.z) << '\n';
-    }
-    out << "CELLS " << mesh.tetrahedron_count() << ' ' << 5 * mesh.tetrahedron_count() << '\n';
-    for (const Tetrahedron& t : mesh.tetrahedra) out << "4 " << t[0] << ' ' << t[1] << ' ' << t[2] << ' ' << t[3] << '\n';
-    out << "CELL_TYPES " << mesh.tetrahedron_count() << '\n';
-    for (std::size_t t = 0; t < mesh.tetrahedron_count(); ++t) out << "10\n";
-    out << "CELL_DATA " << mesh.tetrahedron_count() << "\nSCALARS region int 1\nLOOKUP_TABLE default\n";
-    for (TissueRegion r : mesh.regions) out << static_cast<int>(r) << '\n';
-    if (!out.flush()) {
-      std::error_code ec;
-      std::filesystem::remove(temporary, ec);
-      return Error{path.string() + ": write failed (disk full?)"};
-    }
+  std::ostringstream out(std::ios::out | std::ios::binary);
+  out.precision(10);
+  out << "# vtk DataFile Version 3.0\nResecto tetrahedral tissue model (millimetres)\nASCII\nDATASET UNSTRUCTURED_GRID\n";
+  out << "POINTS " << mesh.node_count() << " double\n";
+  for (const Vec3& p : mesh.positions) {
+    out << units::m_to_mm(p.x) << ' ' << units::m_to_mm(p.y) << ' ' << units::m_to_mm(p.z) << '\n';
   }
-  std::error_code ec;
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) return Error{path.string() + ": cannot replace the file: " + ec.message()};
-  return Ok{};
+  out << "CELLS " << mesh.tetrahedron_count() << ' ' << 5 * mesh.tetrahedron_count() << '\n';
+  for (const Tetrahedron& t : mesh.tetrahedra) out << "4 " << t[0] << ' ' << t[1] << ' ' << t[2] << ' ' << t[3] << '\n';
+  out << "CELL_TYPES " << mesh.tetrahedron_count() << '\n';
+  for (std::size_t t = 0; t < mesh.tetrahedron_count(); ++t) out << "10\n";
+  out << "CELL_DATA " << mesh.tetrahedron_count() << "\nSCALARS region int 1\nLOOKUP_TABLE default\n";
+  for (TissueRegion r : mesh.regions) out << static_cast<int>(r) << '\n';
+  return write_file_atomically(path, out.view());
 }
 
 Result<TetMesh> read_vtk(const std::filesystem::path& path) {
