@@ -78,8 +78,9 @@ Result<std::vector<HallSample>> hall_samples(const NumericCsv& csv, const std::s
   for (size_t r = 0; r < csv.rows.size(); ++r) {
     const auto& row = csv.rows[r];
     if (auto e = row_problem(source, csv.lines[r], "position_mm", row[(*columns)[0]], 0.0, kLoopTravelMm)) return *e;
+    // Each count column within what the two 12-bit channels can sum to; the fit checks the sum.
     for (std::size_t c = 1; c < columns->size(); ++c) {
-      const double limit = summed ? 2.0 * kAdcMaxCounts : kAdcMaxCounts;
+      const double limit = 2.0 * kAdcMaxCounts;
       if (auto e = row_problem(source, csv.lines[r], csv.columns[static_cast<std::size_t>((*columns)[c])].c_str(), row[(*columns)[c]], 0.0, limit)) return *e;
     }
     const double sum = summed ? row[(*columns)[1]] : row[(*columns)[1]] + row[(*columns)[2]];
