@@ -1,8 +1,6 @@
 // The calibration file: JSON in millimetres, read with errors naming the field, written atomically.
 #include "device/calibration/calibration.h"
 
-#include "rtcore/base/atomic_file.h"
-
 #include <unistd.h>
 
 #include <cmath>
@@ -12,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "resecto/lp3500_sensors.h"
+#include "rtcore/base/atomic_file.h"
 #include "rtcore/base/checked_number.h"
 #include "rtcore/base/text_file.h"
 

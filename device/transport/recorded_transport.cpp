@@ -3,6 +3,9 @@
 
 #include <cerrno>
 #include <cstdlib>
+#include <sstream>
+
+#include "rtcore/base/text_file.h"
 
 namespace resecto {
 namespace {
@@ -17,8 +20,10 @@ int hex_digit(char c) {
 }  // namespace
 
 Result<std::vector<RecordedReport>> read_raw_reports(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) return Error{path.string() + ": cannot open recording"};
+  // Read whole and capped: a device such as /dev/zero has no line end and no end.
+  Result<std::string> text = read_text_file(path, " the recording");
+  if (!text) return Error{text.error()};
+  std::istringstream in(*text);
   std::vector<RecordedReport> reports;
   std::string line;
   int line_number = 0;

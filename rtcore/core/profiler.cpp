@@ -1,14 +1,14 @@
 // Statistics and the Chrome trace export of the frame-budget profiler.
 #include "rtcore/core/profiler.h"
 
-#include "rtcore/base/atomic_file.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+
+#include "rtcore/base/atomic_file.h"
 
 namespace resecto {
 namespace {

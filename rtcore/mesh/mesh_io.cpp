@@ -3,10 +3,6 @@
 // into memory and then to disk by the one atomic writer.
 #include "rtcore/mesh/mesh_io.h"
 
-#include "rtcore/base/atomic_file.h"
-#include "rtcore/base/text_file.h"
-#include "rtcore/mesh/mesh_parse.h"
-
 #include <OpenMesh/Core/IO/IOManager.hh>
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
@@ -20,6 +16,10 @@
 #include <string>
 #include <system_error>
 #include <vector>
+
+#include "rtcore/base/atomic_file.h"
+#include "rtcore/base/text_file.h"
+#include "rtcore/mesh/mesh_parse.h"
 
 namespace resecto {
 namespace {

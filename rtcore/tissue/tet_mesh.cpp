@@ -1,8 +1,6 @@
 // Measures, boundary extraction and VTK files of the tetrahedral tissue model.
 #include "rtcore/tissue/tet_mesh.h"
 
-#include "rtcore/base/atomic_file.h"
-
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -11,6 +9,8 @@
 #include <string>
 #include <tuple>
 
+#include "rtcore/base/atomic_file.h"
+#include "rtcore/base/text_file.h"
 #include "rtcore/base/units.h"
 
 namespace resecto {
@@ -118,8 +118,10 @@ Status write_vtk(const std::filesystem::path& path, const TetMesh& mesh) {
 }
 
 Result<TetMesh> read_vtk(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) return Error{path.string() + ": cannot open"};
+  // Read whole and capped, so every count below can be checked against the bytes there are.
+  Result<std::string> text = read_text_file(path, "", std::uintmax_t{1} << 30);
+  if (!text) return Error{text.error()};
+  std::istringstream in(*text);
   const std::string name = path.string();
   TetMesh mesh;
   std::string line;
@@ -127,6 +129,10 @@ Result<TetMesh> read_vtk(const std::filesystem::path& path) {
   // A file cut mid-line ends without its newline: say so, it is the likeliest cause of a bad last line.
   auto fail = [&](const std::string& what) {
     return Error{name + ":" + std::to_string(line_number) + ": " + (in.eof() ? "truncated: " : "") + what};
+  };
+  auto bytes_left = [&]() -> std::size_t {
+    const std::streamoff at = in.tellg();
+    return at < 0 ? 0 : text->size() - static_cast<std::size_t>(at);
   };
   auto next_line = [&]() {
     ++line_number;
@@ -144,6 +150,7 @@ Result<TetMesh> read_vtk(const std::filesystem::path& path) {
     if (keyword == "POINTS") {
       std::size_t n = 0;
       if (!(words >> n)) return fail("POINTS without a count");
+      if (n > bytes_left() / 6) return fail("POINTS " + std::to_string(n) + " is more than the rest of the file holds (truncated?)");  // "0 0 0\n"
       mesh.positions.resize(n);
       for (std::size_t i = 0; i < n; ++i) {
         if (!next_line()) return fail("truncated: expected " + std::to_string(n) + " points");
@@ -154,6 +161,7 @@ Result<TetMesh> read_vtk(const std::filesystem::path& path) {
       }
     } else if (keyword == "CELLS") {
       if (!(words >> cells)) return fail("CELLS without a count");
+      if (cells > bytes_left() / 10) return fail("CELLS " + std::to_string(cells) + " is more than the rest of the file holds (truncated?)");  // "4 0 1 2 3\n"
       mesh.tetrahedra.resize(cells);
       for (std::size_t i = 0; i < cells; ++i) {
         if (!next_line()) return fail("truncated: expected " + std::to_string(cells) + " cells");
