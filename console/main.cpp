@@ -4,6 +4,7 @@
 #include <exception>
 
 #include "console/commands/command_registry.h"
+#include "rtcore/base/atomic_file.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Resecto: a real-time simulator for training transurethral resection of the prostate"};
@@ -15,6 +16,11 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "resecto: %s\n", e.what());
+    return 1;
+  }
+  // A report printed into a full disk or a closed pipe is lost: that is a failure, not exit 0.
+  if (resecto::Status flushed = resecto::flush_standard_output(); !flushed) {
+    std::fprintf(stderr, "resecto: %s\n", flushed.error().c_str());
     return 1;
   }
   return 0;

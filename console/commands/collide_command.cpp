@@ -14,6 +14,9 @@
 #include <nlohmann/json.hpp>
 
 #include "console/commands/command_registry.h"
+#include "console/commands/pose_file.h"
+#include "rtcore/base/atomic_file.h"
+#include "rtcore/base/text_file.h"
 #include "rtcore/collision/collide.h"
 #include "rtcore/mesh/mesh_io.h"
 
@@ -41,50 +44,12 @@ TriangleMesh read_mesh_or_fail(const std::string& path) {
   return std::move(mesh).value();
 }
 
-// One pose a line: 12 numbers, row-major [R|t]; blank lines and '#' comments skipped. The rotation
-// must be orthonormal to 1e-4 (a rigid transform, as the contract says).
 std::vector<RigidTransform> read_poses_or_fail(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) fail(path + ": cannot open the poses file");
-  std::vector<RigidTransform> poses;
-  std::string line;
-  for (int number = 1; std::getline(in, line); ++number) {
-    const std::size_t start = line.find_first_not_of(" \t\r");
-    if (start == std::string::npos || line[start] == '#') continue;
-    const std::string where = path + ":" + std::to_string(number) + ": ";
-    double values[12];
-    const char* cursor = line.c_str();
-    int count = 0;
-    for (;;) {
-      while (*cursor == ' ' || *cursor == '\t' || *cursor == ',' || *cursor == '\r') ++cursor;
-      if (*cursor == '\0') break;
-      char* end = nullptr;
-      const double v = std::strtod(cursor, &end);
-      if (end == cursor) fail(where + "'" + std::string(cursor).substr(0, 20) + "' is not a number");
-      if (!std::isfinite(v)) fail(where + "value " + std::to_string(count + 1) + " is not finite");
-      if (count == 12) fail(where + "more than 12 numbers (expected r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz)");
-      values[count++] = v;
-      cursor = end;
-    }
-    if (count != 12) {
-      fail(where + "expected 12 numbers (r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz), found " + std::to_string(count));
-    }
-    RigidTransform pose;
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) pose.rotation[i][j] = values[4 * i + j];
-      pose.translation[i] = values[4 * i + 3];
-    }
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) {
-        const double rtr = pose.rotation[0][i] * pose.rotation[0][j] + pose.rotation[1][i] * pose.rotation[1][j] +
-                           pose.rotation[2][i] * pose.rotation[2][j];
-        if (std::abs(rtr - (i == j ? 1.0 : 0.0)) > 1e-4) fail(where + "the 3x3 rotation is not orthonormal");
-      }
-    }
-    poses.push_back(pose);
-  }
-  if (poses.empty()) fail(path + ": no poses (12 numbers a line)");
-  return poses;
+  Result<std::string> text = read_text_file(path, " the poses file");
+  if (!text) fail(text.error());
+  Result<std::vector<RigidTransform>> poses = parse_poses(*text, path);
+  if (!poses) fail(poses.error());
+  return std::move(poses).value();
 }
 
 // Nearest-rank percentile of sorted values.
@@ -134,12 +99,11 @@ void run_collide(const CollideOptions& options) {
   for (const auto& f : found) total_pairs += f.size();
 
   if (!options.pairs.empty()) {
-    std::ofstream out(options.pairs, std::ios::binary);
-    out << "pose,tissue_face,tool_face\n";
+    std::string csv = "pose,tissue_face,tool_face\n";
     for (std::size_t p = 0; p < found.size(); ++p) {
-      for (const TrianglePair& pair : found[p]) out << p << ',' << pair.tissue << ',' << pair.tool << '\n';
+      for (const TrianglePair& pair : found[p]) csv += std::to_string(p) + ',' + std::to_string(pair.tissue) + ',' + std::to_string(pair.tool) + '\n';
     }
-    if (!out.flush()) fail(options.pairs + ": cannot write the pairs file");
+    if (Status written = write_file_atomically(options.pairs, csv); !written) fail(written.error());
   }
 
   std::sort(times_us.begin(), times_us.end());

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "console/commands/checked_options.h"
 #include "console/commands/command_registry.h"
 #include "device/calibration/calibration.h"
 #include "device/link/calibration_adapter.h"
@@ -153,6 +154,9 @@ void run_monitor(const MonitorOptions& o) {
       if (!devices) fail(devices.error());
       if (devices->empty()) fail(none_found_line(o.hid));
     }
+    if (!o.hid.path.empty()) {
+      if (Status node = check_hidraw_node(o.hid.path); !node) fail(node.error());
+    }
     HidSelector selector;
     selector.vendor_id = static_cast<std::uint16_t>(o.hid.vendor_id);
     selector.product_id = static_cast<std::uint16_t>(o.hid.product_id);
@@ -255,6 +259,9 @@ void run_monitor(const MonitorOptions& o) {
     clock.sleep_until_ns(std::min(end_ns, now_ns + 5 * kNanosecondsPerMillisecond));
   }
   link.stop();
+  if (recorder) {
+    if (Status finished = recorder->finish(); !finished) fail(finished.error());
+  }
   tool.latch(link.samples(), 0.0);
   const LinkCounters c = link.counters();
   const double seconds = static_cast<double>(clock.now_ns() - start_ns) * 1e-9;
@@ -280,13 +287,13 @@ void register_monitor(CLI::App& family) {
   CLI::App* cmd = family.add_subcommand("monitor", "Show the live device link and its statistics");
   cmd->add_option("--device", o->device, "Where reports come from")
       ->check(CLI::IsMember({"hid", "emulator"}))->capture_default_str();
-  cmd->add_option("--seconds", o->seconds, "How long to monitor")->check(CLI::Range(0.01, 86400.0))->capture_default_str();
-  cmd->add_option("--drop", o->drop, "Inject: probability a report is dropped")->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--duplicate", o->duplicate, "Inject: probability a report arrives twice")->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--corrupt", o->corrupt, "Inject: probability one bit of a report flips")->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--delay", o->delay, "Inject: probability a report arrives late (out of order)")->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--seconds", o->seconds, "How long to monitor")->check(finite_range(0.01, 86400.0))->capture_default_str();
+  cmd->add_option("--drop", o->drop, "Inject: probability a report is dropped")->check(finite_range(0.0, 1.0));
+  cmd->add_option("--duplicate", o->duplicate, "Inject: probability a report arrives twice")->check(finite_range(0.0, 1.0));
+  cmd->add_option("--corrupt", o->corrupt, "Inject: probability one bit of a report flips")->check(finite_range(0.0, 1.0));
+  cmd->add_option("--delay", o->delay, "Inject: probability a report arrives late (out of order)")->check(finite_range(0.0, 1.0));
   cmd->add_option("--unplug", o->unplug, "Inject: probability per read that the cable is pulled for 300 ms")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(finite_range(0.0, 1.0));
   cmd->add_option("--seed", o->seed, "Seed of the injected faults and the emulator's noise")->capture_default_str();
   cmd->add_option("--calibration", o->calibration, "Calibration file (JSON; default: the board's compiled-in one)");
   cmd->add_option("--record", o->record, "Write every raw report to this file (text, timestamped)");

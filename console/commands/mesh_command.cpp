@@ -9,9 +9,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "console/commands/checked_options.h"
 #include "console/commands/command_registry.h"
+#include "rtcore/anatomy/landmarks_file.h"
 #include "rtcore/anatomy/prostate.h"
 #include "rtcore/anatomy/resectoscope.h"
+#include "rtcore/base/atomic_file.h"
+#include "rtcore/base/text_file.h"
 #include "rtcore/base/units.h"
 #include "rtcore/mesh/mesh_io.h"
 #include "rtcore/mesh/mesh_validation.h"
@@ -62,11 +66,7 @@ void register_prostate(CLI::App& mesh) {
     const SurfaceReport report = validated(model.surface, "generated prostate");
     write_or_fail(options->output, model.surface);
     const auto landmarks = landmarks_path_for(options->output);
-    {
-      std::ofstream out(landmarks, std::ios::binary);
-      out << landmarks_to_json(model);
-      if (!out.flush()) fail(landmarks.string() + ": cannot write the landmarks");
-    }
+    if (Status written = write_file_atomically(landmarks, landmarks_to_json(model)); !written) fail(written.error());
     const ProstateShape& s = model.shape;
     std::printf("prostate %s (landmarks %s)\n", options->output.c_str(), landmarks.string().c_str());
     std::printf("  grid             %d around the channel x %d along the meridian\n", model.meridian_segments, model.profile_segments);
@@ -88,7 +88,7 @@ void register_resectoscope(CLI::App& mesh) {
   auto options = std::make_shared<Options>();
   CLI::App* cmd = mesh.add_subcommand("resectoscope", "Write the 488-triangle resectoscope: faces 0-157 sheath, 158-487 loop");
   cmd->add_option("--loop-travel", options->loop_travel_mm, "Loop travel out of the sheath tip, mm")
-      ->check(CLI::Range(0.0, 36.0))->capture_default_str();
+      ->check(finite_range(0.0, 36.0))->capture_default_str();
   cmd->add_option("-o,--output", options->output, "Mesh file (.off, .obj, .ply, .stl), millimetres")->required();
   cmd->callback([options] {
     ResectoscopeShape shape;
@@ -134,12 +134,12 @@ void register_tetra(CLI::App& mesh) {
   cmd->add_option("input", options->input, "Closed surface (.off, .obj, .ply, .stl), millimetres")->required();
   cmd->add_option("-o,--output", options->output, "Tetrahedral mesh, legacy VTK (.vtk), millimetres")->required();
   cmd->add_option("--radius-edge", options->radius_edge, "Largest radius-edge ratio TetGen may leave (-q)")
-      ->check(CLI::Range(1.0, 10.0))->capture_default_str();
+      ->check(finite_range(1.0, 10.0))->capture_default_str();
   cmd->add_option("--min-dihedral", options->min_dihedral_deg, "Smallest dihedral angle TetGen aims for, degrees (-q)")
-      ->check(CLI::Range(0.0, 30.0))->capture_default_str();
+      ->check(finite_range(0.0, 30.0))->capture_default_str();
   cmd->add_option("--max-volume", options->max_volume_mm3, "Largest tetrahedron volume, mm^3 (-a); 0 = unbounded")
-      ->check(CLI::Range(0.0, 1e9))->capture_default_str();
-  cmd->add_option("--capsule", options->capsule_mm, "Capsule shell thickness, mm")->check(CLI::Range(0.0, 20.0))->capture_default_str();
+      ->check(finite_range(0.0, 1e9))->capture_default_str();
+  cmd->add_option("--capsule", options->capsule_mm, "Capsule shell thickness, mm")->check(finite_range(0.0, 20.0))->capture_default_str();
   cmd->callback([options] {
     if (std::filesystem::path(options->output).extension() != ".vtk") fail(options->output + ": the output must be a .vtk file");
     Result<TriangleMesh> surface = read_surface_mesh(options->input);
@@ -154,13 +154,11 @@ void register_tetra(CLI::App& mesh) {
     // The generator's landmarks, when present, say where the urethral channel runs.
     const auto landmarks = landmarks_path_for(options->input);
     if (std::filesystem::exists(landmarks)) {
-      try {
-        const auto doc = nlohmann::json::parse(std::ifstream(landmarks));
-        auto point = [](const nlohmann::json& a) { return Vec3(a.at(0).get<double>(), a.at(1).get<double>(), a.at(2).get<double>()) * units::kMetresPerMillimetre; };
-        tet.channel_axis = {point(doc.at("channel_axis").at("apex")), point(doc.at("channel_axis").at("bladder_neck"))};
-      } catch (const nlohmann::json::exception& e) {
-        fail(landmarks.string() + ": malformed landmarks file: " + e.what());
-      }
+      Result<std::string> text = read_text_file(landmarks);
+      if (!text) fail(text.error());
+      Result<std::pair<Vec3, Vec3>> axis = parse_channel_axis(*text, landmarks.string());
+      if (!axis) fail(axis.error());
+      tet.channel_axis = *axis;
     }
     const auto start = std::chrono::steady_clock::now();
     Result<TetMesh> tetra = tetrahedralize(*surface, tet);

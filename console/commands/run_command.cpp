@@ -9,9 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "console/commands/checked_options.h"
 #include "console/commands/command_registry.h"
 #include "console/commands/parameter_options.h"
 #include "console/headless/headless_run.h"
+#include "rtcore/base/atomic_file.h"
 
 namespace resecto::cli {
 namespace {
@@ -75,9 +77,9 @@ void run(const RunOptions& o) {
   Result<HeadlessResult> result = run_headless(options);
   if (!result) throw std::runtime_error(result.error());
   if (!o.report.empty()) {
-    std::ofstream out(o.report, std::ios::binary);
-    out << result->report.dump(2) << "\n";
-    if (!out.flush()) throw std::runtime_error(o.report + ": cannot write the report");
+    if (Status written = write_file_atomically(o.report, result->report.dump(2) + "\n"); !written) {
+      throw std::runtime_error(written.error());
+    }
   }
   if (o.json) {
     std::printf("%s\n", result->report.dump(2).c_str());
@@ -91,7 +93,7 @@ void register_run(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("run", "Run the simulator (headless: a scripted procedure through the emulated device)");
   cmd->add_flag("--headless", o->headless, "No display: drive the core with a procedure and report");
   cmd->add_option("--procedure", o->procedure, "Built-in procedure (demo, turp) or a procedure file")->capture_default_str();
-  cmd->add_option("--seconds", o->seconds, "Simulated seconds (default: the procedure's length)")->check(CLI::Range(0.0, 86400.0));
+  cmd->add_option("--seconds", o->seconds, "Simulated seconds (default: the procedure's length)")->check(positive_up_to(86400.0));
   cmd->add_flag("--realtime", o->realtime, "Real time: the device link on its own thread, ticks at their deadlines");
   cmd->add_option("--report", o->report, "Write the JSON report here");
   cmd->add_option("--trace", o->trace, "Write a Chrome trace-event JSON (opens in Perfetto)");

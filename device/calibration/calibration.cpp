@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "resecto/lp3500_sensors.h"
+#include "rtcore/base/atomic_file.h"
+#include "rtcore/base/checked_number.h"
 #include "rtcore/base/text_file.h"
 
 namespace resecto::device {
@@ -74,6 +76,9 @@ class FieldReader {
   std::string source_;
   std::string error_;
 };
+
+/// The largest registration translation read, in mm on each axis.
+constexpr double kMaxTranslationMm = 1000.0;
 
 bool is_whole(double v, double lo, double hi) { return v == std::floor(v) && v >= lo && v <= hi; }
 
@@ -168,7 +173,14 @@ Result<Calibration> parse_calibration(const std::string& text, const std::string
     }
   }
   if (!rotation_shape) in.fail("registration.rotation", "must be 3 rows of 3 numbers (row-major)");
-  for (unsigned k = 0; k < 3; ++k) c.translation_mm[k] = translation[k];
+  // The registration places the device within reach of the patient: a metre either way is generous.
+  for (unsigned k = 0; k < 3; ++k) {
+    c.translation_mm[k] = translation[k];
+    const std::string field = "registration.translation_mm[" + std::to_string(k) + "]";
+    if (!in_closed_range(translation[k], -kMaxTranslationMm, kMaxTranslationMm)) {
+      in.fail(field, exact_number(translation[k]) + " is outside [" + exact_number(-kMaxTranslationMm) + ", " + exact_number(kMaxTranslationMm) + "] mm");
+    }
+  }
   if (!in.ok()) return Error{in.error()};
   // R^T R = I and det R = +1, to 1e-6: a registration must be a rotation, not a scale or mirror.
   double worst = 0.0;
@@ -209,27 +221,7 @@ std::string calibration_to_json(const Calibration& c) {
 }
 
 Status write_calibration(const Calibration& calibration, const std::filesystem::path& path) {
-  const std::string text = calibration_to_json(calibration);
-  std::filesystem::path temporary = path;
-  temporary += ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) return Error{temporary.string() + ": cannot create"};
-    out << text;
-    out.flush();
-    if (!out) {
-      std::error_code ignored;
-      std::filesystem::remove(temporary, ignored);
-      return Error{temporary.string() + ": write failed"};
-    }
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::filesystem::remove(temporary, error);
-    return Error{path.string() + ": cannot replace: " + error.message()};
-  }
-  return Ok{};
+  return write_file_atomically(path, calibration_to_json(calibration));
 }
 
 }  // namespace resecto::device

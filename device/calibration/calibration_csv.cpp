@@ -5,6 +5,7 @@
 #include <charconv>
 #include <sstream>
 
+#include "rtcore/base/checked_number.h"
 #include "rtcore/base/text_file.h"
 
 namespace resecto::device {
@@ -56,14 +57,14 @@ Result<NumericCsv> parse_numeric_csv(const std::string& text, const std::string&
     }
     std::vector<double> values;
     for (size_t c = 0; c < cells.size(); ++c) {
-      double value = 0.0;
-      const char* begin = cells[c].data();
-      const char* end = begin + cells[c].size();
-      const auto [ptr, ec] = std::from_chars(begin, end, value);
-      if (ec != std::errc{} || ptr != end || cells[c].empty()) {
-        return Error{where + ": column " + table.columns[c] + ": not a number: '" + cells[c] + "'"};
+      const std::optional<double> value = parse_finite(cells[c]);
+      if (!value) {
+        double any = 0.0;  // "nan", "inf", "1e999" parse but are no measurement
+        const auto [ptr, ec] = std::from_chars(cells[c].data(), cells[c].data() + cells[c].size(), any);
+        const bool number = !cells[c].empty() && ptr == cells[c].data() + cells[c].size() && (ec == std::errc{} || ec == std::errc::result_out_of_range);
+        return Error{where + ": column " + table.columns[c] + (number ? ": not a finite number: '" : ": not a number: '") + cells[c] + "'"};
       }
-      values.push_back(value);
+      values.push_back(*value);
     }
     table.rows.push_back(std::move(values));
     table.lines.push_back(number);

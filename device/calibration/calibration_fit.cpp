@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "resecto/lp3500_sensors.h"
+#include "rtcore/base/checked_number.h"
 
 namespace resecto::device {
 namespace {
@@ -38,6 +40,18 @@ Result<std::vector<int>> require_columns(const NumericCsv& csv, const std::strin
   return indices;
 }
 
+// What the device can measure: the sheath travels 0-230 mm on a 12-bit potentiometer, the loop
+// over the Hall table's 74 points 0.5 mm apart, each Hall channel a 12-bit reading.
+constexpr double kSheathTravelMm = 230.0;
+constexpr double kLoopTravelMm = (LP3500_HALL_TABLE_POINTS - 1) * LP3500_HALL_TABLE_STEP_UM * 1e-3;
+constexpr double kAdcMaxCounts = 4095.0;
+
+/// "<source>:<line>: <problem>" when `value` is outside [lo, hi] (NaN always is), else nothing.
+std::optional<Error> row_problem(const std::string& source, int line, const char* what, double value, double lo, double hi) {
+  if (auto problem = range_problem(what, value, lo, hi)) return Error{source + ":" + std::to_string(line) + ": " + *problem};
+  return std::nullopt;
+}
+
 }  // namespace
 
 Result<std::vector<SheathSample>> sheath_samples(const NumericCsv& csv, const std::string& source) {
@@ -45,7 +59,10 @@ Result<std::vector<SheathSample>> sheath_samples(const NumericCsv& csv, const st
   if (!columns) return Error{columns.error() + " (expected position_mm,potentiometer_counts)"};
   std::vector<SheathSample> samples;
   for (size_t r = 0; r < csv.rows.size(); ++r) {
-    samples.push_back({csv.rows[r][(*columns)[0]], csv.rows[r][(*columns)[1]], csv.lines[r]});
+    const double position = csv.rows[r][(*columns)[0]], counts = csv.rows[r][(*columns)[1]];
+    if (auto e = row_problem(source, csv.lines[r], "position_mm", position, 0.0, kSheathTravelMm)) return *e;
+    if (auto e = row_problem(source, csv.lines[r], "potentiometer_counts", counts, 0.0, kAdcMaxCounts)) return *e;
+    samples.push_back({position, counts, csv.lines[r]});
   }
   return samples;
 }
@@ -60,6 +77,12 @@ Result<std::vector<HallSample>> hall_samples(const NumericCsv& csv, const std::s
   std::vector<HallSample> samples;
   for (size_t r = 0; r < csv.rows.size(); ++r) {
     const auto& row = csv.rows[r];
+    if (auto e = row_problem(source, csv.lines[r], "position_mm", row[(*columns)[0]], 0.0, kLoopTravelMm)) return *e;
+    // Each count column within what the two 12-bit channels can sum to; the fit checks the sum.
+    for (std::size_t c = 1; c < columns->size(); ++c) {
+      const double limit = 2.0 * kAdcMaxCounts;
+      if (auto e = row_problem(source, csv.lines[r], csv.columns[static_cast<std::size_t>((*columns)[c])].c_str(), row[(*columns)[c]], 0.0, limit)) return *e;
+    }
     const double sum = summed ? row[(*columns)[1]] : row[(*columns)[1]] + row[(*columns)[2]];
     samples.push_back({row[(*columns)[0]], sum, csv.lines[r]});
   }

@@ -2,9 +2,14 @@
 #include "device/transport/hid_transport.h"
 
 #include <hidapi.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <climits>
+#include <cstring>
+#include <filesystem>
 #include <cstdio>
 #include <cwchar>
 #include <mutex>
@@ -55,6 +60,22 @@ std::string hex16(std::uint16_t value) {
 }  // namespace
 
 std::string hidapi_version() { return hid_version_str(); }
+
+Status check_hidraw_node(const std::string& path) {
+  struct stat node {};
+  if (::stat(path.c_str(), &node) != 0) return Error{path + ": cannot open the HID device: " + std::strerror(errno)};
+  if (!S_ISCHR(node.st_mode)) return Error{path + ": not a hidraw device (not a character device)"};
+  // The kernel names the driver of every character device: /sys/dev/char/MAJOR:MINOR/subsystem.
+  const std::filesystem::path subsystem = "/sys/dev/char/" + std::to_string(major(node.st_rdev)) + ":" +
+                                          std::to_string(minor(node.st_rdev)) + "/subsystem";
+  std::error_code ec;
+  const std::filesystem::path driver = std::filesystem::read_symlink(subsystem, ec);
+  if (ec || driver.filename() != "hidraw") {
+    return Error{path + ": not a hidraw device (character device " + std::to_string(major(node.st_rdev)) + ":" +
+                 std::to_string(minor(node.st_rdev)) + (ec ? "" : " belongs to " + driver.filename().string()) + ")"};
+  }
+  return Ok{};
+}
 
 Result<std::vector<HidDeviceInfo>> enumerate_hid_devices(std::uint16_t vendor_id, std::uint16_t product_id) {
   if (Status init = ensure_hidapi_initialised(); !init) return Error{init.error()};
@@ -112,6 +133,7 @@ Status HidTransport::open() {
                    " found"};
     }
   }
+  if (Status node = check_hidraw_node(path); !node) return node;
   device_ = hid_open_path(path.c_str());
   if (device_ == nullptr) return Error{"cannot open HID device " + path + ": " + narrow(hid_error(nullptr))};
   opened_path_ = path;

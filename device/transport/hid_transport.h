@@ -41,6 +41,10 @@ Result<std::vector<HidDeviceInfo>> enumerate_hid_devices(std::uint16_t vendor_id
 /// The hidapi library's version string, to show it is really linked.
 std::string hidapi_version();
 
+/// Ok when `path` is a hidraw character device; hidapi's hid_open_path crashes (frees a bad pointer)
+/// when handed a regular file, /dev/null or /dev/zero, so every path is checked before it is opened.
+Status check_hidraw_node(const std::string& path);
+
 /// hidapi-backed transport. Not copyable; closes the device on destruction.
 class HidTransport final : public DeviceTransport {
  public:

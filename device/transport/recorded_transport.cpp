@@ -3,6 +3,9 @@
 
 #include <cerrno>
 #include <cstdlib>
+#include <sstream>
+
+#include "rtcore/base/text_file.h"
 
 namespace resecto {
 namespace {
@@ -17,8 +20,10 @@ int hex_digit(char c) {
 }  // namespace
 
 Result<std::vector<RecordedReport>> read_raw_reports(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) return Error{path.string() + ": cannot open recording"};
+  // Read whole and capped: a device such as /dev/zero has no line end and no end.
+  Result<std::string> text = read_text_file(path, " the recording");
+  if (!text) return Error{text.error()};
+  std::istringstream in(*text);
   std::vector<RecordedReport> reports;
   std::string line;
   int line_number = 0;
@@ -69,10 +74,9 @@ Result<std::vector<RecordedReport>> read_raw_reports(const std::filesystem::path
 
 Result<RawReportWriter> RawReportWriter::create(const std::filesystem::path& path) {
   RawReportWriter writer;
-  writer.path_ = path;
-  writer.out_.open(path, std::ios::trunc);
-  if (!writer.out_) return Error{path.string() + ": cannot create recording"};
-  writer.out_ << kRawReportsHeader << '\n';
+  writer.file_ = std::make_unique<AtomicFile>();
+  if (Status opened = writer.file_->open(path); !opened) return Error{opened.error()};
+  writer.pending_ = std::string(kRawReportsHeader) + '\n';
   return writer;
 }
 
@@ -82,14 +86,27 @@ Status RawReportWriter::write(std::int64_t host_time_ns, std::span<const std::ui
     has_origin_ = true;
   }
   static constexpr char kHex[] = "0123456789abcdef";
-  std::string line = std::to_string((host_time_ns - origin_ns_) / kNanosecondsPerMicrosecond) + ' ';
+  pending_ += std::to_string((host_time_ns - origin_ns_) / kNanosecondsPerMicrosecond);
+  pending_ += ' ';
   for (std::uint8_t b : bytes) {
-    line += kHex[b >> 4];
-    line += kHex[b & 15];
+    pending_ += kHex[b >> 4];
+    pending_ += kHex[b & 15];
   }
-  out_ << line << '\n';
-  if (!out_) return Error{path_.string() + ": write failed"};
-  return Ok{};
+  pending_ += '\n';
+  if (pending_.size() < (std::size_t{1} << 16)) return Ok{};
+  Status written = file_->write(pending_);
+  pending_.clear();
+  return written;
+}
+
+Status RawReportWriter::finish() {
+  Status written = file_->write(pending_);
+  pending_.clear();
+  if (!written) {
+    file_->discard();
+    return written;
+  }
+  return file_->commit();
 }
 
 RecordedTransport::RecordedTransport(std::vector<RecordedReport> reports, HostClock& clock, std::string name)

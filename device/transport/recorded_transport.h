@@ -9,12 +9,14 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <fstream>
 #include <string>
 #include <vector>
 
 #include "device/transport/device_transport.h"
 #include "device/transport/host_clock.h"
+#include "rtcore/base/atomic_file.h"
 
 namespace resecto {
 
@@ -29,21 +31,25 @@ struct RecordedReport {
 /// Parses a whole recording; errors name the file and line.
 Result<std::vector<RecordedReport>> read_raw_reports(const std::filesystem::path& path);
 
-/// Appends reports to a recording as they arrive. Not for the real-time path (it does I/O).
+/// Appends reports to a recording as they arrive. Not for the real-time path (it does I/O). The
+/// recording appears at its path only when finish() succeeds (AtomicFile); a write failure at any
+/// point is kept and reported by finish().
 class RawReportWriter {
  public:
-  /// Creates (truncates) `path` and writes the header line.
+  /// Starts the recording for `path` and writes the header line.
   static Result<RawReportWriter> create(const std::filesystem::path& path);
   /// Writes one report received at `host_time_ns` (the first call fixes the time origin).
   Status write(std::int64_t host_time_ns, std::span<const std::uint8_t> bytes);
+  /// Writes what is buffered and puts the recording in place; the first failure if any write failed.
+  Status finish();
 
   RawReportWriter(RawReportWriter&&) = default;
   RawReportWriter& operator=(RawReportWriter&&) = default;
 
  private:
   RawReportWriter() = default;
-  std::filesystem::path path_;
-  std::ofstream out_;
+  std::unique_ptr<AtomicFile> file_;
+  std::string pending_;  // written out in blocks, not a system call per report
   std::int64_t origin_ns_ = 0;
   bool has_origin_ = false;
 };

@@ -1,23 +1,50 @@
-// Reading a whole text file for a parser that names its errors by the file's path. Header-only so
-// every module can use it, whatever it links.
+// Reading a whole input file for a parser that names its errors by the file's path. Only regular
+// files are read, and only up to a cap, so a device (/dev/urandom), a pipe or a huge file gets an
+// error instead of an endless read. Header-only so every module can use it, whatever it links.
 #pragma once
 
+#include <cstdint>
+#include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
+#include <system_error>
 
 #include "rtcore/base/result.h"
 
 namespace resecto {
 
-/// The file's bytes, or an error "<path>: cannot open<what>".
-inline Result<std::string> read_text_file(const std::filesystem::path& path, const std::string& what = "") {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path.string() + ": cannot open" + what};
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
+/// The largest text input (procedure, poses, calibration, CSV, landmarks) read whole: 64 MiB.
+inline constexpr std::uintmax_t kMaxTextFileBytes = std::uintmax_t{64} << 20;
+
+/// The file's bytes, or an error "<path>: <why>" (missing, a folder, not a regular file, over
+/// `max_bytes`, unreadable). `what` names the file's role in the open error, e.g. " the procedure file".
+inline Result<std::string> read_text_file(const std::filesystem::path& path, const std::string& what = "",
+                                          std::uintmax_t max_bytes = kMaxTextFileBytes) {
+  const std::string name = path.string();
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (status.type() == std::filesystem::file_type::not_found) return Error{name + ": cannot open" + what + ": no such file"};
+  if (ec) return Error{name + ": cannot open" + what + ": " + ec.message()};
+  if (status.type() == std::filesystem::file_type::directory) return Error{name + ": is a folder, not a file"};
+  if (status.type() != std::filesystem::file_type::regular) {
+    return Error{name + ": not a regular file (a device or pipe is never read whole)"};
+  }
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) return Error{name + ": cannot open" + what + ": " + ec.message()};
+  if (size > max_bytes) {
+    return Error{name + ": " + std::to_string(size) + " bytes, more than the " + std::to_string(max_bytes) + "-byte limit for this input"};
+  }
+  std::FILE* file = std::fopen(name.c_str(), "rb");
+  if (file == nullptr) return Error{name + ": cannot open" + what};
+  // Read at most one byte past the size seen: a file that grows meanwhile is cut, never read forever.
+  std::string bytes(static_cast<std::size_t>(size) + 1, '\0');
+  const std::size_t got = std::fread(bytes.data(), 1, bytes.size(), file);
+  const bool failed = std::ferror(file) != 0;
+  std::fclose(file);
+  if (failed) return Error{name + ": read failed"};
+  if (got > size) return Error{name + ": changed size while it was read"};
+  bytes.resize(got);
+  return bytes;
 }
 
 }  // namespace resecto

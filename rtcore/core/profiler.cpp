@@ -6,6 +6,9 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
+
+#include "rtcore/base/atomic_file.h"
 
 namespace resecto {
 namespace {
@@ -59,32 +62,23 @@ Status FrameProfiler::write_chrome_trace(const std::filesystem::path& path) cons
   std::int64_t origin_ns = kept ? trace_[first % trace_.size()].begin_ns : 0;
   for (std::uint64_t i = first; i < trace_written_; ++i) origin_ns = std::min(origin_ns, trace_[i % trace_.size()].begin_ns);
 
-  std::filesystem::path temporary = path;
-  temporary += ".partial";
-  {
-    std::ofstream out(temporary, std::ios::binary);
-    if (!out) return Error{path.string() + ": cannot open for writing"};
-    out << "{\"displayTimeUnit\":\"ms\",\"traceEvents\":[\n";
-    out << R"({"name":"process_name","ph":"M","pid":1,"tid":1,"args":{"name":"resecto core"}},)" << "\n";
-    out << R"json({"name":"thread_name","ph":"M","pid":1,"tid":1,"args":{"name":"core (fixed step)"}},)json" << "\n";
-    out << R"json({"name":"thread_name","ph":"M","pid":1,"tid":2,"args":{"name":"collision (refit + query)"}})json";
-    char line[256];
-    // Oldest first: the order the stages ran in.
-    for (std::uint64_t i = first; i < trace_written_; ++i) {
-      const StageTiming& t = trace_[i % trace_.size()];
-      std::snprintf(line, sizeof line,
-                    ",\n{\"name\":\"%s\",\"cat\":\"core\",\"ph\":\"X\",\"pid\":1,\"tid\":%d,\"ts\":%.3f,\"dur\":%.3f,\"args\":{\"tick\":%llu}}",
-                    stage_name(t.stage), runs_on_collision_thread(t.stage) ? 2 : 1, static_cast<double>(t.begin_ns - origin_ns) * 1e-3, static_cast<double>(t.duration_ns) * 1e-3,
-                    static_cast<unsigned long long>(t.tick));
-      out << line;
-    }
-    out << "\n]}\n";
-    if (!out.flush()) return Error{path.string() + ": write failed"};
+  std::ostringstream out(std::ios::out | std::ios::binary);
+  out << "{\"displayTimeUnit\":\"ms\",\"traceEvents\":[\n";
+  out << R"({"name":"process_name","ph":"M","pid":1,"tid":1,"args":{"name":"resecto core"}},)" << "\n";
+  out << R"json({"name":"thread_name","ph":"M","pid":1,"tid":1,"args":{"name":"core (fixed step)"}},)json" << "\n";
+  out << R"json({"name":"thread_name","ph":"M","pid":1,"tid":2,"args":{"name":"collision (refit + query)"}})json";
+  char line[256];
+  // Oldest first: the order the stages ran in.
+  for (std::uint64_t i = first; i < trace_written_; ++i) {
+    const StageTiming& t = trace_[i % trace_.size()];
+    std::snprintf(line, sizeof line,
+                  ",\n{\"name\":\"%s\",\"cat\":\"core\",\"ph\":\"X\",\"pid\":1,\"tid\":%d,\"ts\":%.3f,\"dur\":%.3f,\"args\":{\"tick\":%llu}}",
+                  stage_name(t.stage), runs_on_collision_thread(t.stage) ? 2 : 1, static_cast<double>(t.begin_ns - origin_ns) * 1e-3, static_cast<double>(t.duration_ns) * 1e-3,
+                  static_cast<unsigned long long>(t.tick));
+    out << line;
   }
-  std::error_code ec;
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) return Error{path.string() + ": cannot replace the file: " + ec.message()};
-  return Ok{};
+  out << "\n]}\n";
+  return write_file_atomically(path, out.view());
 }
 
 }  // namespace resecto

@@ -1,11 +1,10 @@
-// Surface mesh files through OpenMesh. Reading goes through a raw importer rather than an OpenMesh
-// mesh: OpenMesh's own mesh silently drops or duplicates non-manifold faces, which would hide the very
-// defects validation must name. The importer keeps every vertex and face in file order.
+// Surface mesh files: read by Resecto's own strict readers (mesh_parse.cpp; OpenMesh's readers drop
+// bad faces silently, read NaN as 0 and allocate whatever a header claims), written through OpenMesh
+// into memory and then to disk by the one atomic writer.
 #include "rtcore/mesh/mesh_io.h"
 
 #include <OpenMesh/Core/IO/IOManager.hh>
 #include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/IO/importer/BaseImporter.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
@@ -13,80 +12,17 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <system_error>
 #include <vector>
 
+#include "rtcore/base/atomic_file.h"
+#include "rtcore/base/text_file.h"
+#include "rtcore/mesh/mesh_parse.h"
+
 namespace resecto {
 namespace {
-
-/// Collects the raw vertex and face lists OpenMesh's readers parse; everything else is ignored.
-class RawSurfaceImporter final : public OpenMesh::IO::BaseImporter {
- public:
-  using VertexHandle = OpenMesh::VertexHandle;
-  using FaceHandle = OpenMesh::FaceHandle;
-  using HalfedgeHandle = OpenMesh::HalfedgeHandle;
-  using EdgeHandle = OpenMesh::EdgeHandle;
-
-  std::vector<OpenMesh::Vec3d> points;
-  std::vector<std::vector<int>> faces;
-
-  VertexHandle add_vertex(const OpenMesh::Vec3f& p) override { return add_vertex(OpenMesh::Vec3d(p)); }
-  VertexHandle add_vertex(const OpenMesh::Vec3d& p) override {
-    points.push_back(p);
-    return VertexHandle(static_cast<int>(points.size()) - 1);
-  }
-  VertexHandle add_vertex() override { return add_vertex(OpenMesh::Vec3d(0.0, 0.0, 0.0)); }
-  HalfedgeHandle add_edge(VertexHandle, VertexHandle) override { return HalfedgeHandle(); }
-  FaceHandle add_face(const VHandles& indices) override {
-    std::vector<int> face;
-    face.reserve(indices.size());
-    for (const VertexHandle& vh : indices) face.push_back(vh.idx());
-    faces.push_back(std::move(face));
-    return FaceHandle(static_cast<int>(faces.size()) - 1);
-  }
-  FaceHandle add_face(HalfedgeHandle) override { return FaceHandle(); }
-  void set_point(VertexHandle vh, const OpenMesh::Vec3f& p) override {
-    if (vh.idx() >= 0 && static_cast<std::size_t>(vh.idx()) < points.size()) points[vh.idx()] = OpenMesh::Vec3d(p);
-  }
-
-  // Attributes the simulator does not use.
-  void add_face_texcoords(FaceHandle, VertexHandle, const std::vector<OpenMesh::Vec2f>&) override {}
-  void add_face_texcoords(FaceHandle, VertexHandle, const std::vector<OpenMesh::Vec3f>&) override {}
-  void set_face_texindex(FaceHandle, int) override {}
-  void set_halfedge(VertexHandle, HalfedgeHandle) override {}
-  void set_normal(VertexHandle, const OpenMesh::Vec3f&) override {}
-  void set_normal(VertexHandle, const OpenMesh::Vec3d&) override {}
-  void set_color(VertexHandle, const OpenMesh::Vec3uc&) override {}
-  void set_color(VertexHandle, const OpenMesh::Vec4uc&) override {}
-  void set_color(VertexHandle, const OpenMesh::Vec3f&) override {}
-  void set_color(VertexHandle, const OpenMesh::Vec4f&) override {}
-  void set_texcoord(VertexHandle, const OpenMesh::Vec2f&) override {}
-  void set_status(VertexHandle, const OpenMesh::Attributes::StatusInfo&) override {}
-  void set_next(HalfedgeHandle, HalfedgeHandle) override {}
-  void set_face(HalfedgeHandle, FaceHandle) override {}
-  void request_face_texcoords2D() override {}
-  void set_texcoord(HalfedgeHandle, const OpenMesh::Vec2f&) override {}
-  void set_texcoord(VertexHandle, const OpenMesh::Vec3f&) override {}
-  void set_texcoord(HalfedgeHandle, const OpenMesh::Vec3f&) override {}
-  void set_status(HalfedgeHandle, const OpenMesh::Attributes::StatusInfo&) override {}
-  void set_color(EdgeHandle, const OpenMesh::Vec3uc&) override {}
-  void set_color(EdgeHandle, const OpenMesh::Vec4uc&) override {}
-  void set_color(EdgeHandle, const OpenMesh::Vec3f&) override {}
-  void set_color(EdgeHandle, const OpenMesh::Vec4f&) override {}
-  void set_status(EdgeHandle, const OpenMesh::Attributes::StatusInfo&) override {}
-  void set_normal(FaceHandle, const OpenMesh::Vec3f&) override {}
-  void set_normal(FaceHandle, const OpenMesh::Vec3d&) override {}
-  void set_color(FaceHandle, const OpenMesh::Vec3uc&) override {}
-  void set_color(FaceHandle, const OpenMesh::Vec4uc&) override {}
-  void set_color(FaceHandle, const OpenMesh::Vec3f&) override {}
-  void set_color(FaceHandle, const OpenMesh::Vec4f&) override {}
-  void set_status(FaceHandle, const OpenMesh::Attributes::StatusInfo&) override {}
-  void add_texture_information(int, std::string) override {}
-  size_t n_vertices() const override { return points.size(); }
-  size_t n_faces() const override { return faces.size(); }
-  size_t n_edges() const override { return 0; }
-};
 
 std::string lower_extension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
@@ -119,48 +55,10 @@ Result<TriangleMesh> read_surface_mesh(const std::filesystem::path& path, double
   if (!is_supported_extension(ext)) {
     return Error{name + ": unsupported mesh format '" + ext + "' (expected .off, .obj, .ply or .stl)"};
   }
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return Error{name + ": no such file"};
-  if (std::filesystem::file_size(path, ec) == 0) return Error{name + ": file is empty"};
-
-  RawSurfaceImporter importer;
-  OpenMesh::IO::Options options;
-  bool parsed = false;
-  {
-    QuietOpenMesh quiet;
-    parsed = OpenMesh::IO::IOManager().read(name, importer, options);
-  }
-  if (!parsed) return Error{name + ": not a readable " + ext.substr(1) + " mesh (OpenMesh could not parse it)"};
-  if (importer.faces.empty()) return Error{name + ": the file holds no faces"};
-
-  TriangleMesh mesh;
-  mesh.positions.reserve(importer.points.size());
-  for (std::size_t v = 0; v < importer.points.size(); ++v) {
-    const OpenMesh::Vec3d& p = importer.points[v];
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
-      return Error{name + ": vertex " + std::to_string(v) + " has a non-finite coordinate"};
-    }
-    mesh.positions.push_back(Vec3(p[0], p[1], p[2]) * metres_per_unit);
-  }
-  const auto vertex_count = static_cast<int>(importer.points.size());
-  // Faces keep file order; a polygon becomes a fan around its first corner, also in file order.
-  for (std::size_t f = 0; f < importer.faces.size(); ++f) {
-    const std::vector<int>& face = importer.faces[f];
-    if (face.size() < 3) {
-      return Error{name + ": face " + std::to_string(f) + " has " + std::to_string(face.size()) + " corners"};
-    }
-    for (int v : face) {
-      if (v < 0 || v >= vertex_count) {
-        return Error{name + ": face " + std::to_string(f) + " refers to vertex " + std::to_string(v) +
-                     ", but the file has " + std::to_string(vertex_count) + " vertices"};
-      }
-    }
-    for (std::size_t corner = 1; corner + 1 < face.size(); ++corner) {
-      mesh.triangles.push_back({static_cast<std::uint32_t>(face[0]), static_cast<std::uint32_t>(face[corner]),
-                                static_cast<std::uint32_t>(face[corner + 1])});
-    }
-  }
-  return mesh;
+  Result<std::string> bytes = read_text_file(path, " the mesh", kMaxMeshFileBytes);
+  if (!bytes) return Error{bytes.error()};
+  const MeshFormat format = ext == ".off" ? MeshFormat::off : ext == ".obj" ? MeshFormat::obj : ext == ".ply" ? MeshFormat::ply : MeshFormat::stl;
+  return parse_surface_mesh(*bytes, format, name, metres_per_unit);
 }
 
 Status write_surface_mesh(const std::filesystem::path& path, const TriangleMesh& mesh, double metres_per_unit) {
@@ -183,27 +81,18 @@ Status write_surface_mesh(const std::filesystem::path& path, const TriangleMesh&
       return Error{name + ": face " + std::to_string(t) + " makes the surface non-manifold; not written"};
     }
   }
-  // Write beside the target and rename, so a failed write never clobbers an existing file.
-  std::filesystem::path temporary = path;
-  temporary += ".partial" + ext;
-  bool written = false;
+  // Rendered in memory, then written through the one atomic writer: OpenMesh's own file writer
+  // neither checks its writes nor can be asked why it failed.
+  std::ostringstream bytes(std::ios::out | std::ios::binary);
+  bool rendered = false;
   {
     QuietOpenMesh quiet;
     OpenMesh::IO::Options options;
     if (ext == ".stl") options += OpenMesh::IO::Options::Binary;
-    written = OpenMesh::IO::write_mesh(out, temporary.string(), options, 9);
+    rendered = OpenMesh::IO::write_mesh(out, bytes, ext, options, 9);
   }
-  std::error_code ec;
-  if (!written) {
-    std::filesystem::remove(temporary, ec);
-    return Error{name + ": cannot write the mesh (is the folder writable?)"};
-  }
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) {
-    std::filesystem::remove(temporary, ec);
-    return Error{name + ": cannot replace the file: " + ec.message()};
-  }
-  return Ok{};
+  if (!rendered) return Error{name + ": OpenMesh cannot render the mesh as " + ext.substr(1)};
+  return write_file_atomically(path, bytes.view());
 }
 
 }  // namespace resecto

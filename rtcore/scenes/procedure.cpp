@@ -7,6 +7,7 @@
 #include <optional>
 #include <sstream>
 
+#include "rtcore/base/checked_number.h"
 #include "rtcore/base/text_file.h"
 
 namespace resecto {
@@ -146,11 +147,7 @@ Result<Procedure> parse_procedure(const std::string& text, const std::string& so
                                                  std::to_string(count));
     }
     auto out_of = [&](int column, double lo, double hi) -> std::optional<Error> {
-      if (v[column] < lo || v[column] > hi) {
-        std::ostringstream what;
-        what << kColumns[column] << " " << v[column] << " is outside [" << lo << ", " << hi << "]";
-        return line_error(source_name, number, what.str());
-      }
+      if (auto problem = range_problem(kColumns[column], v[column], lo, hi)) return line_error(source_name, number, *problem);
       return std::nullopt;
     };
     for (auto check : {out_of(0, 0.0, 86400.0), out_of(1, -kMaxGimbalDeg, kMaxGimbalDeg), out_of(2, -kMaxGimbalDeg, kMaxGimbalDeg),

@@ -9,6 +9,8 @@
 #include <string>
 #include <tuple>
 
+#include "rtcore/base/atomic_file.h"
+#include "rtcore/base/text_file.h"
 #include "rtcore/base/units.h"
 
 namespace resecto {
@@ -99,38 +101,27 @@ TriangleMesh boundary_surface(const TetMesh& mesh) {
 }
 
 Status write_vtk(const std::filesystem::path& path, const TetMesh& mesh) {
-  std::filesystem::path temporary = path;
-  temporary += ".partial";
-  {
-    std::ofstream out(temporary, std::ios::binary);
-    if (!out) return Error{path.string() + ": cannot open for writing"};
-    out.precision(10);
-    out << "# vtk DataFile Version 3.0\nResecto tetrahedral tissue model (millimetres)\nASCII\nDATASET UNSTRUCTURED_GRID\n";
-    out << "POINTS " << mesh.node_count() << " double\n";
-    for (const Vec3& p : mesh.positions) {
-      out << units::m_to_mm(p.x) << ' ' << units::m_to_mm(p.y) << ' ' << units::m_to_mm(p.z) << '\n';
-    }
-    out << "CELLS " << mesh.tetrahedron_count() << ' ' << 5 * mesh.tetrahedron_count() << '\n';
-    for (const Tetrahedron& t : mesh.tetrahedra) out << "4 " << t[0] << ' ' << t[1] << ' ' << t[2] << ' ' << t[3] << '\n';
-    out << "CELL_TYPES " << mesh.tetrahedron_count() << '\n';
-    for (std::size_t t = 0; t < mesh.tetrahedron_count(); ++t) out << "10\n";
-    out << "CELL_DATA " << mesh.tetrahedron_count() << "\nSCALARS region int 1\nLOOKUP_TABLE default\n";
-    for (TissueRegion r : mesh.regions) out << static_cast<int>(r) << '\n';
-    if (!out.flush()) {
-      std::error_code ec;
-      std::filesystem::remove(temporary, ec);
-      return Error{path.string() + ": write failed (disk full?)"};
-    }
+  std::ostringstream out(std::ios::out | std::ios::binary);
+  out.precision(10);
+  out << "# vtk DataFile Version 3.0\nResecto tetrahedral tissue model (millimetres)\nASCII\nDATASET UNSTRUCTURED_GRID\n";
+  out << "POINTS " << mesh.node_count() << " double\n";
+  for (const Vec3& p : mesh.positions) {
+    out << units::m_to_mm(p.x) << ' ' << units::m_to_mm(p.y) << ' ' << units::m_to_mm(p.z) << '\n';
   }
-  std::error_code ec;
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) return Error{path.string() + ": cannot replace the file: " + ec.message()};
-  return Ok{};
+  out << "CELLS " << mesh.tetrahedron_count() << ' ' << 5 * mesh.tetrahedron_count() << '\n';
+  for (const Tetrahedron& t : mesh.tetrahedra) out << "4 " << t[0] << ' ' << t[1] << ' ' << t[2] << ' ' << t[3] << '\n';
+  out << "CELL_TYPES " << mesh.tetrahedron_count() << '\n';
+  for (std::size_t t = 0; t < mesh.tetrahedron_count(); ++t) out << "10\n";
+  out << "CELL_DATA " << mesh.tetrahedron_count() << "\nSCALARS region int 1\nLOOKUP_TABLE default\n";
+  for (TissueRegion r : mesh.regions) out << static_cast<int>(r) << '\n';
+  return write_file_atomically(path, out.view());
 }
 
 Result<TetMesh> read_vtk(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) return Error{path.string() + ": cannot open"};
+  // Read whole and capped, so every count below can be checked against the bytes there are.
+  Result<std::string> text = read_text_file(path, "", std::uintmax_t{1} << 30);
+  if (!text) return Error{text.error()};
+  std::istringstream in(*text);
   const std::string name = path.string();
   TetMesh mesh;
   std::string line;
@@ -138,6 +129,10 @@ Result<TetMesh> read_vtk(const std::filesystem::path& path) {
   // A file cut mid-line ends without its newline: say so, it is the likeliest cause of a bad last line.
   auto fail = [&](const std::string& what) {
     return Error{name + ":" + std::to_string(line_number) + ": " + (in.eof() ? "truncated: " : "") + what};
+  };
+  auto bytes_left = [&]() -> std::size_t {
+    const std::streamoff at = in.tellg();
+    return at < 0 ? 0 : text->size() - static_cast<std::size_t>(at);
   };
   auto next_line = [&]() {
     ++line_number;
@@ -155,6 +150,7 @@ Result<TetMesh> read_vtk(const std::filesystem::path& path) {
     if (keyword == "POINTS") {
       std::size_t n = 0;
       if (!(words >> n)) return fail("POINTS without a count");
+      if (n > bytes_left() / 6) return fail("POINTS " + std::to_string(n) + " is more than the rest of the file holds (truncated?)");  // "0 0 0\n"
       mesh.positions.resize(n);
       for (std::size_t i = 0; i < n; ++i) {
         if (!next_line()) return fail("truncated: expected " + std::to_string(n) + " points");
@@ -165,6 +161,7 @@ Result<TetMesh> read_vtk(const std::filesystem::path& path) {
       }
     } else if (keyword == "CELLS") {
       if (!(words >> cells)) return fail("CELLS without a count");
+      if (cells > bytes_left() / 10) return fail("CELLS " + std::to_string(cells) + " is more than the rest of the file holds (truncated?)");  // "4 0 1 2 3\n"
       mesh.tetrahedra.resize(cells);
       for (std::size_t i = 0; i < cells; ++i) {
         if (!next_line()) return fail("truncated: expected " + std::to_string(cells) + " cells");

@@ -68,6 +68,7 @@ TEST(RecordedTransport, ReplaysTheRecordedBytesToTheSameSamples) {
       ASSERT_TRUE(writer->write(host_ns, bytes).ok());
     });
     poll_and_drain(link, live, [&] { return link.counters().accepted >= 500; });
+    ASSERT_TRUE(writer->finish().ok());
   }
   auto reports = read_raw_reports(path);
   ASSERT_TRUE(reports.ok()) << reports.error();

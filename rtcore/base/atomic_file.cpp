@@ -1,0 +1,129 @@
+// AtomicFile over POSIX calls: std::ofstream cannot say why a write failed, cannot fsync, and
+// reports a failed close only through a stream state nobody checks.
+#include "rtcore/base/atomic_file.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
+namespace resecto {
+namespace {
+
+/// A name no other writer in this or another process picks: pid plus a process-wide counter.
+std::filesystem::path temporary_beside(const std::filesystem::path& target) {
+  static std::atomic<unsigned> counter{0};
+  std::filesystem::path name = target.parent_path();
+  name /= "." + target.filename().string() + "." + std::to_string(::getpid()) + "." +
+          std::to_string(counter.fetch_add(1)) + ".tmp";
+  return name;
+}
+
+}  // namespace
+
+AtomicFile::~AtomicFile() { discard(); }
+
+Error AtomicFile::failure(const std::string& what, int error_number) {
+  if (first_error_.empty()) first_error_ = target_.string() + ": " + what + ": " + std::strerror(error_number);
+  return Error{first_error_};
+}
+
+Status AtomicFile::open(const std::filesystem::path& target) {
+  discard();
+  target_ = target;
+  first_error_.clear();
+  if (target.empty()) return Error{"an output path is empty"};
+  if (target.filename().empty() || target.filename() == "." || target.filename() == "..") {
+    return Error{target.string() + ": names a folder, not a file"};
+  }
+  // Only a regular file is ever replaced: renaming over a device or a folder would destroy it.
+  struct stat existing {};
+  keep_mode_ = false;
+  if (::stat(target.c_str(), &existing) == 0) {
+    if (S_ISDIR(existing.st_mode)) return Error{target.string() + ": is a folder; not replaced"};
+    if (!S_ISREG(existing.st_mode)) return Error{target.string() + ": is not a regular file (a device or pipe); not replaced"};
+    mode_ = static_cast<int>(existing.st_mode & 07777);
+    keep_mode_ = true;
+  } else if (errno != ENOENT) {
+    return failure("cannot inspect the target", errno);
+  }
+  for (int attempt = 0; attempt < 16; ++attempt) {
+    temporary_ = temporary_beside(target);
+    fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd_ >= 0) break;
+    if (errno != EEXIST) {
+      const int error_number = errno;
+      temporary_.clear();
+      return failure("cannot create a file in its folder", error_number);
+    }
+  }
+  if (fd_ < 0) return Error{target.string() + ": cannot pick a temporary name beside it"};
+  return Ok{};
+}
+
+Status AtomicFile::write(std::string_view bytes) {
+  if (!first_error_.empty()) return Error{first_error_};
+  if (fd_ < 0) return Error{target_.string() + ": written before it was opened"};
+  while (!bytes.empty()) {
+    const ssize_t written = ::write(fd_, bytes.data(), bytes.size());
+    if (written < 0) {
+      if (errno == EINTR) continue;
+      return failure("cannot write", errno);
+    }
+    bytes.remove_prefix(static_cast<std::size_t>(written));
+  }
+  return Ok{};
+}
+
+Status AtomicFile::commit() {
+  if (!first_error_.empty()) {
+    const Error error{first_error_};
+    discard();
+    return error;
+  }
+  if (fd_ < 0) return Error{target_.string() + ": committed before it was opened"};
+  // fsync before the rename: otherwise a crash can leave the new name pointing at empty blocks.
+  Status status = Ok{};
+  if (keep_mode_ && ::fchmod(fd_, static_cast<mode_t>(mode_)) != 0) status = failure("cannot set the permissions", errno);
+  if (status && ::fsync(fd_) != 0 && errno != EINVAL) status = failure("cannot write", errno);
+  const int fd = fd_;
+  fd_ = -1;
+  if (::close(fd) != 0 && status) status = failure("cannot write", errno);
+  if (status && std::rename(temporary_.c_str(), target_.c_str()) != 0) status = failure("cannot replace the file", errno);
+  if (!status) {
+    ::unlink(temporary_.c_str());
+    temporary_.clear();
+    return status;
+  }
+  temporary_.clear();
+  return Ok{};
+}
+
+void AtomicFile::discard() {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  if (!temporary_.empty()) ::unlink(temporary_.c_str());
+  temporary_.clear();
+}
+
+Status write_file_atomically(const std::filesystem::path& target, std::string_view bytes) {
+  AtomicFile file;
+  if (Status opened = file.open(target); !opened) return opened;
+  if (Status written = file.write(bytes); !written) return written;
+  return file.commit();
+}
+
+Status flush_standard_output() {
+  // A write error on stdout sticks in its error flag; fflush reports one still in the buffer.
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    const int error_number = errno;
+    return Error{std::string("cannot write to standard output: ") + std::strerror(error_number != 0 ? error_number : EIO)};
+  }
+  return Ok{};
+}
+
+}  // namespace resecto

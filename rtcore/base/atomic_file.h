@@ -1,0 +1,52 @@
+// The one way Resecto writes an output file: to a temporary file beside the target, every write and
+// the close checked, fsync'd, then renamed over the target. A failure (full disk, no permission, a
+// folder or device in the way) leaves the old file untouched and no temporary behind.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "rtcore/base/result.h"
+
+namespace resecto {
+
+/// An output file being written. Nothing appears at the target until commit() succeeds; destroying
+/// an uncommitted file removes its temporary.
+class AtomicFile {
+ public:
+  AtomicFile() = default;
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  ~AtomicFile();
+
+  /// Creates the temporary beside `target`. Fails if the target exists and is not a regular file.
+  Status open(const std::filesystem::path& target);
+  /// Appends bytes; after the first failure every later call reports it again.
+  Status write(std::string_view bytes);
+  /// Flushes to disk, closes and renames over the target; the target keeps its permission bits.
+  Status commit();
+  /// Removes the temporary without touching the target.
+  void discard();
+
+  bool is_open() const { return fd_ >= 0; }
+  const std::filesystem::path& target() const { return target_; }
+
+ private:
+  Error failure(const std::string& what, int error_number);
+
+  std::filesystem::path target_;
+  std::filesystem::path temporary_;
+  int fd_ = -1;
+  int mode_ = 0666;  // the replaced file's permission bits, or the umask's default
+  bool keep_mode_ = false;
+  std::string first_error_;
+};
+
+/// Writes `bytes` as the whole of `target` through an AtomicFile.
+Status write_file_atomically(const std::filesystem::path& target, std::string_view bytes);
+
+/// Flushes standard output and reports a failed write (a full disk, a closed pipe) as an error.
+Status flush_standard_output();
+
+}  // namespace resecto

@@ -1,0 +1,42 @@
+// Numbers from outside (files, the command line): parsed whole, finite, inside a range, and printed
+// exactly in errors. Every comparison is written so NaN fails it: `!(lo <= v && v <= hi)`, never
+// `v < lo || v > hi`, which NaN passes.
+#pragma once
+
+#include <charconv>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "rtcore/base/result.h"
+
+namespace resecto {
+
+/// The shortest text that reads back as exactly `value` ("230.0001", never a rounded "230").
+inline std::string exact_number(double value) {
+  char buffer[32];
+  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return error == std::errc{} ? std::string(buffer, end) : std::string("?");
+}
+
+/// True when `value` is a finite number in [lo, hi]; NaN is never in range.
+inline bool in_closed_range(double value, double lo, double hi) { return lo <= value && value <= hi; }
+
+/// "<what> <value> is outside [lo, hi]" or "<what> is not a finite number", or nothing when in range.
+inline std::optional<std::string> range_problem(std::string_view what, double value, double lo, double hi) {
+  if (!std::isfinite(value)) return std::string(what) + " is not a finite number (" + exact_number(value) + ")";
+  if (in_closed_range(value, lo, hi)) return std::nullopt;
+  return std::string(what) + " " + exact_number(value) + " is outside [" + exact_number(lo) + ", " + exact_number(hi) + "]";
+}
+
+/// Parses the whole of `text` as a finite double (no leading or trailing characters).
+inline std::optional<double> parse_finite(std::string_view text) {
+  double value = 0.0;
+  if (!text.empty() && text.front() == '+') text.remove_prefix(1);  // from_chars takes no '+'
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || error != std::errc{} || end != text.data() + text.size() || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+}  // namespace resecto

@@ -1,0 +1,117 @@
+// The one output writer: a target appears whole or not at all, and only regular files are replaced.
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "rtcore/base/atomic_file.h"
+#include "rtcore/base/checked_number.h"
+#include "rtcore/base/text_file.h"
+
+namespace resecto {
+namespace {
+
+std::filesystem::path scratch(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("resecto_atomic_file_" + std::to_string(::getpid())) / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+std::string contents(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::size_t entries(const std::filesystem::path& dir) {
+  return static_cast<std::size_t>(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()));
+}
+
+TEST(AtomicFile, ReplacesARegularFileAndKeepsItsPermissions) {
+  const auto dir = scratch("replace");
+  const auto target = dir / "out.txt";
+  ASSERT_TRUE(write_file_atomically(target, "old\n").ok());
+  std::filesystem::permissions(target, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write |
+                                           std::filesystem::perms::group_read);
+  ASSERT_TRUE(write_file_atomically(target, "new\n").ok());
+  EXPECT_EQ(contents(target), "new\n");
+  struct stat s {};
+  ASSERT_EQ(::stat(target.c_str(), &s), 0);
+  EXPECT_EQ(s.st_mode & 0777, 0640u);
+  EXPECT_EQ(entries(dir), 1u);
+}
+
+TEST(AtomicFile, NothingAppearsUntilCommitAndAnUncommittedFileLeavesNothing) {
+  const auto dir = scratch("uncommitted");
+  const auto target = dir / "out.txt";
+  ASSERT_TRUE(write_file_atomically(target, "good\n").ok());
+  {
+    AtomicFile file;
+    ASSERT_TRUE(file.open(target).ok());
+    ASSERT_TRUE(file.write("half of a new").ok());
+    EXPECT_EQ(contents(target), "good\n");
+    EXPECT_EQ(entries(dir), 2u);  // the target and the temporary beside it
+  }
+  EXPECT_EQ(contents(target), "good\n");
+  EXPECT_EQ(entries(dir), 1u);
+}
+
+TEST(AtomicFile, RefusesFoldersDevicesAndMissingFolders) {
+  const auto dir = scratch("refuse");
+  std::filesystem::create_directories(dir / "folder.json");
+  Status folder = write_file_atomically(dir / "folder.json", "x");
+  ASSERT_FALSE(folder.ok());
+  EXPECT_NE(folder.error().find("is a folder; not replaced"), std::string::npos) << folder.error();
+  Status device = write_file_atomically("/dev/null", "x");
+  ASSERT_FALSE(device.ok());
+  EXPECT_NE(device.error().find("/dev/null: is not a regular file"), std::string::npos) << device.error();
+  Status missing = write_file_atomically(dir / "no" / "such" / "folder.txt", "x");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().find("cannot create a file in its folder: No such file or directory"), std::string::npos) << missing.error();
+  EXPECT_EQ(entries(dir), 1u);
+}
+
+TEST(AtomicFile, AFailedOpenKeepsItsReasonThroughWriteAndCommit) {
+  // A full disk is tested end to end on a real full tmpfs (tests/console/hostile_input_test.cpp);
+  // here: the first failure is the one every later call reports.
+  const auto dir = scratch("sticky");
+  AtomicFile file;
+  ASSERT_FALSE(file.open(dir / "missing" / "x.txt").ok());
+  Status write = file.write("x");
+  ASSERT_FALSE(write.ok());
+  EXPECT_NE(write.error().find("cannot create a file in its folder"), std::string::npos) << write.error();
+  Status commit = file.commit();
+  ASSERT_FALSE(commit.ok());
+  EXPECT_EQ(commit.error(), write.error());
+}
+
+TEST(TextFile, RefusesDevicesFoldersAndFilesOverTheCap) {
+  const auto dir = scratch("text");
+  EXPECT_NE(read_text_file("/dev/urandom").error().find("not a regular file"), std::string::npos);
+  EXPECT_NE(read_text_file(dir).error().find("is a folder, not a file"), std::string::npos);
+  EXPECT_NE(read_text_file(dir / "missing.txt").error().find("no such file"), std::string::npos);
+  ASSERT_TRUE(write_file_atomically(dir / "big.txt", std::string(100, 'x')).ok());
+  EXPECT_NE(read_text_file(dir / "big.txt", "", 99).error().find("100 bytes, more than the 99-byte limit"), std::string::npos);
+  EXPECT_EQ(read_text_file(dir / "big.txt", "", 100).value().size(), 100u);
+}
+
+TEST(CheckedNumber, NanIsNeverInRangeAndValuesPrintExactly) {
+  EXPECT_FALSE(in_closed_range(std::nan(""), 0.0, 1.0));
+  EXPECT_EQ(range_problem("x", 230.0001, 0.0, 230.0).value(), "x 230.0001 is outside [0, 230]");
+  EXPECT_EQ(range_problem("x", std::nan(""), 0.0, 230.0).value(), "x is not a finite number (nan)");
+  EXPECT_FALSE(range_problem("x", 230.0, 0.0, 230.0));
+  EXPECT_FALSE(parse_finite("nan"));
+  EXPECT_FALSE(parse_finite("1e309"));
+  EXPECT_FALSE(parse_finite("1.5x"));
+  EXPECT_EQ(parse_finite("+2.5").value(), 2.5);
+}
+
+}  // namespace
+}  // namespace resecto
