@@ -43,6 +43,9 @@ void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_r
   cmd.add_option("--height", o.height, "Window height, pixels")->check(CLI::Range(480, 8192))->capture_default_str();
   cmd.add_option("--slow-frame-ms", o.slow_frame_ms, "Make every frame this much slower (to show the core is never held back)")
       ->check(CLI::Range(0.0, 10000.0));
+  cmd.add_option("--view-scale", o.view_scale,
+                 "Resolution of the 3-D views relative to their panels (default: 1 on a GPU, 0.5 on a software rasteriser)")
+      ->check(CLI::Range(0.1, 2.0));
   cmd.add_flag("--no-vsync", o.no_vsync, "Draw frames as fast as possible instead of at the display's refresh");
 }
 
@@ -86,6 +89,7 @@ void open_console(const ConsoleCliOptions& o) {
   options.report_path = o.report;
   options.slow_frame_ms = o.slow_frame_ms;
   options.vsync = !o.no_vsync;
+  options.view_scale = o.view_scale;
   Result<nlohmann::ordered_json> report = gui::run_console(options);
   if (!report) throw std::runtime_error(report.error());
   std::fputs(gui::summarize_console_report(*report).c_str(), stdout);

@@ -29,6 +29,7 @@ struct ConsoleCliOptions {
   int height = 1000;
   double slow_frame_ms = 0.0;
   bool no_vsync = false;
+  double view_scale = 0.0;
   int collision_hz = 60;
   int substeps = 16;
   std::int64_t spin_us = kDefaultRealtimeSpinUs;

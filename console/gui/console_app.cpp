@@ -71,6 +71,7 @@ class ConsoleWindow {
   void layout_and_draw();
   void draw_endoscope_window(const ImVec2& pos, const ImVec2& size);
   void draw_outside_window(const ImVec2& pos, const ImVec2& size);
+  int scaled(int pixels) const { return std::max(16, static_cast<int>(std::lround(pixels * options_.view_scale))); }
 
   GLFWwindow* window_;
   const ConsoleOptions& options_;
@@ -164,7 +165,7 @@ void ConsoleWindow::draw_endoscope_window(const ImVec2& pos, const ImVec2& size)
                                                         ImGuiWindowFlags_NoScrollbar);
   const ImVec2 avail = ImGui::GetContentRegionAvail();
   const int w = std::max(16, static_cast<int>(avail.x)), h = std::max(16, static_cast<int>(avail.y));
-  endoscope_target_.resize(w, h, 0);
+  endoscope_target_.resize(scaled(w), scaled(h), 0);
   const LiveFrame& f = controller_.frame();
   const CameraView camera = endoscope_camera(f.snapshot.tool.sheath, ui_.lens, static_cast<float>(w) / static_cast<float>(h));
   renderer_.draw_endoscope(endoscope_target_, camera);
@@ -199,7 +200,7 @@ void ConsoleWindow::draw_outside_window(const ImVec2& pos, const ImVec2& size) {
                ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoScrollbar);
   const ImVec2 avail = ImGui::GetContentRegionAvail();
   const int w = std::max(16, static_cast<int>(avail.x)), h = std::max(16, static_cast<int>(avail.y));
-  outside_target_.resize(w, h, 0);
+  outside_target_.resize(scaled(w), scaled(h), 0);
   const CameraView camera = ui_.orbit.view(static_cast<float>(w) / static_cast<float>(h));
   renderer_.draw_outside(outside_target_, camera);
   const ImVec2 origin = ImGui::GetCursorScreenPos();
@@ -426,17 +427,24 @@ Result<ordered_json> run_console(const ConsoleOptions& options) {
   ImGui_ImplGlfw_InitForOpenGL(window, true);
   ImGui_ImplOpenGL3_Init("#version 330 core");
 
+  ConsoleOptions resolved = options;
+  const char* renderer_name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const std::string gl_renderer = renderer_name ? renderer_name : "unknown";
+  const bool software = gl_renderer.find("llvmpipe") != std::string::npos || gl_renderer.find("softpipe") != std::string::npos;
+  if (resolved.view_scale <= 0.0) resolved.view_scale = software ? 0.5 : 1.0;
+
   const auto wall_start = std::chrono::steady_clock::now();
   session.start();
   Status ran = Ok{};
   ordered_json report;
   {
-    ConsoleWindow console(window, options, session, **renderer, std::move(actions));
+    ConsoleWindow console(window, resolved, session, **renderer, std::move(actions));
     ran = console.run();
     session.stop();
     int w = 0, h = 0;
     glfwGetFramebufferSize(window, &w, &h);
     report = make_report(session, console.ui(), std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count(), w, h);
+    report["renderer"] = {{"gl_renderer", gl_renderer}, {"view_scale", resolved.view_scale}};
     renderer->reset();  // its GL objects go while the context lives
   }
   ImGui_ImplOpenGL3_Shutdown();

@@ -24,6 +24,9 @@ struct ConsoleOptions {
   std::string report_path;      ///< --report: the session's JSON report
   double slow_frame_ms = 0.0;   ///< every frame takes this much longer (tests of frame pacing)
   bool vsync = true;
+  /// The views' resolution relative to their panels (drawn smaller and scaled up when below 1);
+  /// 0: 1 on a GPU, 0.5 on a software rasteriser (llvmpipe), where every pixel costs CPU time.
+  double view_scale = 0.0;
 };
 
 /// Runs the console; the report (also written to `report_path`) on a clean exit, an error when the

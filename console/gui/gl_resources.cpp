@@ -46,6 +46,7 @@ Status ShaderProgram::build(const char* name, const char* vertex_source, const c
   glBindAttribLocation(program_, 0, "in_position");
   glBindAttribLocation(program_, 1, "in_normal");
   glBindAttribLocation(program_, 2, "in_color");
+  glBindAttribLocation(program_, 3, "in_rest");
   glLinkProgram(program_);
   glDeleteShader(*vertex);
   glDeleteShader(*fragment);
@@ -141,6 +142,8 @@ MeshBuffers::MeshBuffers() {
   glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(MeshVertex, normal)));
   glEnableVertexAttribArray(2);
   glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(MeshVertex, color)));
+  glEnableVertexAttribArray(3);
+  glVertexAttribPointer(3, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(MeshVertex, rest)));
   glBindVertexArray(0);
 }
 

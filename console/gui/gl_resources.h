@@ -63,11 +63,13 @@ class RenderTarget {
   GLuint resolve_fbo_ = 0, texture_ = 0;
 };
 
-/// Interleaved float vertices (position, normal, colour) and 32-bit indices.
+/// Interleaved float vertices and 32-bit indices. `rest` is where the vertex was before any
+/// deformation: surface detail is painted there, so it stays on the tissue as it moves.
 struct MeshVertex {
   float position[3];
   float normal[3];
   float color[3];
+  float rest[3];
 };
 
 class MeshBuffers {

@@ -15,12 +15,15 @@ const char* kVertexShader = R"(#version 330 core
 in vec3 in_position;
 in vec3 in_normal;
 in vec3 in_color;
+in vec3 in_rest;
 uniform mat4 model;
 uniform mat4 view_projection;
 out vec3 world_position;
 out vec3 world_normal;
 out vec3 base_color;
+out vec3 rest_mm;
 void main() {
+  rest_mm = in_rest * 1000.0;
   vec4 world = model * vec4(in_position, 1.0);
   world_position = world.xyz;
   world_normal = mat3(model) * in_normal;
@@ -29,6 +32,8 @@ void main() {
 }
 )";
 
+// Tissue surfaces carry procedural mucosal detail painted at their rest position (so it moves with
+// the tissue): a mottled colour and a net of fine vessels, as the lining looks through the lens.
 // A point light at `light_position` (the endoscope's tip, or the outside view's eye) with an
 // inverse-square fall-off beyond `falloff_m`, a wet specular highlight, and for the endoscope a
 // round image with a soft black edge, as a rod-lens telescope shows it.
@@ -36,6 +41,9 @@ const char* kFragmentShader = R"(#version 330 core
 in vec3 world_position;
 in vec3 world_normal;
 in vec3 base_color;
+in vec3 rest_mm;
+uniform int mucosa_detail;
+uniform sampler3D noise_volume;
 uniform vec3 eye;
 uniform vec3 light_position;
 uniform float falloff_m;
@@ -47,12 +55,21 @@ uniform vec3 emissive;
 uniform int round_image;
 uniform vec2 viewport;
 out vec4 out_color;
+float value_noise(vec3 p) { return texture(noise_volume, p * (1.0 / 32.0)).r; }
+vec3 mucosa(vec3 color, vec3 p) {
+  float mottle = 0.5 * value_noise(p * 0.8) + 0.3 * value_noise(p * 2.1) + 0.2 * value_noise(p * 5.3);
+  color *= 0.78 + 0.45 * mottle;
+  float vessel = 1.0 - smoothstep(0.0, 0.035, abs(value_noise(p * 0.9) - 0.5));
+  float fine = 1.0 - smoothstep(0.0, 0.03, abs(value_noise(p * 2.7 + 17.0) - 0.5));
+  return mix(color, vec3(0.50, 0.06, 0.07), 0.65 * vessel + 0.35 * fine);
+}
 void main() {
   if (round_image == 1) {
     float r = length(gl_FragCoord.xy - 0.5 * viewport) / (0.5 * min(viewport.x, viewport.y));
     if (r > 1.0) discard;
   }
   vec3 color = color_override.a > 0.0 ? color_override.rgb : base_color;
+  if (mucosa_detail == 1) color = mucosa(color, rest_mm);
   vec3 n = normalize(world_normal);
   if (!gl_FrontFacing) n = -n;
   vec3 to_light = light_position - world_position;
@@ -81,6 +98,30 @@ glm::vec3 look_color(SurfaceLook look) {
   return {1.0f, 0.0f, 1.0f};
 }
 
+/// A tileable 32^3 lattice of hashed values, filtered by the texture unit: the mucosa's noise for a
+/// few texture reads per pixel instead of dozens of hashes (software rasterisers feel the difference).
+GLuint make_noise_volume() {
+  constexpr int n = 32;
+  std::vector<std::uint8_t> values(static_cast<std::size_t>(n) * n * n);
+  std::uint32_t state = 0x9e3779b9u;  // fixed: the same tissue every session
+  for (std::uint8_t& v : values) {
+    state ^= state << 13;
+    state ^= state >> 17;
+    state ^= state << 5;
+    v = static_cast<std::uint8_t>(state >> 24);
+  }
+  GLuint texture = 0;
+  glGenTextures(1, &texture);
+  glBindTexture(GL_TEXTURE_3D, texture);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage3D(GL_TEXTURE_3D, 0, GL_R8, n, n, n, 0, GL_RED, GL_UNSIGNED_BYTE, values.data());
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) glTexParameteri(GL_TEXTURE_3D, wrap, GL_REPEAT);
+  glBindTexture(GL_TEXTURE_3D, 0);
+  return texture;
+}
+
 std::unique_ptr<MeshBuffers> upload_mesh(const TriangleMesh& mesh, glm::vec3 color) {
   // Flat normals: the tool's facets should read as machined metal.
   std::vector<MeshVertex> vertices;
@@ -91,7 +132,8 @@ std::unique_ptr<MeshBuffers> upload_mesh(const TriangleMesh& mesh, glm::vec3 col
     for (int k = 0; k < 3; ++k) {
       const Vec3& p = mesh.positions[t[k]];
       indices.push_back(static_cast<std::uint32_t>(vertices.size()));
-      vertices.push_back({{float(p.x), float(p.y), float(p.z)}, {float(n.x), float(n.y), float(n.z)}, {color.r, color.g, color.b}});
+      vertices.push_back({{float(p.x), float(p.y), float(p.z)}, {float(n.x), float(n.y), float(n.z)}, {color.r, color.g, color.b},
+                          {float(p.x), float(p.y), float(p.z)}});
     }
   }
   auto buffers = std::make_unique<MeshBuffers>();
@@ -126,6 +168,10 @@ int surface_region(const Snapshot& snapshot, std::size_t f) {
 
 }  // namespace
 
+SceneRenderer::~SceneRenderer() {
+  if (noise_volume_) glDeleteTextures(1, &noise_volume_);
+}
+
 glm::mat4 model_matrix(const RigidPose& pose) {
   glm::mat4 m(1.0f);
   for (int c = 0; c < 3; ++c)
@@ -144,6 +190,7 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const ProstateModel
   r->loop_ = upload_mesh(tool.loop, {0.85f, 0.85f, 0.80f});
   r->marker_ = upload_mesh(octahedron(), {1.0f, 1.0f, 1.0f});
   r->tissue_ = std::make_unique<MeshBuffers>();
+  r->noise_volume_ = make_noise_volume();
   r->landmarks_ = prostate.landmarks;
   r->shape_ = prostate.shape;
   return r;
@@ -154,6 +201,7 @@ void SceneRenderer::classify_faces(const SimulationSnapshot& s) {
   if (initial_surface_node_.empty()) {
     // The first surface seen is the uncut gland: its nodes are the original lining and capsule.
     initial_surface_node_.assign(nodes, 0);
+    rest_.assign(s.node_positions.begin(), s.node_positions.begin() + static_cast<std::ptrdiff_t>(nodes));
     for (std::uint32_t f = 0; f < s.surface_triangle_count; ++f)
       for (int c = 0; c < 3; ++c) initial_surface_node_[s.surface_triangles[f][c]] = 1;
   }
@@ -207,7 +255,8 @@ void SceneRenderer::update(const SimulationSnapshot& s, bool cutting) {
     const float len = glm::length(node_normal_[i]);
     const glm::vec3 n = len > 0.0f ? node_normal_[i] / len : glm::vec3(0.0f, 0.0f, 1.0f);
     const glm::vec3 c = i < node_color_.size() ? node_color_[i] : glm::vec3(0.5f);
-    vertices_[i] = {{p.x, p.y, p.z}, {n.x, n.y, n.z}, {c.r, c.g, c.b}};
+    const glm::vec3 r = i < rest_.size() ? glm::vec3(rest_[i]) : p;
+    vertices_[i] = {{p.x, p.y, p.z}, {n.x, n.y, n.z}, {c.r, c.g, c.b}, {r.x, r.y, r.z}};
   }
   tissue_->upload_vertices(vertices_.data(), vertices_.size());
   sheath_model_ = model_matrix(s.tool.sheath);
@@ -216,11 +265,15 @@ void SceneRenderer::update(const SimulationSnapshot& s, bool cutting) {
 }
 
 void SceneRenderer::draw_tool(bool endoscope) const {
+  shader_.set("mucosa_detail", 0);
   shader_.set("specular", 0.9f);
   shader_.set("model", sheath_model_);
   // Through the lens only the sheath's open end shows (the lens sits inside it): its walls from
-  // inside, no caps. From outside, the whole closed sheath.
+  // inside, no caps, drawn over whatever lies behind them: from inside the tube its wall is nearer
+  // than anything outside, and tissue the contact lets a millimetre into the sheath must not hide it.
+  if (endoscope) glDepthFunc(GL_ALWAYS);
   sheath_->draw(0, endoscope ? sheath_wall_indices_ : SIZE_MAX);
+  glDepthFunc(GL_LESS);
   shader_.set("model", loop_model_);
   // The loop glows while the cutting current flows.
   shader_.set("emissive", cutting_ ? glm::vec3(0.9f, 0.45f, 0.1f) : glm::vec3(0.0f));
@@ -248,7 +301,12 @@ void SceneRenderer::draw_endoscope(RenderTarget& target, const CameraView& camer
   shader_.set("viewport", glm::vec2(static_cast<float>(target.width()), static_cast<float>(target.height())));
   shader_.set("specular", 0.35f);
   shader_.set("model", glm::mat4(1.0f));
+  shader_.set("mucosa_detail", 1);
+  shader_.set("noise_volume", 0);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_3D, noise_volume_);
   tissue_->draw();
+  glBindTexture(GL_TEXTURE_3D, 0);
   draw_tool(true);
   target.end();
 }
@@ -289,6 +347,7 @@ void SceneRenderer::draw_outside(RenderTarget& target, const CameraView& camera)
   shader_.set("model", glm::mat4(1.0f));
   shader_.set("specular", 0.25f);
   shader_.set("alpha", 0.22f);
+  shader_.set("mucosa_detail", 0);
   glCullFace(GL_FRONT);
   tissue_->draw();
   glCullFace(GL_BACK);

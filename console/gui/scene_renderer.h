@@ -33,6 +33,9 @@ class SceneRenderer {
  public:
   /// Compiles the shaders and uploads the tool and marker meshes.
   static Result<std::unique_ptr<SceneRenderer>> create(const ProstateModel& prostate);
+  ~SceneRenderer();
+  SceneRenderer(const SceneRenderer&) = delete;
+  SceneRenderer& operator=(const SceneRenderer&) = delete;
 
   /// Takes a new snapshot's geometry: indices when its topology changed, positions and normals always.
   void update(const SimulationSnapshot& snapshot, bool cutting);
@@ -53,6 +56,7 @@ class SceneRenderer {
 
   ShaderProgram shader_;
   std::unique_ptr<MeshBuffers> tissue_, sheath_, loop_, marker_;
+  GLuint noise_volume_ = 0;
   std::size_t sheath_wall_indices_ = 0;  ///< the sheath's side walls come first; the caps after
   std::vector<Landmark> landmarks_;
   ProstateShape shape_;
@@ -62,6 +66,7 @@ class SceneRenderer {
   std::uint32_t triangle_count_ = 0;
   std::uint64_t topology_uploads_ = 0;
   std::vector<std::uint8_t> initial_surface_node_;  ///< nodes on the surface before any cut
+  std::vector<Vec3> rest_;  ///< node positions in the first snapshot, where surface detail is painted
   std::vector<glm::vec3> node_color_;
   std::vector<glm::vec3> node_normal_;
   std::vector<MeshVertex> vertices_;

@@ -22,8 +22,10 @@ CameraView endoscope_camera(const RigidPose& sheath, const EndoscopeLens& lens, 
   camera.forward = glm::vec3(forward);
   camera.up = glm::vec3(up);
   camera.view = glm::lookAt(camera.eye, camera.eye + camera.forward, camera.up);
-  camera.projection = glm::perspective(glm::radians(static_cast<float>(lens.field_of_view_deg)), aspect,
-                                       static_cast<float>(lens.near_m), static_cast<float>(lens.far_m));
+  // The field of view spans the round image, which fits the narrower side of the view.
+  const double half = 0.5 * lens.field_of_view_deg * std::acos(-1.0) / 180.0;
+  const double fovy = 2.0 * std::atan(std::tan(half) / std::min(1.0, static_cast<double>(aspect)));
+  camera.projection = glm::perspective(static_cast<float>(fovy), aspect, static_cast<float>(lens.near_m), static_cast<float>(lens.far_m));
   return camera;
 }
 

@@ -13,9 +13,9 @@ namespace resecto::gui {
 /// The lens, in the tool frame (rtcore/anatomy/resectoscope.h: axis +z, loop below the axis, -y).
 struct EndoscopeLens {
   double tilt_deg = 30.0;             ///< off the sheath axis, toward the loop
-  double field_of_view_deg = 80.0;    ///< vertical, across the round image
+  double field_of_view_deg = 80.0;    ///< across the round image
   double lens_y_m = 0.0022;           ///< above the axis: the loop's working channel runs below it
-  double lens_z_m = -0.003;           ///< recessed in the sheath, so its beak shows at the image's edge
+  double lens_z_m = -0.0035;          ///< recessed in the sheath, so its open end shows at the image's edge
   double near_m = 0.0003;
   double far_m = 0.15;
 };
