@@ -37,7 +37,7 @@ struct OrbitCamera {
   glm::vec3 target{0.0f, -0.004f, 0.0207f};  ///< the gland's middle
   float yaw_deg = -60.0f;
   float pitch_deg = 25.0f;
-  float distance_m = 0.16f;
+  float distance_m = 0.11f;
   float field_of_view_deg = 40.0f;
 
   /// Mouse drag in pixels: horizontal turns, vertical tilts (clamped short of the poles).
