@@ -22,6 +22,7 @@ struct RunOptions {
   bool realtime = false;
   std::string report;
   std::string trace;
+  std::string record;
   std::vector<std::string> sets;
   int triangles = 8640;
   int collision_hz = 60;
@@ -58,6 +59,7 @@ void run(const RunOptions& o) {
   options.seconds = o.seconds;
   options.realtime = o.realtime;
   options.trace_path = o.trace;
+  options.record_path = o.record;
   options.seed = o.seed;
   options.simulation.prostate_triangles = o.triangles;
   options.simulation.collision_hz = o.collision_hz;
@@ -95,6 +97,7 @@ void register_run(CLI::App& app) {
   cmd->add_flag("--realtime", o->realtime, "Real time: the device link on its own thread, ticks at their deadlines");
   cmd->add_option("--report", o->report, "Write the JSON report here");
   cmd->add_option("--trace", o->trace, "Write a Chrome trace-event JSON (opens in Perfetto)");
+  cmd->add_option("--record", o->record, "Record the session to FILE (replay with `resecto replay FILE --verify`)");
   add_parameter_option(*cmd, o->sets);
   cmd->add_option("--triangles", o->triangles, "Prostate surface triangles")->check(CLI::Range(200, 1000000))->capture_default_str();
   cmd->add_option("--collision-hz", o->collision_hz, "Collision steps per second")->check(CLI::Range(10, 1000))->capture_default_str();

@@ -15,6 +15,7 @@
 #include "device/link/calibration_adapter.h"
 #include "device/calibration/calibration.h"
 #include "device/link/tool_input.h"
+#include "recordings/recorder.h"
 #include "rtcore/concurrency/spsc_ring.h"
 #include "rtcore/concurrency/triple_buffer.h"
 #include "rtcore/core/fixed_step_scheduler.h"
@@ -124,6 +125,18 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
     lockstep = std::make_unique<LockstepDevice>(options.procedure, calibration, options.seed);
   }
 
+  std::unique_ptr<rec::Recorder> recorder;
+  if (!options.record_path.empty()) {
+    rec::SessionHeader description;
+    description.procedure = options.procedure.name;
+    description.mode = options.realtime ? "realtime" : "batch";
+    description.seed = options.seed;
+    description.calibration = ordered_json::parse(device::calibration_to_json(calibration));
+    Result<std::unique_ptr<rec::Recorder>> started = rec::Recorder::start(options.record_path, std::move(description), sim);
+    if (!started) return Error{started.error()};
+    recorder = std::move(*started);
+  }
+
   TripleBuffer<SimulationSnapshot> snapshots(sim.make_snapshot());
   SnapshotConsumer consumer(snapshots, options.consumer_delay_ms);
 
@@ -155,16 +168,16 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
         relay_link_samples(live->link(), samples, newest_sample_host_ns);
       }
       tool_input.latch(samples, tick_s);
-      input.joints = tool_input.joints();
-      input.pedals = tool_input.pedals();
-      input.tool_present = tool_input.state() != ToolInputState::kNoDevice;
+      input = tool_input.tick_input();
     }
+    if (recorder) recorder->record_tick(tick, input, {});
     sim.step(input, {}, &profiler);
     if (sim.is_collision_tick(tick)) {
       result.collision_hashes.push_back(sim.state_hash());
       RESECTO_PROFILE_STAGE(&profiler, Stage::kPublish, tick);
       sim.fill_snapshot(snapshots.write_slot());
       snapshots.publish();
+      if (recorder) recorder->record_step(sim);
       if (live && newest_sample_host_ns > published_sample_host_ns) {
         input_to_snapshot_us.add(static_cast<double>(FrameProfiler::now_ns() - newest_sample_host_ns) * 1e-3);
         published_sample_host_ns = newest_sample_host_ns;
@@ -229,6 +242,18 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   }
   r["snapshots"] = {{"published", result.collision_hashes.size()}, {"received", consumer.received()}};
   r["metrics"] = metrics_json(sim.metrics());
+  if (recorder) {
+    Result<rec::RecorderCounters> recorded = recorder->finish({{"ticks", result.ticks}, {"state_hash", hex_hash(result.final_hash)}});
+    if (!recorded) return Error{"recording " + options.record_path + ": " + recorded.error()};
+    r["recording"] = {{"path", options.record_path},
+                      {"bytes", recorded->bytes},
+                      {"ticks", recorded->ticks},
+                      {"steps", recorded->steps},
+                      {"keyframes", recorded->keyframes},
+                      {"lost", {{"ticks", recorded->ticks_lost}, {"steps", recorded->steps_lost}, {"commands", recorded->commands_lost},
+                                {"keyframes", recorded->keyframes_lost}}},
+                      {"keyframe_encode_ms", {{"mean", recorded->keyframe_encode_ms_mean}, {"max", recorded->keyframe_encode_ms_max}}}};
+  }
   if (profiler.trace_dropped() > 0) r["trace_dropped_events"] = profiler.trace_dropped();
 
   if (!options.trace_path.empty()) {
@@ -271,6 +296,18 @@ std::string summarize_report(const ordered_json& r) {
                 m.at("contact_time_s").get<double>(), m.at("peak_reaction_force_n").get<double>(), m.at("cut_pedal_time_s").get<double>(),
                 m.at("cut_in_contact_time_s").get<double>(), m.at("max_tissue_displacement_mm").get<double>());
   std::string summary = text;
+  if (r.contains("recording")) {
+    const auto& recording = r.at("recording");
+    const auto& lost = recording.at("lost");
+    std::snprintf(text, sizeof text, "  recording  %s: %.2f MB, %llu ticks, %llu keyframes (encode mean %.2f ms, max %.2f ms), lost %llu\n",
+                  recording.at("path").get<std::string>().c_str(), static_cast<double>(recording.at("bytes").get<std::uint64_t>()) / 1e6,
+                  static_cast<unsigned long long>(recording.at("ticks").get<std::uint64_t>()),
+                  static_cast<unsigned long long>(recording.at("keyframes").get<std::uint64_t>()), recording.at("keyframe_encode_ms").at("mean").get<double>(),
+                  recording.at("keyframe_encode_ms").at("max").get<double>(),
+                  static_cast<unsigned long long>(lost.at("ticks").get<std::uint64_t>() + lost.at("steps").get<std::uint64_t>() +
+                                                  lost.at("commands").get<std::uint64_t>() + lost.at("keyframes").get<std::uint64_t>()));
+    summary += text;
+  }
   if (r.at("mode") == "realtime") {
     const auto& d = r.at("deadlines");
     std::snprintf(text, sizeof text,

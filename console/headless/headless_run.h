@@ -25,6 +25,7 @@ struct HeadlessOptions {
   SimulationConfig simulation;
   std::uint64_t seed = 1;        ///< the emulator's sensor noise
   std::string trace_path;        ///< empty: no trace
+  std::string record_path;       ///< empty: no recording (recordings/: the session file replay reads)
   double consumer_delay_ms = 0;  ///< makes the snapshot consumer slow on purpose (tests)
   std::int64_t spin_us = kDefaultRealtimeSpinUs;  ///< real time: spin this long before each tick instead of sleeping
   /// The device's calibration: sensor conversion and the registration that places the gimbal in the

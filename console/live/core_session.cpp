@@ -161,9 +161,7 @@ void CoreSession::step_once() {
       relay_link_samples(live_->link(), samples_, status_.newest_sample_host_ns);
     }
     tool_input_.latch(samples_, tick_s);
-    input.joints = tool_input_.joints();
-    input.pedals = tool_input_.pedals();
-    input.tool_present = tool_input_.state() != ToolInputState::kNoDevice;
+    input = tool_input_.tick_input();
     // Commands due now, in the order the console queued them (the same order on replay).
     due_.clear();
     std::size_t kept = 0;
@@ -188,7 +186,7 @@ void CoreSession::step_once() {
   }
   sim_->step(input, due_, &profiler_);
   status_.joints = input.joints;
-  status_.pedals = input.pedals;
+  status_.pedals = tool_input_.pedals();
   status_.input_state = tool_input_.state();
   if (!due_.empty()) status_.parameters = sim_->tissue().parameters();
   profiler_.record(Stage::kTick, tick, tick_begin_ns, FrameProfiler::now_ns());

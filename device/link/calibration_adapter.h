@@ -4,7 +4,7 @@
 #pragma once
 
 #include "device/calibration/calibration.h"
-#include "device/kinematics/tool_kinematics.h"
+#include "rtcore/kinematics/tool_kinematics.h"
 #include "device/link/report_decoder.h"
 
 namespace resecto {

@@ -5,7 +5,8 @@
 
 #include <cstdint>
 
-#include "device/kinematics/tool_kinematics.h"
+#include "resecto/lp3500_protocol.h"
+#include "rtcore/kinematics/tool_kinematics.h"
 
 namespace resecto {
 
@@ -16,9 +17,9 @@ enum class LinkEvent : std::uint8_t {
   kDisconnected = 2,  ///< transport error or silence past the timeout; hold the tool
 };
 
-/// Pedal bits as the board sends them.
-inline constexpr std::uint8_t kPedalCut = 0x01;
-inline constexpr std::uint8_t kPedalCoagulate = 0x02;
+/// Pedal bits as the board sends them (the protocol's, lp3500_protocol.h).
+inline constexpr std::uint8_t kPedalCut = LP3500_PEDAL_CUT;
+inline constexpr std::uint8_t kPedalCoagulate = LP3500_PEDAL_COAGULATE;
 
 /// A reading in SI units with its provenance. Trivially copyable: the ring moves it by value.
 struct DeviceSample {

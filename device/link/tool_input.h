@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "device/link/device_sample.h"
+#include "rtcore/core/tick_input.h"
 #include "rtcore/concurrency/spsc_ring.h"
 
 namespace resecto {
@@ -38,6 +39,15 @@ class ToolInput {
   const DeviceJoints& joints() const { return joints_; }
   /// Pedal bits in force: zero unless tracking.
   std::uint8_t pedals() const { return state_ == ToolInputState::kTracking ? pedals_ : 0; }
+  /// This tick's input in the core's terms: the joints, the pedals in force, whether a device has reported.
+  TickInput tick_input() const {
+    TickInput input;
+    input.joints = joints_;
+    input.cut = (pedals() & kPedalCut) != 0;
+    input.coagulate = (pedals() & kPedalCoagulate) != 0;
+    input.tool_present = state_ != ToolInputState::kNoDevice;
+    return input;
+  }
   /// The newest sample's sequence number and device time (0 before any).
   std::uint64_t last_sequence() const { return last_sequence_; }
   std::uint64_t last_device_time_us() const { return last_device_time_us_; }

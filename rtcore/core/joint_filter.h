@@ -6,7 +6,7 @@
 // cut-off rises with speed, so a still hand is smoothed hard and a fast one is followed closely.
 #pragma once
 
-#include "device/kinematics/tool_kinematics.h"
+#include "rtcore/kinematics/tool_kinematics.h"
 
 namespace resecto {
 

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "device/link/device_sample.h"
 #include "rtcore/base/units.h"
 #include "rtcore/tissue/state_hash.h"
 #include "rtcore/tissue/tetrahedralize.h"
@@ -201,7 +200,7 @@ void Simulation::update_metrics(const TickInput& input, bool collision_tick) {
   const double h = config_.tick_s();
   const bool contact = tissue_->tool().stats().penetrating > 0;
   const double force = length(reaction_.force_n);
-  const bool cutting = input.tool_present && (input.pedals & kPedalCut) != 0;
+  const bool cutting = input.tool_present && input.cut;
   metrics_.peak_reaction_force_n = std::max(metrics_.peak_reaction_force_n, force);
   if (contact) {
     metrics_.contact_time_s = static_cast<double>(++contact_ticks_) * h;

@@ -11,13 +11,14 @@
 #include <span>
 #include <vector>
 
-#include "device/kinematics/tool_kinematics.h"
 #include "rtcore/anatomy/prostate.h"
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/base/result.h"
 #include "rtcore/concurrency/job_thread.h"
 #include "rtcore/core/joint_filter.h"
 #include "rtcore/core/profiler.h"
+#include "rtcore/core/tick_input.h"
+#include "rtcore/kinematics/tool_kinematics.h"
 #include "rtcore/tissue/mass_spring.h"
 #include "rtcore/tissue/tissue_parameters.h"
 
@@ -44,13 +45,6 @@ struct SimulationConfig {
   double tick_s() const { return 1.0 / (static_cast<double>(collision_hz) * physics_per_collision); }
   /// The tick rates as a user would write them, or an error naming the bad value.
   Status validate() const;
-};
-
-/// The input latched for one tick.
-struct TickInput {
-  DeviceJoints joints;
-  std::uint8_t pedals = 0;       ///< kPedalCut | kPedalCoagulate
-  bool tool_present = false;     ///< false until the device has reported (the tool stays withdrawn)
 };
 
 /// A trainee's procedure in numbers, accumulated every tick.

@@ -12,7 +12,7 @@
 #include "console/gui/action_script.h"
 #include "console/gui/tissue_presets.h"
 #include "console/gui/view_cameras.h"
-#include "device/kinematics/tool_kinematics.h"
+#include "rtcore/kinematics/tool_kinematics.h"
 #include "tests/console/run_resecto.h"
 
 namespace resecto::gui {

@@ -28,7 +28,7 @@ TickInput input_at(std::uint64_t tick, double tick_s) {
   input.joints.roll_rad = 1.2 * std::sin(t);
   input.joints.yaw_rad = t > 1.0 ? 0.01 * std::sin(3.0 * t) : 0.0;
   input.joints.loop_travel_m = 0.006 * (1.0 - std::cos(t));
-  input.pedals = t > 1.5 ? 1 : 0;
+  input.cut = t > 1.5;
   return input;
 }
 

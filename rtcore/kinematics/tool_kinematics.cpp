@@ -1,5 +1,5 @@
 // Forward kinematics of the disk-ring gimbal: joints -> sheath and loop poses (see the header for frames).
-#include "device/kinematics/tool_kinematics.h"
+#include "rtcore/kinematics/tool_kinematics.h"
 
 namespace resecto {
 

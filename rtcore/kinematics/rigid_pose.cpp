@@ -1,5 +1,5 @@
 // Rigid pose composition and conversions for the device kinematics.
-#include "device/kinematics/rigid_pose.h"
+#include "rtcore/kinematics/rigid_pose.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 // Forward kinematics: known joints give known poses, poses are rigid, the registration transform is
 // applied last, and zero yaw/pitch keeps the tip on the channel axis over the insertion range.
-#include "device/kinematics/tool_kinematics.h"
+#include "rtcore/kinematics/tool_kinematics.h"
 
 #include <gtest/gtest.h>
 

@@ -1,0 +1,193 @@
+// `resecto rec info|verify|recover|export`: the recording tools (recordings/README.md has the file's
+// layout). Every one reads damaged and cut files: what is intact is used, what is not is named.
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "console/commands/command_registry.h"
+#include "recordings/recover.h"
+
+namespace resecto::cli {
+namespace {
+
+using nlohmann::ordered_json;
+
+rec::Recording open_recording(const std::string& file) {
+  Result<rec::Recording> recording = rec::Recording::open(file);
+  if (!recording) throw std::runtime_error(recording.error());
+  return std::move(*recording);
+}
+
+std::string describe(const rec::DamagedRange& d) {
+  char text[256];
+  if (d.frame_intact) {
+    std::snprintf(text, sizeof text, "%s chunk %u at byte %llu (%llu bytes): payload CRC mismatch",
+                  std::string(rec::chunk_type_name(d.type)).c_str(), d.sequence, static_cast<unsigned long long>(d.offset),
+                  static_cast<unsigned long long>(d.bytes));
+  } else {
+    std::snprintf(text, sizeof text, "%llu bytes at byte %llu hold no intact chunk (a damaged frame, or a chunk cut off)",
+                  static_cast<unsigned long long>(d.bytes), static_cast<unsigned long long>(d.offset));
+  }
+  return text;
+}
+
+struct InfoOptions {
+  std::string file;
+  bool json = false;
+};
+
+void info(const InfoOptions& o) {
+  const rec::Recording r = open_recording(o.file);
+  const auto chunks = r.chunks_by_type();
+  const auto bytes = r.bytes_by_type();
+  ordered_json chunk_counts = ordered_json::object(), byte_counts = ordered_json::object();
+  for (int type = 1; type < rec::kChunkTypeCount; ++type) {
+    const std::string name(rec::chunk_type_name(static_cast<std::uint16_t>(type)));
+    chunk_counts[name] = chunks[static_cast<std::size_t>(type)];
+    byte_counts[name] = bytes[static_cast<std::size_t>(type)];
+  }
+  chunk_counts["total"] = r.chunks().size();
+  byte_counts["file"] = r.bytes().size();
+  ordered_json damaged = ordered_json::array();
+  for (const rec::DamagedRange& d : r.damaged()) {
+    damaged.push_back({{"offset", d.offset}, {"bytes", d.bytes}, {"description", describe(d)}});
+  }
+  const rec::SessionHeader& h = r.header();
+  const double keyframe_hz = r.keyframes().size() > 1
+                                 ? static_cast<double>(r.keyframes().size() - 1) / (r.keyframes().back().time_s - r.keyframes().front().time_s)
+                                 : 0.0;
+  ordered_json out = {{"file", o.file},
+                      {"build", h.build},
+                      {"procedure", h.procedure},
+                      {"mode", h.mode},
+                      {"duration_s", r.duration_s()},
+                      {"ticks", r.ticks().size()},
+                      {"replayable_ticks", r.replayable_ticks()},
+                      {"collision_steps", r.steps().size()},
+                      {"commands", r.commands().size()},
+                      {"keyframes", r.keyframes().size()},
+                      {"keyframe_hz", keyframe_hz},
+                      {"chunks", chunk_counts},
+                      {"bytes", byte_counts},
+                      {"index_present", r.index_present()},
+                      {"damaged_chunks", r.damaged().size()},
+                      {"damaged", damaged},
+                      {"content_errors", r.content_errors().size()},
+                      {"summary", r.summary()}};
+  if (o.json) {
+    std::printf("%s\n", out.dump(2).c_str());
+    return;
+  }
+  std::printf("%s: %s recording of '%s' by %s\n", o.file.c_str(), h.mode.c_str(), h.procedure.c_str(), h.build.c_str());
+  std::printf("  duration   %.2f s, %zu ticks (%llu replayable), %zu collision steps, %zu commands\n", r.duration_s(), r.ticks().size(),
+              static_cast<unsigned long long>(r.replayable_ticks()), r.steps().size(), r.commands().size());
+  std::printf("  keyframes  %zu (%.1f Hz), grid %d bits over %.1f mm\n", r.keyframes().size(), keyframe_hz, h.grid.bits,
+              static_cast<double>(h.grid.range) * 1e3);
+  std::printf("  chunks     %zu:", r.chunks().size());
+  for (const auto& [name, count] : chunk_counts.items()) {
+    if (name != "total" && count.get<std::uint64_t>() > 0) std::printf(" %s %llu", name.c_str(), static_cast<unsigned long long>(count.get<std::uint64_t>()));
+  }
+  std::printf("\n  bytes      %zu:", r.bytes().size());
+  for (const auto& [name, count] : byte_counts.items()) {
+    if (name != "file" && count.get<std::uint64_t>() > 0) std::printf(" %s %llu", name.c_str(), static_cast<unsigned long long>(count.get<std::uint64_t>()));
+  }
+  std::printf("\n  index      %s; %zu damaged ranges\n", r.index_present() ? "present" : "absent (not closed: `rec recover` rebuilds it)", r.damaged().size());
+  for (const rec::DamagedRange& d : r.damaged()) std::printf("  damaged    %s\n", describe(d).c_str());
+}
+
+void verify(const std::string& file) {
+  const rec::Recording r = open_recording(file);
+  std::size_t problems = 0;
+  for (const rec::DamagedRange& d : r.damaged()) {
+    std::fprintf(stderr, "%s: damaged: %s\n", file.c_str(), describe(d).c_str());
+    ++problems;
+  }
+  for (const std::string& e : r.content_errors()) {
+    std::fprintf(stderr, "%s: undecodable: %s\n", file.c_str(), e.c_str());
+    ++problems;
+  }
+  if (!r.index_present()) {
+    std::fprintf(stderr, "%s: no index: the recording was not closed (`resecto rec recover %s OUT` rebuilds it)\n", file.c_str(), file.c_str());
+    ++problems;
+  }
+  if (problems > 0) throw std::runtime_error(file + ": " + std::to_string(problems) + " problem(s), " + std::to_string(r.chunks().size()) + " intact chunks");
+  std::printf("%s: ok, %zu chunks, every CRC matches, index present\n", file.c_str(), r.chunks().size());
+}
+
+void recover(const std::string& in, const std::string& out) {
+  const rec::Recording r = open_recording(in);
+  Result<rec::RecoverReport> report = rec::recover(r, out);
+  if (!report) throw std::runtime_error(report.error());
+  std::printf("%s -> %s: kept %llu chunks, dropped %llu damaged ranges; %llu ticks (%.2f s) replayable\n", in.c_str(), out.c_str(),
+              static_cast<unsigned long long>(report->chunks_kept), static_cast<unsigned long long>(report->damaged_ranges),
+              static_cast<unsigned long long>(report->replayable_ticks),
+              static_cast<double>(report->replayable_ticks) * r.header().simulation.tick_s());
+}
+
+struct ExportOptions {
+  std::string file;
+  std::string out;
+  int keyframe = -1;
+  double time_s = -1.0;
+  bool inputs = false;
+};
+
+void export_recording(const ExportOptions& o) {
+  const rec::Recording r = open_recording(o.file);
+  const int choices = (o.keyframe >= 0 ? 1 : 0) + (o.time_s >= 0.0 ? 1 : 0) + (o.inputs ? 1 : 0);
+  if (choices != 1) throw std::runtime_error("rec export: give exactly one of --keyframe N, --time S or --inputs");
+  if (o.inputs) {
+    if (Status written = rec::export_inputs_csv(r, o.out); !written) throw std::runtime_error(written.error());
+    std::printf("%s: %zu ticks' inputs\n", o.out.c_str(), r.ticks().size());
+    return;
+  }
+  std::size_t k = static_cast<std::size_t>(o.keyframe);
+  if (o.time_s >= 0.0) {
+    const std::optional<std::size_t> at = r.keyframe_at_time(o.time_s);
+    if (!at) throw std::runtime_error(o.file + ": no keyframe at or before " + std::to_string(o.time_s) + " s");
+    k = *at;
+  }
+  if (Status written = rec::export_keyframe(r, k, o.out); !written) throw std::runtime_error(written.error());
+  const rec::KeyframeInfo& info = r.keyframes()[k];
+  std::printf("%s: keyframe %zu at %.3f s (tick %llu), %u vertices, %u triangles\n", o.out.c_str(), k, info.time_s,
+              static_cast<unsigned long long>(info.tick), info.vertex_count, info.triangle_count);
+}
+
+void register_rec(CLI::App& app) {
+  CLI::App& family = subcommand_family(app, "rec", "Recording tools: info, verify, recover, export");
+  family.require_subcommand(1);
+
+  auto info_options = std::make_shared<InfoOptions>();
+  CLI::App* info_cmd = family.add_subcommand("info", "Duration, ticks, chunks and bytes by type, keyframes, index, damage");
+  info_cmd->add_option("FILE", info_options->file, "Recording")->required();
+  info_cmd->add_flag("--json", info_options->json, "Print JSON (duration_s, ticks, chunks, keyframes, bytes, damaged_chunks, index_present)");
+  info_cmd->callback([info_options] { info(*info_options); });
+
+  auto verify_file = std::make_shared<std::string>();
+  CLI::App* verify_cmd = family.add_subcommand("verify", "Check every chunk's CRC; exit 1 naming each damaged chunk and its byte offset");
+  verify_cmd->add_option("FILE", *verify_file, "Recording")->required();
+  verify_cmd->callback([verify_file] { verify(*verify_file); });
+
+  auto recover_files = std::make_shared<std::pair<std::string, std::string>>();
+  CLI::App* recover_cmd = family.add_subcommand("recover", "Write a complete file (index rebuilt) from every intact chunk of IN");
+  recover_cmd->add_option("IN", recover_files->first, "Damaged, cut or killed recording")->required();
+  recover_cmd->add_option("OUT", recover_files->second, "Recovered recording")->required();
+  recover_cmd->callback([recover_files] { recover(recover_files->first, recover_files->second); });
+
+  auto export_options = std::make_shared<ExportOptions>();
+  CLI::App* export_cmd = family.add_subcommand("export", "A keyframe's surface (.drc .ply .obj .off .stl) or the per-tick inputs (.csv)");
+  export_cmd->add_option("FILE", export_options->file, "Recording")->required();
+  export_cmd->add_option("--keyframe", export_options->keyframe, "Keyframe number (0-based)")->check(CLI::NonNegativeNumber);
+  export_cmd->add_option("--time", export_options->time_s, "The last keyframe at or before this simulated time, seconds")->check(CLI::NonNegativeNumber);
+  export_cmd->add_flag("--inputs", export_options->inputs, "Export the per-tick inputs as CSV instead");
+  export_cmd->add_option("-o,--output", export_options->out, "Output file; format by extension")->required();
+  export_cmd->callback([export_options] { export_recording(*export_options); });
+}
+
+const RegisterCommand kRegister{"rec", &register_rec};
+
+}  // namespace
+}  // namespace resecto::cli

@@ -1,0 +1,134 @@
+// Chunk framing, CRCs and the resynchronising scan of a recording (layout in recordings/README.md).
+#include "recordings/chunk_format.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include <zlib.h>
+
+#include "recordings/byte_io.h"
+
+namespace resecto::rec {
+namespace {
+
+std::uint32_t load_u32(const std::uint8_t* p) {
+  std::uint32_t v;
+  std::memcpy(&v, p, 4);
+  return v;
+}
+
+/// The chunk whose marker is at `pos`, if its frame is intact (CRC, plausible length, inside the
+/// file); `payload_ok` tells whether the payload's CRC holds too.
+bool parse_chunk_at(std::span<const std::uint8_t> file, std::uint64_t limit, std::uint64_t pos, ChunkLocation& chunk,
+                    bool& payload_ok) {
+  if (limit - pos < kChunkFrameBytes + kChunkTrailerBytes) return false;
+  const std::uint8_t* frame = file.data() + pos;
+  if (load_u32(frame) != kChunkMarker) return false;
+  if (crc32_of(std::span<const std::uint8_t>(frame, 16)) != load_u32(frame + 16)) return false;
+  ByteReader reader(std::span<const std::uint8_t>(frame + 4, 12));
+  chunk.offset = pos;
+  chunk.type = reader.get<std::uint16_t>();
+  reader.get<std::uint16_t>();  // flags: none defined yet
+  chunk.sequence = reader.get<std::uint32_t>();
+  chunk.payload_bytes = reader.get<std::uint32_t>();
+  if (chunk.payload_bytes > kMaxChunkPayloadBytes) return false;
+  if (limit - pos < kChunkFrameBytes + std::uint64_t{chunk.payload_bytes} + kChunkTrailerBytes) return false;  // cut off
+  const std::span<const std::uint8_t> payload(file.data() + chunk.payload_offset(), chunk.payload_bytes);
+  payload_ok = crc32_of(payload) == load_u32(file.data() + chunk.payload_offset() + chunk.payload_bytes);
+  return true;
+}
+
+}  // namespace
+
+std::string_view chunk_type_name(std::uint16_t type) {
+  switch (static_cast<ChunkType>(type)) {
+    case ChunkType::kHeader: return "header";
+    case ChunkType::kTicks: return "ticks";
+    case ChunkType::kCommands: return "commands";
+    case ChunkType::kSteps: return "steps";
+    case ChunkType::kKeyframe: return "keyframe";
+    case ChunkType::kSummary: return "summary";
+    case ChunkType::kIndex: return "index";
+  }
+  return "unknown";
+}
+
+std::uint32_t crc32_of(std::span<const std::uint8_t> bytes) {
+  return static_cast<std::uint32_t>(::crc32(::crc32(0L, Z_NULL, 0), bytes.data(), static_cast<uInt>(bytes.size())));
+}
+
+void append_chunk(std::vector<std::uint8_t>& out, ChunkType type, std::uint32_t sequence, std::span<const std::uint8_t> payload) {
+  const std::size_t frame_at = out.size();
+  ByteWriter w(out);
+  w.put(kChunkMarker);
+  w.put(static_cast<std::uint16_t>(type));
+  w.put(std::uint16_t{0});
+  w.put(sequence);
+  w.put(static_cast<std::uint32_t>(payload.size()));
+  w.put(crc32_of(std::span<const std::uint8_t>(out.data() + frame_at, 16)));
+  w.put_bytes(payload);
+  w.put(crc32_of(payload));
+}
+
+ChunkScan scan_chunks(std::span<const std::uint8_t> file) {
+  ChunkScan scan;
+  scan.file_bytes = file.size();
+  std::uint64_t pos = 0;
+  if (file.size() >= sizeof kFileSignature && std::memcmp(file.data(), kFileSignature, sizeof kFileSignature) == 0) {
+    scan.signature_ok = true;
+    pos = sizeof kFileSignature;
+  }
+  // A clean close leaves a trailer naming the index chunk; the scan then stops before the trailer.
+  std::uint64_t limit = file.size();
+  if (file.size() >= sizeof kFileSignature + kFileTrailerBytes &&
+      std::memcmp(file.data() + file.size() - 8, kTrailerMagic, sizeof kTrailerMagic) == 0) {
+    std::uint64_t index_at = 0;
+    std::memcpy(&index_at, file.data() + file.size() - kFileTrailerBytes, 8);
+    ChunkLocation index;
+    bool payload_ok = false;
+    const std::uint64_t body = file.size() - kFileTrailerBytes;
+    if (index_at < body && parse_chunk_at(file, body, index_at, index, payload_ok) && payload_ok &&
+        index.type == static_cast<std::uint16_t>(ChunkType::kIndex) && index.end() == body) {
+      scan.trailer_present = true;
+      limit = body;
+    }
+  }
+
+  std::uint64_t garbage_from = pos;  // start of bytes not yet accounted for by an intact chunk
+  bool in_garbage = false;
+  auto close_garbage = [&](std::uint64_t end) {
+    if (in_garbage && end > garbage_from) scan.damaged.push_back({garbage_from, end - garbage_from, 0, 0, false});
+    in_garbage = false;
+  };
+  std::uint64_t last_end = pos;
+  while (pos < limit) {
+    ChunkLocation chunk;
+    bool payload_ok = false;
+    if (parse_chunk_at(file, limit, pos, chunk, payload_ok)) {
+      close_garbage(pos);
+      if (payload_ok) {
+        scan.chunks.push_back(chunk);
+      } else {
+        // The frame's CRC vouches for the length, so only this chunk is lost and the next one
+        // starts right after it.
+        scan.damaged.push_back({pos, chunk.end() - pos, chunk.type, chunk.sequence, true});
+      }
+      pos = chunk.end();
+      last_end = pos;
+      continue;
+    }
+    if (!in_garbage) {
+      in_garbage = true;
+      garbage_from = pos;
+    }
+    // Resynchronise: the next byte that could start a marker.
+    const auto* next = static_cast<const std::uint8_t*>(
+        std::memchr(file.data() + pos + 1, kChunkMarker & 0xff, static_cast<std::size_t>(limit - pos - 1)));
+    pos = next ? static_cast<std::uint64_t>(next - file.data()) : limit;
+  }
+  close_garbage(limit);
+  scan.tail_bytes = limit - last_end;
+  return scan;
+}
+
+}  // namespace resecto::rec

@@ -1,0 +1,102 @@
+// Recorder: the recording's real-time side. The core's thread hands it one record per tick and one
+// per collision step through lock-free SPSC rings, and on keyframe steps copies the snapshot into a
+// preallocated slot; the recorder's own thread encodes (deflate, Draco) and writes chunks, flushing
+// at least twice a second. The core never waits: a full ring loses the record and counts it.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <span>
+#include <thread>
+#include <vector>
+
+#include "recordings/keyframe_codec.h"
+#include "recordings/records.h"
+#include "recordings/recording_writer.h"
+#include "recordings/session_header.h"
+#include "rtcore/concurrency/spsc_ring.h"
+#include "rtcore/core/simulation.h"
+
+namespace resecto::rec {
+
+struct RecorderSettings {
+  std::size_t tick_ring = 1u << 15;     ///< ~34 s of ticks at 960 Hz
+  std::size_t step_ring = 1u << 11;     ///< ~34 s of collision steps at 60 Hz
+  std::size_t command_ring = 1024;
+  int keyframe_slots = 8;               ///< snapshots waiting for the encoder
+  int keyframe_every_steps = 6;         ///< 60 Hz collision steps / 6 = 10 Hz keyframes
+  int quantisation_bits = 14;
+  KeyframeCodecSettings codec;
+  std::uint32_t ticks_per_chunk = 480;  ///< half a second at 960 Hz
+  std::uint32_t steps_per_chunk = 30;
+  double flush_interval_s = 0.5;        ///< a killed process loses at most this (plus a chunk in the making)
+};
+
+/// What was recorded and lost; `rec info` shows the same from the summary chunk.
+struct RecorderCounters {
+  std::uint64_t ticks = 0, steps = 0, commands = 0, keyframes = 0;
+  std::uint64_t ticks_lost = 0, steps_lost = 0, commands_lost = 0, keyframes_lost = 0;  ///< ring full
+  std::uint64_t chunks = 0, bytes = 0;
+  double keyframe_encode_ms_max = 0.0, keyframe_encode_ms_mean = 0.0;
+  std::string write_error;  ///< the first I/O failure; recording stopped there
+};
+
+class Recorder {
+ public:
+  /// Creates the file, writes the header (the description's simulation config is replaced by
+  /// `sim`'s) and starts the recorder thread.
+  static Result<std::unique_ptr<Recorder>> start(const std::filesystem::path& path, SessionHeader description, const Simulation& sim,
+                                                 const RecorderSettings& settings = {});
+  ~Recorder();
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
+
+  /// Core thread, before step(tick): the input and the commands the step will apply.
+  void record_tick(std::uint64_t tick, const TickInput& input, std::span<const ParameterCommand> commands);
+  /// Core thread, after a collision tick's step(): hash, poses, metrics, and the surface on keyframe steps.
+  void record_step(const Simulation& sim);
+  /// Stops the thread after it has written everything queued, then writes the summary (with
+  /// `extra`, e.g. the run's final hash) and the index. Call once, from the core's thread.
+  Result<RecorderCounters> finish(const nlohmann::ordered_json& extra = nullptr);
+  /// Lost records so far (any thread).
+  std::uint64_t lost() const;
+
+ private:
+  Recorder(const RecorderSettings& settings, const Simulation& sim);
+  void run();
+  bool drain();  ///< one pass over the rings; true if anything was taken
+  void write_ticks();
+  void write_steps();
+  void write_commands();
+  void write_keyframe(int slot);
+  void note_error(const Status& status);
+
+  RecorderSettings settings_;
+  RecordingWriter writer_;
+  SessionHeader header_;
+  int physics_per_collision_ = 16;
+  SpscRing<TickRecord> ticks_;
+  SpscRing<StepRecord> steps_;
+  SpscRing<ParameterCommand> commands_;
+  std::vector<SimulationSnapshot> keyframe_pool_;
+  SpscRing<int> free_slots_;    ///< recorder -> core
+  SpscRing<int> filled_slots_;  ///< core -> recorder
+  // Core-side counters (written by the core thread only, read after the thread stops or relaxed).
+  std::atomic<std::uint64_t> ticks_lost_{0}, steps_lost_{0}, commands_lost_{0}, keyframes_lost_{0};
+  // Recorder-thread state.
+  std::vector<TickRecord> pending_ticks_;
+  std::vector<StepRecord> pending_steps_;
+  std::vector<ParameterCommand> pending_commands_;
+  std::vector<std::uint8_t> payload_, draco_;
+  std::vector<bool> used_nodes_;
+  std::uint64_t last_topology_version_ = UINT64_MAX;
+  RecorderCounters counters_;
+  double encode_ms_sum_ = 0.0;
+  std::atomic<bool> running_{true};
+  bool finished_ = false;
+  std::thread thread_;
+};
+
+}  // namespace resecto::rec

@@ -1,0 +1,90 @@
+// Recording: a recording file opened for reading, replay and browsing (the console's replay panel
+// uses this API; see recordings/README.md). Opening reads the file, scans every chunk (a file with
+// no index, cut or killed, reads the same way as a closed one: every whole chunk is kept, a damaged
+// chunk is lost alone), parses the header and decodes the ticks, steps and commands. Keyframes are
+// indexed at open and decoded on demand.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "recordings/chunk_format.h"
+#include "recordings/keyframe_codec.h"
+#include "recordings/records.h"
+#include "recordings/session_header.h"
+#include "rtcore/base/result.h"
+
+namespace resecto::rec {
+
+/// A keyframe as the index lists it.
+struct KeyframeInfo {
+  std::uint64_t tick = 0;        ///< the collision tick it shows (state after that tick ran)
+  double time_s = 0.0;           ///< (tick + 1) * tick_s: simulated time of that state
+  std::uint64_t topology_version = 0;
+  bool topology_changed = false;
+  std::uint32_t vertex_count = 0;
+  std::uint32_t triangle_count = 0;
+  std::uint32_t draco_bytes = 0;
+  std::size_t chunk = 0;         ///< into chunks()
+};
+
+class Recording {
+ public:
+  /// Reads and scans `path`. An error only when there is nothing to replay from: an unreadable file
+  /// or no intact header chunk; any other damage is reported by damaged(), not fatal.
+  static Result<Recording> open(const std::filesystem::path& path);
+  /// The same from bytes in memory (tests, fuzzing).
+  static Result<Recording> from_bytes(std::vector<std::uint8_t> bytes, std::string name = "recording");
+
+  const SessionHeader& header() const { return header_; }
+  const ChunkScan& scan() const { return scan_; }
+  std::span<const ChunkLocation> chunks() const { return scan_.chunks; }
+  std::span<const DamagedRange> damaged() const { return scan_.damaged; }
+  bool index_present() const { return scan_.trailer_present; }
+  /// Chunks whose CRCs held but whose content did not decode (should never happen; counted).
+  std::span<const std::string> content_errors() const { return content_errors_; }
+
+  /// Every tick recorded, sorted by tick (gaps where chunks were lost).
+  std::span<const TickRecord> ticks() const { return ticks_; }
+  /// The ticks replay can run: from the header's start tick up to the first missing one.
+  std::uint64_t replayable_ticks() const { return replayable_ticks_; }
+  std::span<const StepRecord> steps() const { return steps_; }
+  std::span<const ParameterCommand> commands() const { return commands_; }
+  std::span<const KeyframeInfo> keyframes() const { return keyframes_; }
+  /// The keyframe nearest before or at `time_s` (none before the first).
+  std::optional<std::size_t> keyframe_at_time(double time_s) const;
+  /// Decodes keyframe `k` to positions (with node ids) and triangles.
+  Result<SurfaceFrame> decode_keyframe(std::size_t k) const;
+  /// The keyframe's Draco bytes as stored (a valid .drc file).
+  std::span<const std::uint8_t> keyframe_draco(std::size_t k) const;
+  /// The summary chunk's JSON (null when the run did not close the file).
+  const nlohmann::ordered_json& summary() const { return summary_; }
+
+  /// Simulated seconds the ticks cover.
+  double duration_s() const;
+  /// Bytes of intact chunks (frames included) by chunk type (index = ChunkType value).
+  std::array<std::uint64_t, kChunkTypeCount> bytes_by_type() const;
+  std::array<std::uint64_t, kChunkTypeCount> chunks_by_type() const;
+  std::span<const std::uint8_t> payload(const ChunkLocation& chunk) const;
+  std::span<const std::uint8_t> bytes() const { return bytes_; }
+
+ private:
+  std::vector<std::uint8_t> bytes_;
+  ChunkScan scan_;
+  SessionHeader header_;
+  std::vector<TickRecord> ticks_;
+  std::uint64_t replayable_ticks_ = 0;
+  std::vector<StepRecord> steps_;
+  std::vector<ParameterCommand> commands_;
+  std::vector<KeyframeInfo> keyframes_;
+  nlohmann::ordered_json summary_;
+  std::vector<std::string> content_errors_;
+};
+
+}  // namespace resecto::rec
