@@ -11,6 +11,7 @@
 
 #include "console/commands/checked_options.h"
 #include "console/commands/command_registry.h"
+#include "console/commands/console_command.h"
 #include "console/commands/parameter_options.h"
 #include "console/headless/headless_run.h"
 #include "rtcore/base/atomic_file.h"
@@ -37,11 +38,24 @@ struct RunOptions {
   std::uint64_t seed = 1;
   std::string calibration;
   bool json = false;
+  ConsoleCliOptions console;  ///< without --headless: the console's own options
 };
 
 void run(const RunOptions& o) {
   if (!o.headless) {
-    throw std::runtime_error("the operator console is not built yet; run with --headless");
+    // The console with this run's simulation settings (its real-time core is the same as --realtime's).
+    ConsoleCliOptions console = o.console;
+    console.procedure = o.procedure;
+    console.triangles = o.triangles;
+    console.sets = o.sets;
+    console.collision_hz = o.collision_hz;
+    console.substeps = o.substeps;
+    console.spin_us = o.spin_us;
+    console.seed = o.seed;
+    console.calibration = o.calibration;
+    console.report = o.report;
+    open_console(console);
+    return;
   }
   HeadlessOptions options;
   Result<Procedure> procedure = find_procedure(o.procedure);
@@ -90,7 +104,7 @@ void run(const RunOptions& o) {
 
 void register_run(CLI::App& app) {
   auto o = std::make_shared<RunOptions>();
-  CLI::App* cmd = app.add_subcommand("run", "Run the simulator (headless: a scripted procedure through the emulated device)");
+  CLI::App* cmd = app.add_subcommand("run", "Run the simulator: the operator console, or with --headless a scripted procedure and its report");
   cmd->add_flag("--headless", o->headless, "No display: drive the core with a procedure and report");
   cmd->add_option("--procedure", o->procedure, "Built-in procedure (demo, turp) or a procedure file")->capture_default_str();
   cmd->add_option("--seconds", o->seconds, "Simulated seconds (default: the procedure's length)")->check(positive_up_to(86400.0));
@@ -113,6 +127,7 @@ void register_run(CLI::App& app) {
   cmd->add_option("--calibration", o->calibration, "Device calibration file (default: the reference device's)");
   cmd->add_option("--seed", o->seed, "Seed of the emulated sensors' noise")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print the JSON report instead of the summary");
+  add_console_options(*cmd, o->console, true);
   cmd->callback([o] { run(*o); });
 }
 

@@ -11,12 +11,10 @@
 #include <thread>
 
 #include "console/headless/lockstep_device.h"
-#include "device/calibration/calibration.h"
+#include "console/live/live_device.h"
 #include "device/link/calibration_adapter.h"
-#include "device/link/device_link.h"
+#include "device/calibration/calibration.h"
 #include "device/link/tool_input.h"
-#include "device/transport/emulator_transport.h"
-#include "device/transport/host_clock.h"
 #include "recordings/recorder.h"
 #include "rtcore/concurrency/spsc_ring.h"
 #include "rtcore/concurrency/triple_buffer.h"
@@ -62,28 +60,6 @@ class SnapshotConsumer {
   std::atomic<std::uint64_t> received_{0};
   std::atomic<std::uint64_t> last_tick_{0};
   std::thread thread_;
-};
-
-/// The real-time device: the emulated board behind the host link's own thread and transport.
-struct LiveDevice {
-  LiveDevice(const Procedure& procedure, const device::Calibration& calibration, std::uint64_t seed)
-      : emulator([&] {
-          firmware::EmulatorOptions options;
-          options.seed = seed;
-          return options;
-        }()),
-        transport(emulator, clock),
-        link(transport, clock, [&] {
-          LinkConfig config;
-          config.calibration = joint_calibration_from(calibration);
-          return config;
-        }()) {
-    emulator.set_motion(motion_script_for(procedure));  // before the link thread first opens the board
-  }
-  firmware::Emulator emulator;
-  SteadyHostClock clock;
-  EmulatorTransport transport;
-  DeviceLink link;
 };
 
 ordered_json stage_json(const StageStatistics& s) {
@@ -153,8 +129,12 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   std::unique_ptr<LockstepDevice> lockstep;
   std::unique_ptr<LiveDevice> live;
   if (options.realtime) {
-    live = std::make_unique<LiveDevice>(options.procedure, calibration, options.seed);
-    live->link.start();
+    LiveDeviceOptions device_options;
+    device_options.procedure = options.procedure;
+    device_options.calibration = calibration;
+    device_options.seed = options.seed;
+    live = std::make_unique<LiveDevice>(device_options);
+    live->link().start();
   } else {
     lockstep = std::make_unique<LockstepDevice>(options.procedure, calibration, options.seed);
   }
@@ -199,12 +179,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
       if (lockstep) {
         lockstep->advance_to(static_cast<std::uint64_t>(tick) * static_cast<std::uint64_t>(period_ns) / 1000, samples);
       } else {
-        // Relay the link's ring into the core's, noting when the newest sample reached the host.
-        DeviceSample sample;
-        while (live->link.samples().try_pop(sample)) {
-          if (sample.event == LinkEvent::kSample) newest_sample_host_ns = std::max(newest_sample_host_ns, sample.host_time_ns);
-          samples.try_push(sample);
-        }
+        relay_link_samples(live->link(), samples, newest_sample_host_ns);
       }
       tool_input.latch(samples, tick_s);
       input = tool_input.tick_input();
@@ -229,7 +204,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   const bool core_raised = core_priority && core_priority->raised();
   core_priority.reset();
   consumer.stop();
-  if (live) live->link.stop();
+  if (live) live->link().stop();
 
   result.ticks = sim.tick();
   result.final_hash = sim.state_hash();
@@ -272,7 +247,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
                    {"duplicates", c.duplicates}, {"rejected", c.rejected},
                    {"rate_hz", r["simulated_s"].get<double>() > 0 ? static_cast<double>(c.accepted) / r["simulated_s"].get<double>() : 0.0}};
   } else {
-    const LinkCounters c = live->link.counters();
+    const LinkCounters c = live->link().counters();
     r["device"] = {{"transport", "emulator (link thread)"}, {"reports", c.reports}, {"accepted", c.accepted}, {"lost", c.lost},
                    {"duplicates", c.duplicates}, {"rejected", c.rejected}, {"rate_hz", c.rate_hz},
                    {"latency_us", {{"median", c.latency_median_us}, {"p99", c.latency_p99_us}}}};

@@ -55,6 +55,8 @@ class FrameProfiler {
 
   StageStatistics statistics(Stage stage) const;
   double budget_us(Stage stage) const { return budgets_us_[static_cast<int>(stage)]; }
+  /// The stage's most recent duration, microseconds (what a live plot samples).
+  double last_us(Stage stage) const { return last_us_[static_cast<int>(stage)]; }
   /// Stage timings recorded so far that the trace ring no longer holds.
   std::uint64_t trace_dropped() const { return trace_written_ > trace_.size() ? trace_written_ - trace_.size() : 0; }
 
@@ -65,6 +67,7 @@ class FrameProfiler {
   std::array<double, kStageCount> budgets_us_;
   std::array<TimingHistogram, kStageCount> histograms_;
   std::array<std::uint64_t, kStageCount> over_budget_{};
+  std::array<double, kStageCount> last_us_{};
   std::vector<StageTiming> trace_;
   std::uint64_t trace_written_ = 0;
 };

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# The operator console's rendering cost and its effect on the core, measured the console's own way
+# (its session report): frame time median/p99 and input-to-photon latency at 8640 and 34560 surface
+# triangles under Xvfb (Mesa llvmpipe), each beside the headless real-time run of the same model and
+# the machine's own deadline floor, back to back in one invocation so they share the machine's state.
+# Usage: benchmarks/console_frames.sh [build-dir] [frames]   (prints a table; keep it in results/)
+set -euo pipefail
+build="${1:-build/release}"
+frames="${2:-60}"
+bin="$build/console/resecto"
+floor="$build/benchmarks/deadline_floor_bench"
+out="$(mktemp -d)"
+trap 'rm -rf "$out"' EXIT
+field() { python3 -c "import json,sys; r=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$1" "$2"; }
+
+echo "console_frames $(date -u +%Y-%m-%dT%H:%MZ) on $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg)"
+printf '%-9s %-26s %8s %8s %8s %8s %9s %9s %8s\n' triangles run frames frame_med frame_p99 i2p_med ticks misses miss%
+for tri in 8640 34560; do
+  xvfb-run -a -s '-screen 0 1920x1200x24' "$bin" console --device emulator --procedure demo --triangles "$tri" --frames "$frames" \
+    --report "$out/console-$tri.json" >/dev/null
+  r="$out/console-$tri.json"
+  printf '%-9s %-26s %8s %8.1f %8.1f %8.1f %9s %9s %8.3f\n' "$tri" "console (llvmpipe, $(field "$r" 'r["renderer"]["view_scale"]')x views)" \
+    "$(field "$r" 'r["frames"]')" "$(field "$r" 'r["frame_ms"]["median"]')" "$(field "$r" 'r["frame_ms"]["p99"]')" \
+    "$(field "$r" 'r["input_to_photon_ms"]["median"]')" "$(field "$r" 'r["core"]["ticks"]')" "$(field "$r" 'r["core"]["deadline_misses"]')" \
+    "$(field "$r" '100*r["core"]["miss_fraction"]')"
+  seconds="$(field "$r" 'round(r["core"]["ticks"]/960.0, 1)')"
+  "$bin" run --headless --realtime --procedure demo --triangles "$tri" --seconds "$seconds" --report "$out/headless-$tri.json" >/dev/null
+  h="$out/headless-$tri.json"
+  printf '%-9s %-26s %8s %8s %8s %8s %9s %9s %8.3f\n' "$tri" "headless --realtime" - - - - "$(field "$h" 'r["deadlines"]["ticks"]')" \
+    "$(field "$h" 'r["deadlines"]["misses"]')" "$(field "$h" '100*r["deadlines"]["miss_fraction"]')"
+done
+if [ -x "$floor" ]; then
+  echo "the machine's floor (same schedule, each tick 300 us of busy waiting, 10 s):"
+  "$floor" --benchmark_filter='BM_DeadlineFloor/300/' 2>/dev/null | tail -2
+fi

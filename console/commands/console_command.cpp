@@ -1,0 +1,111 @@
+// `resecto console`: the operator console (console/gui/), and the options `resecto run` shares with it.
+#include "console/commands/console_command.h"
+
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+
+#include "console/commands/command_registry.h"
+#include "console/commands/parameter_options.h"
+#include "console/gui/console_app.h"
+#include "console/gui/tissue_presets.h"
+
+namespace resecto::cli {
+
+void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_run) {
+  if (!shared_with_run) {
+    cmd.add_option("--procedure", o.procedure, "Built-in procedure (demo) or a procedure file the emulated device follows")->capture_default_str();
+    cmd.add_option("--triangles", o.triangles, "Prostate surface triangles")->check(CLI::Range(200, 1000000))->capture_default_str();
+    cmd.add_option("--report", o.report, "Write the session's JSON report here when the console closes");
+    add_parameter_option(cmd, o.sets);
+    cmd.add_option("--collision-hz", o.collision_hz, "Collision steps per second")->check(CLI::Range(10, 1000))->capture_default_str();
+    cmd.add_option("--substeps", o.substeps, "Physics steps per collision step")->check(CLI::Range(1, 64))->capture_default_str();
+    cmd.add_option("--spin-us", o.spin_us, "Spin this long before each tick instead of sleeping")->check(CLI::Range(0, 100000))->capture_default_str();
+    cmd.add_option("--seed", o.seed, "Seed of the emulated sensors' noise")->capture_default_str();
+    cmd.add_option("--calibration", o.calibration, "Device calibration file (default: the reference device's)");
+  }
+  cmd.add_option("--device", o.device,
+                 "emulator: the emulated board follows the procedure; keyboard: you drive it (keys, mouse, gamepad, sliders); "
+                 "hid: the LP3500 over USB")
+      ->check(CLI::IsMember({"emulator", "keyboard", "hid"}))
+      ->capture_default_str();
+  cmd.add_option("--preset", o.preset, "Tissue parameter preset (JSON) to start from");
+  cmd.add_option("--replay", o.replay, "Open this recording in the replay panel");
+  cmd.add_option("--actions", o.actions, "Scripted UI actions, one 'frame N VERB ...' per line (README, \"Operator console\")");
+  CLI::Option* frames = cmd.add_option("--frames", o.frames, "Quit after this many frames")->check(CLI::Range(1, 100000000));
+  cmd.add_option("--screenshot", o.screenshot, "Write a PNG of the whole window after the last of --frames")->needs(frames);
+  cmd.add_flag("--lockstep", o.lockstep,
+               "Step the emulated board with the core's ticks (no link thread): the state depends only on the procedure and the commands");
+  cmd.add_option("--insertion-mm", o.start_insertion_mm, "--device keyboard: where the sheath starts, mm past the pivot (the apex is at 150)")
+      ->check(CLI::Range(0.0, 230.0))
+      ->capture_default_str();
+  cmd.add_option("--width", o.width, "Window width, pixels")->check(CLI::Range(640, 8192))->capture_default_str();
+  cmd.add_option("--height", o.height, "Window height, pixels")->check(CLI::Range(480, 8192))->capture_default_str();
+  cmd.add_option("--slow-frame-ms", o.slow_frame_ms, "Make every frame this much slower (to show the core is never held back)")
+      ->check(CLI::Range(0.0, 10000.0));
+  cmd.add_option("--view-scale", o.view_scale,
+                 "Resolution of the 3-D views relative to their panels (default: 1 on a GPU, 0.5 on a software rasteriser)")
+      ->check(CLI::Range(0.1, 2.0));
+  cmd.add_flag("--no-vsync", o.no_vsync, "Draw frames as fast as possible instead of at the display's refresh");
+}
+
+void open_console(const ConsoleCliOptions& o) {
+  if (!o.replay.empty()) throw std::runtime_error("--replay " + o.replay + ": recordings not available in this build");
+  if (!gui::display_available()) {
+    throw std::runtime_error("no display (neither DISPLAY nor WAYLAND_DISPLAY is set): run the console under X or Wayland, "
+                             "or use `resecto run --headless`");
+  }
+  gui::ConsoleOptions options;
+  Result<Procedure> procedure = find_procedure(o.procedure);
+  if (!procedure) throw std::runtime_error(procedure.error());
+  options.core.device.procedure = std::move(*procedure);
+  options.core.device.source = o.device == "keyboard" ? DeviceSource::kEmulatorManual
+                               : o.device == "hid"    ? DeviceSource::kHid
+                                                      : DeviceSource::kEmulatorScript;
+  options.core.device.manual_start.insertion_mm = o.start_insertion_mm;
+  options.core.device.seed = o.seed;
+  if (!o.calibration.empty()) {
+    Result<device::Calibration> calibration = device::read_calibration(o.calibration);
+    if (!calibration) throw std::runtime_error(calibration.error());
+    options.core.device.calibration = *calibration;
+  }
+  options.core.lockstep = o.lockstep;
+  options.core.spin_us = o.spin_us;
+  options.core.simulation.prostate_triangles = o.triangles;
+  options.core.simulation.collision_hz = o.collision_hz;
+  options.core.simulation.physics_per_collision = o.substeps;
+  TissueParameters parameters = parameters_from_assignments(o.sets);
+  if (!o.preset.empty()) {
+    Result<TissueParameters> preset = gui::load_preset(o.preset, parameters);
+    if (!preset) throw std::runtime_error(preset.error());
+    parameters = *preset;
+  }
+  options.settings.parameters = parameters;
+  options.settings.window_width = o.width;
+  options.settings.window_height = o.height;
+  options.actions_path = o.actions;
+  options.screenshot_path = o.screenshot;
+  options.frames = o.frames;
+  options.report_path = o.report;
+  options.slow_frame_ms = o.slow_frame_ms;
+  options.vsync = !o.no_vsync;
+  options.view_scale = o.view_scale;
+  Result<nlohmann::ordered_json> report = gui::run_console(options);
+  if (!report) throw std::runtime_error(report.error());
+  std::fputs(gui::summarize_console_report(*report).c_str(), stdout);
+  if (!o.screenshot.empty()) std::printf("  screenshot       %s\n", o.screenshot.c_str());
+}
+
+namespace {
+
+void register_console(CLI::App& app) {
+  auto o = std::make_shared<ConsoleCliOptions>();
+  CLI::App* cmd = app.add_subcommand("console", "The operator console: endoscopic and outside views, live tissue tuning, profiler");
+  add_console_options(*cmd, *o, false);
+  cmd->callback([o] { open_console(*o); });
+}
+
+const RegisterCommand kRegister{"console", &register_console};
+
+}  // namespace
+}  // namespace resecto::cli

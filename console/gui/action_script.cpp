@@ -1,0 +1,115 @@
+// Parsing the console's action scripts.
+#include "console/gui/action_script.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace resecto::gui {
+namespace {
+
+bool parse_number(const std::string& text, double& out) {
+  const char* end = text.data() + text.size();
+  const auto [ptr, error] = std::from_chars(text.data(), end, out);
+  return error == std::errc{} && ptr == end && std::isfinite(out);
+}
+
+struct VerbSpec {
+  const char* name;
+  ActionVerb verb;
+  std::size_t min_words, max_words;
+};
+
+constexpr VerbSpec kVerbs[] = {
+    {"set", ActionVerb::kSet, 2, 2},       {"pedal", ActionVerb::kPedal, 2, 2},
+    {"key", ActionVerb::kKey, 2, 2},       {"drag", ActionVerb::kDrag, 3, 3},
+    {"pause", ActionVerb::kPause, 0, 0},   {"resume", ActionVerb::kResume, 0, 0},
+    {"step", ActionVerb::kStep, 1, 1},     {"record", ActionVerb::kRecord, 1, 1},
+    {"screenshot", ActionVerb::kScreenshot, 1, 1}, {"preset", ActionVerb::kPreset, 2, 2},
+    {"replay", ActionVerb::kReplay, 1, 2}, {"quit", ActionVerb::kQuit, 0, 0},
+};
+
+}  // namespace
+
+Result<std::vector<Action>> parse_actions(const std::string& text, const std::string& source_name) {
+  std::vector<Action> actions;
+  std::istringstream lines(text);
+  std::string line;
+  int number = 0;
+  while (std::getline(lines, line)) {
+    ++number;
+    if (const std::size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+    std::istringstream fields(line);
+    std::vector<std::string> words;
+    for (std::string w; fields >> w;) words.push_back(w);
+    if (words.empty()) continue;
+    const std::string where = source_name + ":" + std::to_string(number) + ": ";
+    double frame = 0.0;
+    if (words.size() < 3 || words[0] != "frame" || !parse_number(words[1], frame) || frame < 0 || frame != std::floor(frame)) {
+      return Error{where + "expected 'frame N VERB ...' with N a whole number of frames, got '" + line + "'"};
+    }
+    const VerbSpec* spec = nullptr;
+    for (const VerbSpec& v : kVerbs)
+      if (words[2] == v.name) spec = &v;
+    if (!spec) return Error{where + "unknown action '" + words[2] + "' (set, pedal, key, drag, pause, resume, step, record, screenshot, preset, replay, quit)"};
+    Action a;
+    a.frame = static_cast<std::uint64_t>(frame);
+    a.verb = spec->verb;
+    a.line = number;
+    a.words.assign(words.begin() + 3, words.end());
+    if (a.words.size() < spec->min_words || a.words.size() > spec->max_words) {
+      return Error{where + "'" + words[2] + "' takes " + std::to_string(spec->min_words) +
+                   (spec->max_words != spec->min_words ? "-" + std::to_string(spec->max_words) : std::string()) + " argument(s), got " +
+                   std::to_string(a.words.size())};
+    }
+    switch (a.verb) {
+      case ActionVerb::kSet:
+        if (!parse_number(a.words[1], a.value)) return Error{where + "set " + a.words[0] + ": '" + a.words[1] + "' is not a number"};
+        break;
+      case ActionVerb::kPedal:
+        if (a.words[0] != "cut" && a.words[0] != "coagulate") return Error{where + "pedal: expected cut or coagulate, got '" + a.words[0] + "'"};
+        if (a.words[1] != "on" && a.words[1] != "off") return Error{where + "pedal: expected on or off, got '" + a.words[1] + "'"};
+        break;
+      case ActionVerb::kKey:
+        if (a.words[1] != "down" && a.words[1] != "up") return Error{where + "key: expected down or up, got '" + a.words[1] + "'"};
+        break;
+      case ActionVerb::kDrag:
+        if (a.words[0] != "endoscope" && a.words[0] != "outside") return Error{where + "drag: expected endoscope or outside, got '" + a.words[0] + "'"};
+        if (!parse_number(a.words[1], a.value) || !parse_number(a.words[2], a.value2)) return Error{where + "drag: DX and DY must be numbers"};
+        break;
+      case ActionVerb::kStep:
+        if (!parse_number(a.words[0], a.value) || a.value < 1 || a.value != std::floor(a.value) || a.value > 1e7) {
+          return Error{where + "step: expected a whole number of ticks in [1, 10000000], got '" + a.words[0] + "'"};
+        }
+        break;
+      case ActionVerb::kPreset:
+        if (a.words[0] != "save" && a.words[0] != "load") return Error{where + "preset: expected save or load, got '" + a.words[0] + "'"};
+        break;
+      case ActionVerb::kReplay: {
+        const std::string& op = a.words[0];
+        const bool takes_argument = op == "open" || op == "seek" || op == "speed";
+        const bool plain = op == "play" || op == "pause" || op == "step" || op == "verify";
+        if (!takes_argument && !plain) return Error{where + "replay: unknown operation '" + op + "' (open, play, pause, step, seek, speed, verify)"};
+        if (takes_argument != (a.words.size() == 2)) return Error{where + "replay " + op + (takes_argument ? " needs one argument" : " takes no argument")};
+        if ((op == "seek" || op == "speed") && !parse_number(a.words[1], a.value)) return Error{where + "replay " + op + ": '" + a.words[1] + "' is not a number"};
+        break;
+      }
+      default: break;
+    }
+    actions.push_back(std::move(a));
+  }
+  std::stable_sort(actions.begin(), actions.end(), [](const Action& a, const Action& b) { return a.frame < b.frame; });
+  return actions;
+}
+
+Result<std::vector<Action>> load_actions(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{path.string() + ": cannot open the actions file"};
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return parse_actions(buffer.str(), path.string());
+}
+
+}  // namespace resecto::gui

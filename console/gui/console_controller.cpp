@@ -1,0 +1,121 @@
+// The console's changes, turned into commands for the core.
+#include "console/gui/console_controller.h"
+
+#include <cmath>
+
+#include "console/gui/tissue_presets.h"
+#include "rtcore/base/units.h"
+
+namespace resecto::gui {
+
+bool ConsoleController::refresh() { return session_.frames().update(); }
+
+bool ConsoleController::send(const CoreControl& control) {
+  if (session_.send(control)) return true;
+  ui_.message = "the core's command ring is full; try again";
+  return false;
+}
+
+bool ConsoleController::set_parameter(TissueParameter id, double value) {
+  TissueParameters check;
+  if (Status valid = check.set(id, value); !valid) {
+    ui_.message = valid.error();
+    return false;
+  }
+  CoreControl control;
+  control.kind = CoreControlKind::kParameter;
+  control.id = ui_.next_control_id++;
+  // "The next tick": the one the core has not run yet. If the core gets there before it reads the
+  // ring, it applies the change at its next tick and says which.
+  control.parameter = {static_cast<std::int64_t>(session_.next_tick()), id, value};
+  if (!send(control)) return false;
+  ui_.slider_values[static_cast<std::size_t>(id)] = value;
+  ParameterChange change;
+  change.id = control.id;
+  change.parameter = id;
+  change.value = value;
+  change.frame_sent = ui_.frame;
+  change.stamped_tick = control.parameter.apply_tick;
+  ui_.changes.push_back(change);
+  return true;
+}
+
+bool ConsoleController::manual_device() const {
+  return session_.live_device() && session_.live_device()->manual();
+}
+
+Status ConsoleController::set_by_key(const std::string& key, double value) {
+  if (const std::optional<TissueParameter> id = find_tissue_parameter(key)) {
+    if (!set_parameter(*id, value)) return Error{ui_.message};
+    return Ok{};
+  }
+  if (key == "speed") {
+    if (!(value > 0.0 && value <= 1.0)) return Error{"speed " + std::to_string(value) + " is outside (0, 1]"};
+    set_speed(value);
+    return Ok{};
+  }
+  const bool joint = key == "yaw" || key == "pitch" || key == "roll" || key == "insertion" || key == "loop";
+  if (!joint) return Error{"unknown key '" + key + "': a tissue parameter (resecto params), yaw, pitch, roll, insertion, loop or speed"};
+  if (!manual_device()) return Error{"set " + key + ": the joints follow the device; start with --device keyboard to set them"};
+  firmware::MotionState state = ui_.manual.state();
+  if (key == "yaw") state.yaw_rad = units::deg_to_rad(value);
+  if (key == "pitch") state.pitch_rad = units::deg_to_rad(value);
+  if (key == "roll") state.roll_rad = units::deg_to_rad(value);
+  if (key == "insertion") state.insertion_mm = value;
+  if (key == "loop") state.loop_mm = value;
+  // Through ManualMotion so the device's travel limits hold for a slider as for the keys.
+  ui_.manual = ManualMotion(state);
+  ui_.manual.apply(ManualCommand{}, 0.0);
+  return Ok{};
+}
+
+void ConsoleController::pause() { send({CoreControlKind::kPause, {}, 0, 0, 1.0}); }
+void ConsoleController::resume() { send({CoreControlKind::kResume, {}, 0, 0, 1.0}); }
+void ConsoleController::step(std::uint32_t ticks) { send({CoreControlKind::kStep, {}, 0, ticks, 1.0}); }
+void ConsoleController::set_speed(double speed) { send({CoreControlKind::kSpeed, {}, 0, 0, speed}); }
+
+Status ConsoleController::save_preset(const std::string& path) {
+  Status saved = gui::save_preset(path, frame().status.parameters);
+  ui_.preset_message = saved ? "saved " + path : saved.error();
+  return saved;
+}
+
+Status ConsoleController::load_preset(const std::string& path) {
+  Result<TissueParameters> loaded = gui::load_preset(path, frame().status.parameters);
+  if (!loaded) {
+    ui_.preset_message = loaded.error();
+    return Error{loaded.error()};
+  }
+  // Every value that differs becomes a command, in table order.
+  for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
+    if (loaded->get(spec.id) != frame().status.parameters.get(spec.id)) set_parameter(spec.id, loaded->get(spec.id));
+  }
+  settings_.parameters = *loaded;
+  ui_.preset_message = "loaded " + path;
+  return Ok{};
+}
+
+void ConsoleController::drag_endoscope(float dx_pixels, float dy_pixels) {
+  if (!manual_device()) return;
+  firmware::MotionState state = ui_.manual.state();
+  // A drag to the right swings the tip right in the image; up lifts it (0.1 degree per pixel).
+  state.yaw_rad += units::deg_to_rad(0.1 * dx_pixels);
+  state.pitch_rad -= units::deg_to_rad(0.1 * dy_pixels);
+  ui_.manual = ManualMotion(state);
+  ui_.manual.apply(ManualCommand{}, 0.0);  // clamps to the travel limits
+}
+
+void ConsoleController::track_changes() {
+  const LiveFrame& f = frame();
+  for (ParameterChange& change : ui_.changes) {
+    if (change.first_frame_shown >= 0) continue;
+    const auto p = static_cast<std::size_t>(change.parameter);
+    if (f.status.applied_id[p] < change.id) continue;
+    change.applied_tick = f.status.applied_tick[p];
+    change.first_frame_shown = static_cast<std::int64_t>(ui_.frame);
+    change.shown_snapshot_tick = f.snapshot.tick;
+    change.shown_value = f.status.parameters.get(change.parameter);
+  }
+}
+
+}  // namespace resecto::gui

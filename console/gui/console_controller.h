@@ -1,0 +1,54 @@
+// ConsoleController: every change a person can make in the console, in one place, used alike by the
+// widgets and by the action script (so a script drives exactly what a person drives). Changes to the
+// simulation become CoreControls for the core's next tick; nothing here writes into the core.
+#pragma once
+
+#include <string>
+
+#include "console/gui/console_state.h"
+
+namespace resecto::gui {
+
+class ConsoleController {
+ public:
+  ConsoleController(CoreSession& session, ConsoleUi& ui, ConsoleSettings& settings)
+      : session_(session), ui_(ui), settings_(settings) {}
+
+  /// The newest frame from the core (valid after the first refresh()).
+  const LiveFrame& frame() const { return session_.frames().read_slot(); }
+  /// Takes the core's newest frame; true when it is new.
+  bool refresh();
+
+  /// Queues a tissue parameter change stamped for the core's next tick; false with a message in
+  /// ui.message when the value is out of range or the ring is full.
+  bool set_parameter(TissueParameter id, double value);
+  /// `set KEY VALUE` as the action script and the command line write it: a tissue parameter, a
+  /// joint of the hand-driven device (yaw, pitch, roll in degrees; insertion, loop in millimetres) or
+  /// the core's speed.
+  Status set_by_key(const std::string& key, double value);
+  void pause();
+  void resume();
+  void step(std::uint32_t ticks);
+  void set_speed(double speed);
+  Status save_preset(const std::string& path);
+  Status load_preset(const std::string& path);
+  /// Moves the hand-driven device's yaw and pitch as a mouse drag across the endoscope image would.
+  void drag_endoscope(float dx_pixels, float dy_pixels);
+  bool manual_device() const;
+
+  /// Follows queued parameter changes to the frame that shows them (call once per new frame).
+  void track_changes();
+
+  CoreSession& session() { return session_; }
+  ConsoleUi& ui() { return ui_; }
+  ConsoleSettings& settings() { return settings_; }
+
+ private:
+  bool send(const CoreControl& control);
+
+  CoreSession& session_;
+  ConsoleUi& ui_;
+  ConsoleSettings& settings_;
+};
+
+}  // namespace resecto::gui

@@ -1,0 +1,248 @@
+// Panel layouts. Figures carry their units; what the core has not applied yet is shown as pending.
+#include "console/gui/console_panels.h"
+
+#include <imgui.h>
+
+#include <algorithm>
+#include <cinttypes>
+#include <cstdio>
+#include <string>
+
+#include "rtcore/base/units.h"
+
+namespace resecto::gui {
+namespace {
+
+const char* input_state_name(ToolInputState state) {
+  switch (state) {
+    case ToolInputState::kNoDevice: return "no device yet";
+    case ToolInputState::kTracking: return "tracking";
+    case ToolInputState::kFrozen: return "frozen (disconnected)";
+    case ToolInputState::kReengaging: return "re-engaging";
+  }
+  return "?";
+}
+
+constexpr double kSpeeds[] = {1.0, 0.5, 0.25, 0.125, 1.0 / 16.0};
+constexpr const char* kSpeedNames[] = {"1x (real time)", "1/2", "1/4", "1/8", "1/16"};
+
+/// A row of a two-column table: label, then formatted text.
+template <class... Args>
+void row(const char* label, const char* format, Args... args) {
+  ImGui::TableNextRow();
+  ImGui::TableSetColumnIndex(0);
+  ImGui::TextUnformatted(label);
+  ImGui::TableSetColumnIndex(1);
+  ImGui::Text(format, args...);
+}
+
+}  // namespace
+
+void draw_simulation_panel(ConsoleController& console) {
+  const LiveFrame& f = console.frame();
+  const CoreStatus& s = f.status;
+  ConsoleUi& ui = console.ui();
+  const double tick_s = console.session().simulation().config().tick_s();
+  const bool diverged = f.snapshot.metrics.non_finite_steps > 0;
+  const char* verdict = diverged ? "diverged" : (s.paused ? "paused" : "ok");
+  ImGui::Text("tick %" PRIu64 "  (%.3f s)   state %s   hash %016" PRIx64, s.next_tick, static_cast<double>(s.next_tick) * tick_s, verdict,
+              f.snapshot.state_hash);
+  if (s.paused) {
+    if (ImGui::Button("Resume (P)")) console.resume();
+  } else {
+    if (ImGui::Button("Pause (P)")) console.pause();
+  }
+  ImGui::SameLine();
+  ImGui::BeginDisabled(!s.paused);
+  if (ImGui::Button("Step (N)")) console.step(1);
+  ImGui::SameLine();
+  if (ImGui::Button("Step 1 collision")) console.step(static_cast<std::uint32_t>(console.session().simulation().config().physics_per_collision));
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(80);
+  ImGui::InputInt("##batch", &ui.batch_steps, 0);
+  ui.batch_steps = std::clamp(ui.batch_steps, 1, 1000000);
+  ImGui::SameLine();
+  if (ImGui::Button("Run batch")) console.step(static_cast<std::uint32_t>(ui.batch_steps));
+  ImGui::EndDisabled();
+  if (s.pending_steps > 0) ImGui::Text("stepping: %" PRIu64 " ticks to go", s.pending_steps);
+  ImGui::SetNextItemWidth(160);
+  if (ImGui::Combo("speed", &ui.speed_index, kSpeedNames, IM_ARRAYSIZE(kSpeedNames))) console.set_speed(kSpeeds[ui.speed_index]);
+  ImGui::SameLine();
+  ImGui::Text("core at %.3gx", s.speed);
+  if (!ui.message.empty()) ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.3f, 1.0f), "%s", ui.message.c_str());
+}
+
+void draw_parameter_panel(ConsoleController& console) {
+  const CoreStatus& s = console.frame().status;
+  ConsoleUi& ui = console.ui();
+  ImGui::TextDisabled("a change applies at the core's next tick; 'in force' is what the core uses");
+  for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
+    const auto p = static_cast<std::size_t>(spec.id);
+    double value = ui.slider_values[p];
+    const std::string label = std::string(spec.key) + " (" + std::string(spec.unit) + ")";
+    ImGui::SetNextItemWidth(200);
+    const ImGuiSliderFlags flags = spec.min_value > 0.0 && spec.max_value / spec.min_value > 50.0 ? ImGuiSliderFlags_Logarithmic : 0;
+    const bool changed = ImGui::SliderScalar(label.c_str(), ImGuiDataType_Double, &value, &spec.min_value, &spec.max_value, "%.4g", flags);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s\nrange %g .. %g %s", std::string(spec.description).c_str(), spec.min_value,
+                                                  spec.max_value, std::string(spec.unit).c_str());
+    if (changed) console.set_parameter(spec.id, value);
+    ImGui::SameLine();
+    const double in_force = s.parameters.get(spec.id);
+    if (s.applied_tick[p] >= 0) {
+      ImGui::TextDisabled("in force %.4g, since tick %" PRId64, in_force, s.applied_tick[p]);
+    } else {
+      ImGui::TextDisabled("in force %.4g", in_force);
+    }
+  }
+  ImGui::SetNextItemWidth(220);
+  char path[512];
+  std::snprintf(path, sizeof path, "%s", ui.preset_path.c_str());
+  if (ImGui::InputText("preset file", path, sizeof path)) ui.preset_path = path;
+  if (ImGui::Button("Save preset")) (void)console.save_preset(ui.preset_path);
+  ImGui::SameLine();
+  if (ImGui::Button("Load preset")) (void)console.load_preset(ui.preset_path);
+  ImGui::SameLine();
+  if (ImGui::Button("Defaults")) {
+    for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
+      if (s.parameters.get(spec.id) != spec.default_value) console.set_parameter(spec.id, spec.default_value);
+    }
+  }
+  if (!ui.preset_message.empty()) ImGui::TextDisabled("%s", ui.preset_message.c_str());
+}
+
+void draw_device_panel(ConsoleController& console) {
+  const CoreStatus& s = console.frame().status;
+  ConsoleUi& ui = console.ui();
+  LiveDevice* live = console.session().live_device();
+  if (ImGui::BeginTable("device", 2, ImGuiTableFlags_SizingStretchProp)) {
+    row("transport", "%s", console.session().device_description().c_str());
+    if (live) {
+      const LinkCounters c = live->link().published_counters();
+      row("connection", "%s", live->link().connected() ? "connected" : "not connected");
+      row("rate", "%.0f Hz", c.rate_hz);
+      row("reports / lost", "%" PRIu64 " / %" PRIu64, c.reports, c.lost);
+      row("rejected / dup.", "%" PRIu64 " / %" PRIu64, c.rejected, c.duplicates);
+      row("latency", "median %.0f us, p99 %.0f us", c.latency_median_us, c.latency_p99_us);
+    } else {
+      row("connection", "lockstep (stepped with the core)");
+      row("reports / lost", "%" PRIu64 " / %" PRIu64, s.lockstep_reports, s.lockstep_lost);
+    }
+    row("input", "%s", input_state_name(s.input_state));
+    row("yaw", "%+7.2f deg", units::rad_to_deg(s.joints.yaw_rad));
+    row("pitch", "%+7.2f deg", units::rad_to_deg(s.joints.pitch_rad));
+    row("roll", "%+7.2f deg", units::rad_to_deg(s.joints.roll_rad));
+    row("insertion", "%7.2f mm", units::m_to_mm(s.joints.insertion_m));
+    row("loop", "%7.2f mm", units::m_to_mm(s.joints.loop_travel_m));
+    row("pedals", "cut %s   coag %s", (s.pedals & kPedalCut) ? "DOWN" : "up", (s.pedals & kPedalCoagulate) ? "DOWN" : "up");
+    ImGui::EndTable();
+  }
+  if (console.manual_device()) {
+    ImGui::Separator();
+    ImGui::TextDisabled("drive: W/S insert, A/D yaw, R/F pitch, Q/E roll, X/Z loop, Space cut, C coag;");
+    ImGui::TextDisabled("drag the endoscope image to steer, wheel to insert; %s",
+                        ui.gamepad_present ? ui.gamepad_name.c_str() : "no gamepad");
+    firmware::MotionState m = ui.manual.state();
+    double yaw = units::rad_to_deg(m.yaw_rad), pitch = units::rad_to_deg(m.pitch_rad), roll = units::rad_to_deg(m.roll_rad);
+    bool changed = false;
+    ImGui::SetNextItemWidth(200);
+    changed |= ImGui::DragScalar("yaw (deg)", ImGuiDataType_Double, &yaw, 0.2f);
+    ImGui::SetNextItemWidth(200);
+    changed |= ImGui::DragScalar("pitch (deg)", ImGuiDataType_Double, &pitch, 0.2f);
+    ImGui::SetNextItemWidth(200);
+    changed |= ImGui::DragScalar("roll (deg)", ImGuiDataType_Double, &roll, 0.5f);
+    ImGui::SetNextItemWidth(200);
+    changed |= ImGui::DragScalar("insertion (mm)", ImGuiDataType_Double, &m.insertion_mm, 0.2f);
+    ImGui::SetNextItemWidth(200);
+    changed |= ImGui::DragScalar("loop (mm)", ImGuiDataType_Double, &m.loop_mm, 0.1f);
+    if (changed) {
+      (void)console.set_by_key("yaw", yaw);
+      (void)console.set_by_key("pitch", pitch);
+      (void)console.set_by_key("roll", roll);
+      (void)console.set_by_key("insertion", m.insertion_mm);
+      (void)console.set_by_key("loop", m.loop_mm);
+    }
+  }
+}
+
+void draw_metrics_panel(ConsoleController& console) {
+  const LiveFrame& f = console.frame();
+  const ProcedureMetrics& m = f.snapshot.metrics;
+  if (!ImGui::BeginTable("metrics", 2, ImGuiTableFlags_SizingStretchProp)) return;
+  row("contact now", "%d points, %.2f N", f.snapshot.penetrating_points, length(f.snapshot.reaction.force_n));
+  row("contact time", "%.2f s", m.contact_time_s);
+  row("force", "peak %.2f N, mean %.2f N", m.peak_reaction_force_n, m.mean_contact_force_n);
+  row("cut pedal", "%.2f s (%.2f s in contact)", m.cut_pedal_time_s, m.cut_in_contact_time_s);
+  row("tissue moved", "up to %.2f mm", m.max_tissue_displacement_mm);
+  row("deepest insertion", "%.1f mm", m.max_insertion_mm);
+  if (m.distal_margin_mm > 1e8) {
+    row("verumontanum margin", "no cut yet");
+  } else {
+    row("verumontanum margin", "%.1f mm (%" PRIu64 " violations)", m.distal_margin_mm, m.verumontanum_violations);
+  }
+  row("faults", "%" PRIu64 " non-finite, %" PRIu64 " contact overflows", m.non_finite_steps, m.contact_overflows);
+  row("fast motion", "%" PRIu64 " ticks beyond the contact margin", m.contact_margin_exceeded_ticks);
+  row("surface", "%u triangles, topology v%" PRIu64, f.snapshot.surface_triangle_count, f.snapshot.topology_version);
+  ImGui::EndTable();
+}
+
+void draw_profiler_panel(ConsoleController& console) {
+  const CoreStatus& s = console.frame().status;
+  ConsoleUi& ui = console.ui();
+  ImGui::Text("deadlines: %" PRIu64 " missed of %" PRIu64 " ticks (%.3f%%), worst %.0f us late, %" PRIu64 " re-anchorings; core %s",
+              s.deadline_misses, s.deadline_ticks,
+              s.deadline_ticks ? 100.0 * static_cast<double>(s.deadline_misses) / static_cast<double>(s.deadline_ticks) : 0.0,
+              s.max_late_us, s.resynchronizations, console.session().realtime_priority_held() ? "SCHED_FIFO" : "normal priority");
+  ImGui::Text("frame: median %.1f ms, p99 %.1f ms   input-to-photon: median %.1f ms, p99 %.1f ms (%" PRIu64 " frames)",
+              ui.frame_ms_as_us.quantile(0.5) * 1e-3, ui.frame_ms_as_us.quantile(0.99) * 1e-3,
+              ui.input_to_photon_us.quantile(0.5) * 1e-3, ui.input_to_photon_us.quantile(0.99) * 1e-3, ui.input_to_photon_us.count());
+  // The stage plots: the worst tick of each collision step over the last ten seconds, budget in red.
+  const float plot_width = std::max(120.0f, (ImGui::GetContentRegionAvail().x - 16.0f) / 3.0f);
+  std::array<float, kStageHistoryLength> ordered{};
+  const std::size_t n = s.history_count;
+  for (int st = 0; st < kStageCount; ++st) {
+    const auto& h = s.history_us[static_cast<std::size_t>(st)];
+    const std::size_t start = n < kStageHistoryLength ? 0 : s.history_next;
+    for (std::size_t i = 0; i < n; ++i) ordered[i] = h[(start + i) % kStageHistoryLength];
+    const float budget = static_cast<float>(s.budget_us[static_cast<std::size_t>(st)]);
+    float top = budget * 1.5f;
+    for (std::size_t i = 0; i < n; ++i) top = std::max(top, ordered[i]);
+    char overlay[160];
+    std::snprintf(overlay, sizeof overlay, "%s  med %.0f p99 %.0f / %.0f us  over %" PRIu64, stage_name(static_cast<Stage>(st)),
+                  s.median_us[static_cast<std::size_t>(st)], s.p99_us[static_cast<std::size_t>(st)], budget,
+                  s.over_budget[static_cast<std::size_t>(st)]);
+    if (st % 3 != 0) ImGui::SameLine();
+    ImGui::PlotLines(("##stage" + std::to_string(st)).c_str(), ordered.data(), static_cast<int>(n), 0, overlay, 0.0f, top,
+                     ImVec2(plot_width, 70.0f));
+    const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
+    const float y = hi.y - (hi.y - lo.y) * (budget / top);
+    ImGui::GetWindowDrawList()->AddLine(ImVec2(lo.x, y), ImVec2(hi.x, y), IM_COL32(255, 70, 60, 220), 1.5f);
+  }
+  std::array<float, 240> frames{};
+  for (std::size_t i = 0; i < frames.size(); ++i) frames[i] = ui.frame_history_ms[(ui.frame_history_next + i) % frames.size()];
+  ImGui::PlotLines("##frames", frames.data(), static_cast<int>(frames.size()), 0, "console frame time (ms), last 240 frames", 0.0f,
+                   std::max(50.0f, *std::max_element(frames.begin(), frames.end())), ImVec2(ImGui::GetContentRegionAvail().x, 60.0f));
+}
+
+void draw_recording_panel(ConsoleController&) {
+  ImGui::TextDisabled("recordings not available in this build");
+  ImGui::TextWrapped("The recording format (recordings/) is not part of this build yet: there is nothing to record with.");
+}
+
+void draw_replay_panel(ConsoleController&) {
+  ImGui::TextDisabled("recordings not available in this build");
+  ImGui::BeginDisabled();
+  ImGui::Button("Open...");
+  ImGui::SameLine();
+  ImGui::Button("Play");
+  ImGui::SameLine();
+  ImGui::Button("Pause");
+  ImGui::SameLine();
+  ImGui::Button("Step");
+  ImGui::SameLine();
+  ImGui::Button("Verify");
+  float t = 0.0f;
+  ImGui::SliderFloat("timeline (s)", &t, 0.0f, 1.0f);
+  ImGui::EndDisabled();
+}
+
+}  // namespace resecto::gui

@@ -1,0 +1,18 @@
+// The console's ImGui panels: simulation control (pause, steps, speed), tissue parameters, device,
+// procedure metrics, profiler plots, recording and replay. Each reads the core's newest frame and
+// changes things only through the ConsoleController.
+#pragma once
+
+#include "console/gui/console_controller.h"
+
+namespace resecto::gui {
+
+void draw_simulation_panel(ConsoleController& console);
+void draw_parameter_panel(ConsoleController& console);
+void draw_device_panel(ConsoleController& console);
+void draw_metrics_panel(ConsoleController& console);
+void draw_profiler_panel(ConsoleController& console);
+void draw_recording_panel(ConsoleController& console);
+void draw_replay_panel(ConsoleController& console);
+
+}  // namespace resecto::gui

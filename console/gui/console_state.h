@@ -1,0 +1,73 @@
+// The console's state, in the three kinds STYLE.md keeps apart: saved settings (what a preset file
+// holds and the command line sets), per-session UI state (cameras, the sliders' values, held keys,
+// what the panels show) and the simulation's state, which the console only ever reads from the
+// core's newest LiveFrame and changes only by sending CoreControls.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "console/gui/action_script.h"
+#include "console/gui/view_cameras.h"
+#include "console/live/core_session.h"
+#include "device/input/manual_motion.h"
+#include "rtcore/base/timing_histogram.h"
+
+namespace resecto::gui {
+
+/// Saved settings: what outlives a session.
+struct ConsoleSettings {
+  TissueParameters parameters;  ///< the tissue the session starts with (a preset)
+  int window_width = 1600;
+  int window_height = 1000;
+};
+
+/// One parameter change followed from the widget (or action) to the frame that shows it.
+struct ParameterChange {
+  std::uint64_t id = 0;
+  TissueParameter parameter = TissueParameter::kStiffness;
+  double value = 0.0;
+  std::uint64_t frame_sent = 0;
+  std::int64_t stamped_tick = 0;      ///< the core's next tick when the console sent it
+  std::int64_t applied_tick = -1;     ///< the tick the core applied it at (from its status)
+  std::int64_t first_frame_shown = -1;  ///< the first frame drawn from a snapshot after that tick
+  std::uint64_t shown_snapshot_tick = 0;
+  double shown_value = 0.0;
+};
+
+/// Per-session UI state.
+struct ConsoleUi {
+  OrbitCamera orbit;
+  EndoscopeLens lens;
+  std::array<double, kTissueParameterCount> slider_values{};  ///< what the sliders show
+  std::vector<ParameterChange> changes;
+  std::uint64_t next_control_id = 1;
+  // The hand-driven device: the pose asked for, and keys held by the action script.
+  ManualMotion manual;
+  std::array<bool, 512> script_keys{};
+  bool script_cut = false, script_coagulate = false;
+  bool gamepad_present = false;
+  std::string gamepad_name;
+  // Pause, steps and slow motion as last asked (the core's status says what holds).
+  int speed_index = 0;
+  int batch_steps = 960;
+  // Presets.
+  std::string preset_path = "tissue-preset.json";
+  std::string preset_message;
+  // Frames and their timing.
+  std::uint64_t frame = 0;
+  TimingHistogram frame_ms_as_us;       ///< frame time (stored in the histogram's microsecond unit as ms * 1000)
+  TimingHistogram input_to_photon_us;   ///< device report received -> the frame that shows it, on screen
+  std::array<float, 240> frame_history_ms{};
+  std::uint32_t frame_history_next = 0;
+  std::int64_t last_counted_sample_ns = 0;
+  // Where the views were drawn last frame, window pixels (for screenshots and tests).
+  std::array<float, 4> endoscope_rect{}, outside_rect{};
+  std::vector<std::string> screenshots;
+  std::string message;  ///< the last error a person should see (bad preset file, ...)
+};
+
+}  // namespace resecto::gui

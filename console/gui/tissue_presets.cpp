@@ -1,0 +1,51 @@
+// Preset files.
+#include "console/gui/tissue_presets.h"
+
+#include <fstream>
+#include <string>
+#include <system_error>
+
+#include <nlohmann/json.hpp>
+
+namespace resecto::gui {
+
+Status save_preset(const std::filesystem::path& path, const TissueParameters& parameters) {
+  nlohmann::ordered_json preset;
+  preset["resecto_preset"] = 1;
+  for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
+    preset["parameters"][std::string(spec.key)] = parameters.get(spec.id);
+  }
+  const std::filesystem::path temporary = path.string() + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary);
+    out << preset.dump(2) << "\n";
+    if (!out.flush()) return Error{path.string() + ": cannot write the preset"};
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) return Error{path.string() + ": cannot move the preset into place: " + error.message()};
+  return Ok{};
+}
+
+Result<TissueParameters> load_preset(const std::filesystem::path& path, const TissueParameters& base) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{path.string() + ": cannot open the preset"};
+  const nlohmann::json preset = nlohmann::json::parse(in, nullptr, false);
+  if (preset.is_discarded() || !preset.is_object()) return Error{path.string() + ": not a JSON object"};
+  if (!preset.contains("resecto_preset") || preset["resecto_preset"] != 1) {
+    return Error{path.string() + ": not a Resecto preset (\"resecto_preset\": 1 is missing)"};
+  }
+  if (!preset.contains("parameters") || !preset["parameters"].is_object()) {
+    return Error{path.string() + ": \"parameters\" must be an object of key: value"};
+  }
+  TissueParameters result = base;
+  for (const auto& [key, value] : preset["parameters"].items()) {
+    const std::optional<TissueParameter> id = find_tissue_parameter(key);
+    if (!id) return Error{path.string() + ": unknown parameter '" + key + "' (see resecto params)"};
+    if (!value.is_number()) return Error{path.string() + ": parameter '" + key + "' must be a number"};
+    if (Status set = result.set(*id, value.get<double>()); !set) return Error{path.string() + ": " + set.error()};
+  }
+  return result;
+}
+
+}  // namespace resecto::gui

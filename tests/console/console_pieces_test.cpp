@@ -1,0 +1,139 @@
+// The console's parts that need no window: the action script's parser and its messages, tissue
+// presets (round trip, clear errors), and the endoscope's camera (30 degrees toward the loop, turning
+// with the sheath's roll).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include <glm/trigonometric.hpp>
+#include <glm/geometric.hpp>
+
+#include "console/gui/action_script.h"
+#include "console/gui/tissue_presets.h"
+#include "console/gui/view_cameras.h"
+#include "rtcore/kinematics/tool_kinematics.h"
+#include "tests/console/run_resecto.h"
+
+namespace resecto::gui {
+namespace {
+
+TEST(ActionScript, ParsesEveryVerbInFrameOrder) {
+  const char* text =
+      "# a tutorial\n"
+      "frame 30 quit\n"
+      "frame 5 set stiffness 120   # stiffer\n"
+      "frame 5 pedal cut on\n"
+      "frame 6 key W down\n"
+      "frame 7 drag outside 40 -10\n"
+      "frame 8 pause\nframe 9 step 16\nframe 10 resume\n"
+      "frame 11 record out.resecto\nframe 12 screenshot a.png\nframe 13 preset save p.json\n"
+      "frame 14 replay seek 2.5\n";
+  Result<std::vector<Action>> actions = parse_actions(text, "t.actions");
+  ASSERT_TRUE(actions) << actions.error();
+  ASSERT_EQ(actions->size(), 12u);
+  EXPECT_EQ((*actions)[0].frame, 5u);
+  EXPECT_EQ((*actions)[0].verb, ActionVerb::kSet);
+  EXPECT_EQ((*actions)[0].words[0], "stiffness");
+  EXPECT_EQ((*actions)[0].value, 120.0);
+  EXPECT_EQ((*actions)[1].verb, ActionVerb::kPedal);  // same frame: written order
+  EXPECT_EQ((*actions)[3].value, 40.0);
+  EXPECT_EQ((*actions)[3].value2, -10.0);
+  EXPECT_EQ((*actions)[5].value, 16.0);
+  EXPECT_EQ((*actions)[10].value, 2.5);
+  EXPECT_EQ(actions->back().verb, ActionVerb::kQuit);
+  EXPECT_EQ(actions->back().line, 2);
+}
+
+TEST(ActionScript, ErrorsNameTheLineAndTheProblem) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"frame 1 pause\nframe x quit\n", "t:2: expected 'frame N VERB"},
+      {"frame 1 jump\n", "t:1: unknown action 'jump'"},
+      {"frame 1 set stiffness soft\n", "'soft' is not a number"},
+      {"frame 1 pedal cut maybe\n", "expected on or off"},
+      {"frame 1 step 0\n", "whole number of ticks"},
+      {"frame 1 quit now\n", "takes 0 argument(s), got 1"},
+      {"frame 1 replay rewind\n", "unknown operation 'rewind'"},
+      {"frame -3 quit\n", "t:1:"},
+  };
+  for (const auto& [text, expected] : cases) {
+    Result<std::vector<Action>> parsed = parse_actions(text, "t");
+    ASSERT_FALSE(parsed) << text;
+    EXPECT_NE(parsed.error().find(expected), std::string::npos) << parsed.error();
+  }
+  EXPECT_FALSE(load_actions("/nonexistent/x.actions"));
+}
+
+TEST(TissuePresets, RoundTripAndClearErrors) {
+  const auto dir = testing::scratch_directory("presets");
+  TissueParameters tuned;
+  ASSERT_TRUE(tuned.set(TissueParameter::kStiffness, 75.0));
+  ASSERT_TRUE(tuned.set(TissueParameter::kCuttingRadius, 1.5));
+  ASSERT_TRUE(save_preset(dir / "p.json", tuned));
+  Result<TissueParameters> loaded = load_preset(dir / "p.json", TissueParameters{});
+  ASSERT_TRUE(loaded) << loaded.error();
+  EXPECT_EQ(loaded->values, tuned.values);
+
+  std::ofstream(dir / "partial.json") << R"({"resecto_preset": 1, "parameters": {"density": 1.2}})";
+  Result<TissueParameters> partial = load_preset(dir / "partial.json", tuned);
+  ASSERT_TRUE(partial);
+  EXPECT_EQ(partial->get(TissueParameter::kDensity), 1.2);
+  EXPECT_EQ(partial->get(TissueParameter::kStiffness), 75.0);
+
+  const std::pair<const char*, const char*> bad[] = {
+      {R"({"resecto_preset": 1, "parameters": {"hardness": 3}})", "unknown parameter 'hardness'"},
+      {R"({"resecto_preset": 1, "parameters": {"stiffness": 9000}})", "out of range"},
+      {R"({"resecto_preset": 1, "parameters": {"stiffness": "hard"}})", "must be a number"},
+      {R"({"parameters": {}})", "not a Resecto preset"},
+      {R"(not json)", "not a JSON object"},
+  };
+  for (const auto& [text, expected] : bad) {
+    std::ofstream(dir / "bad.json") << text;
+    Result<TissueParameters> r = load_preset(dir / "bad.json", TissueParameters{});
+    ASSERT_FALSE(r) << text;
+    EXPECT_NE(r.error().find(expected), std::string::npos) << r.error();
+    EXPECT_NE(r.error().find("bad.json"), std::string::npos) << r.error();
+  }
+}
+
+TEST(EndoscopeCamera, LooksThirtyDegreesTowardTheLoopAndRollsWithTheSheath) {
+  DeviceJoints joints;
+  joints.insertion_m = 0.168;
+  const GimbalGeometry geometry;
+  const ToolPoses straight = tool_poses(joints, geometry);
+  const EndoscopeLens lens;
+  const CameraView view = endoscope_camera(straight.sheath, lens, 1.0f);
+  const glm::vec3 axis = glm::vec3(straight.sheath.apply_vector(Vec3(0, 0, 1)));
+  const glm::vec3 loop_side = glm::vec3(straight.sheath.apply_vector(Vec3(0, -1, 0)));
+  EXPECT_NEAR(glm::degrees(std::acos(glm::dot(view.forward, axis))), 30.0, 1e-3);
+  EXPECT_GT(glm::dot(view.forward, loop_side), 0.49f) << "tilted toward the loop";
+  // The loop's wire front (tool frame: 4.5 mm below the axis, 4 mm ahead) is inside the image.
+  const Vec3 loop_front = straight.sheath.apply_point(Vec3(0.0, -0.0045, 0.004));
+  const glm::vec4 clip = view.projection * view.view * glm::vec4(glm::vec3(loop_front), 1.0f);
+  ASSERT_GT(clip.w, 0.0f);
+  EXPECT_LT(std::abs(clip.x / clip.w), 1.0f);
+  EXPECT_LT(std::abs(clip.y / clip.w), 1.0f);
+
+  joints.roll_rad = std::acos(-1.0) / 2.0;
+  const CameraView rolled = endoscope_camera(tool_poses(joints, geometry).sheath, lens, 1.0f);
+  // The image's up, seen along the sheath's axis, turns by the roll.
+  auto across = [&](glm::vec3 v) { return glm::normalize(v - glm::dot(v, axis) * axis); };
+  EXPECT_NEAR(glm::degrees(std::acos(glm::dot(across(rolled.up), across(view.up)))), 90.0, 1e-2) << "a quarter roll turns the image a quarter";
+  EXPECT_NEAR(glm::degrees(std::acos(glm::dot(rolled.forward, axis))), 30.0, 1e-3);
+}
+
+TEST(OrbitCamera, DragTurnsAndTiltsWithinLimitsAndZoomStaysBounded) {
+  OrbitCamera orbit;
+  const float yaw = orbit.yaw_deg;
+  orbit.drag(100.0f, 0.0f);
+  EXPECT_NE(orbit.yaw_deg, yaw);
+  orbit.drag(0.0f, 10000.0f);
+  EXPECT_LE(orbit.pitch_deg, 85.0f);
+  for (int i = 0; i < 100; ++i) orbit.zoom(5.0f);
+  EXPECT_GE(orbit.distance_m, 0.03f);
+  const CameraView v = orbit.view(1.5f);
+  EXPECT_NEAR(glm::length(v.eye - orbit.target), orbit.distance_m, 1e-5f);
+}
+
+}  // namespace
+}  // namespace resecto::gui

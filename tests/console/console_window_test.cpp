@@ -1,0 +1,242 @@
+// The operator console in a real window under Xvfb (Mesa's llvmpipe): it starts, renders and writes
+// a screenshot of the size asked; the endoscope shows tissue with the sheath in the urethra and its
+// image turns when the sheath rolls; a scripted `set stiffness` becomes a command the core applies at
+// its next tick, the first frame after shows it, and the state hashes differ from that tick on
+// (against the headless run of the same procedure); slow frames never hold the core back. Each test
+// skips, saying why, where no X server can be started.
+#include <gtest/gtest.h>
+#include <stb_image.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "console/headless/headless_run.h"
+#include "tests/console/run_resecto.h"
+
+namespace resecto {
+namespace {
+
+using testing::CommandOutput;
+using testing::read_text;
+using testing::scratch_directory;
+
+bool x_server_available() {
+  static const bool available = std::system("command -v xvfb-run >/dev/null 2>&1 && xvfb-run -a true >/dev/null 2>&1") == 0;
+  return available;
+}
+
+#define REQUIRE_X_SERVER() \
+  if (!x_server_available()) GTEST_SKIP() << "no X server can be started here (xvfb-run missing or failing); the console needs a window"
+
+/// `resecto ARGS` inside a fresh Xvfb with a screen larger than any window the tests open.
+CommandOutput run_in_xvfb(const std::string& arguments, const std::filesystem::path& dir) {
+  const std::string command = "xvfb-run -a -s '-screen 0 1920x1200x24' " + std::string(RESECTO_EXE) + " " + arguments + " >" +
+                              (dir / "stdout.txt").string() + " 2>" + (dir / "stderr.txt").string() + " </dev/null";
+  const int status = std::system(command.c_str());
+  CommandOutput out;
+  out.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  out.out = read_text(dir / "stdout.txt");
+  out.err = read_text(dir / "stderr.txt");
+  return out;
+}
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgb;
+  const std::uint8_t* at(int x, int y) const { return &rgb[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) * 3]; }
+};
+
+Image load_png(const std::filesystem::path& path) {
+  Image image;
+  int channels = 0;
+  std::unique_ptr<stbi_uc, void (*)(void*)> pixels(stbi_load(path.string().c_str(), &image.width, &image.height, &channels, 3), stbi_image_free);
+  if (!pixels) return image;
+  image.rgb.assign(pixels.get(), pixels.get() + static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3);
+  return image;
+}
+
+/// The endoscope's round image inside the view rectangle the report gives, 95% of its radius.
+struct Circle {
+  double cx, cy, r;
+};
+Circle endoscope_circle(const nlohmann::json& report) {
+  const auto& v = report.at("views").at("endoscope");
+  const double x = v[0], y = v[1], w = v[2], h = v[3];
+  return {x + 0.5 * w, y + 0.5 * h, 0.95 * 0.5 * std::min(w, h)};
+}
+
+template <class Visit>
+void for_each_in(const Image& image, const Circle& c, Visit visit) {
+  for (int y = static_cast<int>(c.cy - c.r); y <= static_cast<int>(c.cy + c.r); ++y)
+    for (int x = static_cast<int>(c.cx - c.r); x <= static_cast<int>(c.cx + c.r); ++x)
+      if (x >= 0 && y >= 0 && x < image.width && y < image.height && std::hypot(x - c.cx, y - c.cy) <= c.r) visit(x, y);
+}
+
+/// Pink to red, lit: what mucosa looks like through the lens (the lumen's dark depth is not).
+bool tissue_coloured(const std::uint8_t* p) { return p[0] > 50 && p[0] > 1.2 * p[1] && p[0] > 1.2 * p[2]; }
+
+nlohmann::json load_json(const std::filesystem::path& path) { return nlohmann::json::parse(read_text(path)); }
+
+/// A procedure that starts with the sheath inside the gland (so the tissue is pressed from the first
+/// tick and stiffness matters), rolls and pushes the loop out.
+std::filesystem::path write_in_gland_procedure(const std::filesystem::path& dir) {
+  const auto path = dir / "in_gland.txt";
+  std::ofstream(path) << "# time_s yaw pitch roll insertion loop cut coagulate\n"
+                         "0.0 0 0 0 168 0 0 0\n"
+                         "3.0 0 0 60 168 6 0 0\n"
+                         "6.0 0 0 -60 170 12 0 0\n";
+  return path;
+}
+
+TEST(ConsoleWindow, RendersAndWritesAScreenshotOfTheSizeAsked) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_screenshot");
+  const CommandOutput run = run_in_xvfb("console --triangles 1296 --frames 4 --width 1280 --height 800 --screenshot " +
+                                            (dir / "shot.png").string() + " --report " + (dir / "report.json").string(),
+                                        dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const Image shot = load_png(dir / "shot.png");
+  ASSERT_EQ(shot.width, 1280);
+  ASSERT_EQ(shot.height, 800);
+  // Not blank: many distinct colours and a real spread of brightness.
+  std::vector<bool> seen(1u << 15, false);
+  double sum = 0.0, sum2 = 0.0;
+  std::size_t distinct = 0;
+  for (std::size_t i = 0; i < shot.rgb.size(); i += 3) {
+    const unsigned key = (shot.rgb[i] >> 3u) << 10u | (shot.rgb[i + 1] >> 3u) << 5u | (shot.rgb[i + 2] >> 3u);
+    if (!seen[key]) {
+      seen[key] = true;
+      ++distinct;
+    }
+    sum += shot.rgb[i];
+    sum2 += static_cast<double>(shot.rgb[i]) * shot.rgb[i];
+  }
+  const double n = static_cast<double>(shot.rgb.size() / 3);
+  EXPECT_GT(distinct, 200u);
+  EXPECT_GT(std::sqrt(sum2 / n - (sum / n) * (sum / n)), 15.0);
+  const nlohmann::json report = load_json(dir / "report.json");
+  EXPECT_EQ(report.at("frames"), 4);
+  EXPECT_NE(run.out.find("input-to-photon"), std::string::npos) << run.out;
+}
+
+TEST(ConsoleWindow, EndoscopeShowsTissueAndTurnsWhenTheSheathRolls) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_roll");
+  const auto before = dir / "before.png", after = dir / "after.png";
+  std::ofstream(dir / "roll.actions") << "frame 12 screenshot " << before.string() << "\n"
+                                      << "frame 13 set roll 90\n"
+                                      << "frame 45 screenshot " << after.string() << "\n"
+                                      << "frame 46 quit\n";
+  const CommandOutput run = run_in_xvfb("console --device keyboard --triangles 1296 --actions " + (dir / "roll.actions").string() +
+                                            " --report " + (dir / "report.json").string(),
+                                        dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json report = load_json(dir / "report.json");
+  const Circle circle = endoscope_circle(report);
+  const Image a = load_png(before), b = load_png(after);
+  ASSERT_GT(a.width, 0);
+  ASSERT_EQ(a.width, b.width);
+  std::size_t pixels = 0, tissue = 0;
+  double difference = 0.0;
+  for_each_in(a, circle, [&](int x, int y) {
+    ++pixels;
+    if (tissue_coloured(a.at(x, y))) ++tissue;
+    for (int c = 0; c < 3; ++c) difference += std::abs(int(a.at(x, y)[c]) - int(b.at(x, y)[c]));
+  });
+  ASSERT_GT(pixels, 10000u);
+  EXPECT_GT(static_cast<double>(tissue) / static_cast<double>(pixels), 0.5) << "the urethra's walls fill most of the image";
+  EXPECT_GT(difference / (3.0 * static_cast<double>(pixels)), 8.0) << "rolling the sheath by 90 degrees turns the image";
+}
+
+TEST(ConsoleWindow, StiffnessActionAppliesAtTheNextTickAndTheFirstFrameAfterShowsIt) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_stiffness");
+  const auto procedure = write_in_gland_procedure(dir);
+  std::ofstream(dir / "stiff.actions") << "frame 6 set stiffness 200\n"
+                                       << "frame 40 preset save " << (dir / "preset.json").string() << "\n"
+                                       << "frame 41 quit\n";
+  const CommandOutput run = run_in_xvfb("console --lockstep --procedure " + procedure.string() + " --triangles 1296 --actions " +
+                                            (dir / "stiff.actions").string() + " --report " + (dir / "report.json").string(),
+                                        dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json report = load_json(dir / "report.json");
+  ASSERT_EQ(report.at("parameter_changes").size(), 1u);
+  const nlohmann::json& change = report.at("parameter_changes")[0];
+  EXPECT_EQ(change.at("key"), "stiffness");
+  EXPECT_EQ(change.at("frame_sent"), 6);
+  const std::int64_t stamped = change.at("stamped_tick"), applied = change.at("applied_tick");
+  // The core applies it at the first tick it runs after the command arrives: the stamped tick, or a
+  // tick or two later when the core moved on between the console's reading and its sending.
+  EXPECT_GE(applied, stamped);
+  EXPECT_LE(applied, stamped + 96);
+  const std::int64_t shown_frame = change.at("first_frame_shown");
+  EXPECT_GE(shown_frame, 6);
+  EXPECT_GT(change.at("shown_snapshot_tick").get<std::int64_t>(), applied);
+  EXPECT_EQ(change.at("shown_value"), 200.0);
+  EXPECT_NE(read_text(dir / "preset.json").find("\"stiffness\": 200"), std::string::npos);
+
+  // The same procedure headless (batch): equal hashes before the change's tick, different after.
+  const auto& hashes = report.at("collision_hashes");
+  ASSERT_GT(hashes.size(), 4u);
+  HeadlessOptions headless;
+  headless.procedure = *load_procedure(procedure);
+  headless.simulation.prostate_triangles = 1296;
+  headless.seconds = (hashes.back()[0].get<double>() + 1.0) / 960.0;
+  Result<HeadlessResult> reference = run_headless(headless);
+  ASSERT_TRUE(reference);
+  std::size_t before = 0, after = 0;
+  for (std::size_t i = 0; i < hashes.size() && i < reference->collision_hashes.size(); ++i) {
+    const std::int64_t tick = hashes[i][0];
+    const std::string hash = hashes[i][1];
+    if (tick < applied) {
+      EXPECT_EQ(hash, hex_hash(reference->collision_hashes[i])) << "tick " << tick;
+      ++before;
+    } else {
+      EXPECT_NE(hash, hex_hash(reference->collision_hashes[i])) << "tick " << tick;
+      ++after;
+    }
+  }
+  EXPECT_GT(after, 0u);
+}
+
+TEST(ConsoleWindow, SlowFramesNeverHoldTheCoreBack) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_slow");
+  const CommandOutput run = run_in_xvfb("console --triangles 1296 --frames 12 --slow-frame-ms 100 --report " + (dir / "report.json").string(), dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json report = load_json(dir / "report.json");
+  EXPECT_GE(report.at("frame_ms").at("median").get<double>(), 100.0);
+  // The core kept its 960 Hz through frames of 100 ms and more: it never waits for the console.
+  const double ticks = report.at("core").at("ticks");
+  const double wall_s = report.at("wall_s");
+  EXPECT_GT(ticks, 0.85 * 960.0 * wall_s) << run.out;
+}
+
+TEST(ConsoleWindow, RunWithoutHeadlessOpensTheConsole) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_run");
+  const CommandOutput run = run_in_xvfb("run --triangles 1296 --frames 2 --screenshot " + (dir / "run.png").string(), dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_GT(load_png(dir / "run.png").width, 0);
+}
+
+TEST(ConsoleWindow, BadActionsAndUnavailableReplayAreClearErrors) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_errors");
+  std::ofstream(dir / "bad.actions") << "frame 1 pause\nframe 2 fly away\n";
+  const CommandOutput bad = run_in_xvfb("console --triangles 1296 --actions " + (dir / "bad.actions").string(), dir);
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.err.find("bad.actions:2"), std::string::npos) << bad.err;
+  std::ofstream(dir / "range.actions") << "frame 1 set stiffness 100000\n";
+  const CommandOutput range = run_in_xvfb("console --triangles 1296 --actions " + (dir / "range.actions").string(), dir);
+  EXPECT_NE(range.exit_code, 0);
+  EXPECT_NE(range.err.find("range.actions:1"), std::string::npos) << range.err;
+  EXPECT_NE(range.err.find("out of range"), std::string::npos) << range.err;
+}
+
+}  // namespace
+}  // namespace resecto
