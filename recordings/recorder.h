@@ -62,6 +62,8 @@ class Recorder {
   Result<RecorderCounters> finish(const nlohmann::ordered_json& extra = nullptr);
   /// Lost records so far (any thread).
   std::uint64_t lost() const;
+  /// The recorder thread, for raising its priority in real-time runs.
+  std::thread::native_handle_type native_handle() { return thread_.native_handle(); }
 
  private:
   Recorder(const RecorderSettings& settings, const Simulation& sim);
