@@ -119,7 +119,7 @@ void codec_grid(benchmark::internal::Benchmark* b) {
   // Draco's sequential connectivity is shown once: it codes each vertex's bits nearly raw (10x larger).
   b->Args({14, 5, 0, 1});
   for (int bits : {11, 12, 14}) {
-    for (int speed : {0, 3, 5, 7, 10}) {
+    for (int speed : {0, 1, 2, 3, 5, 7, 10}) {
       for (int ids : {0, 1}) b->Args({bits, speed, 1, ids});
     }
   }

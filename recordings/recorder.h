@@ -1,7 +1,7 @@
 // Recorder: the recording's real-time side. The core's thread hands it one record per tick and one
 // per collision step through lock-free SPSC rings, and on keyframe steps copies the snapshot into a
 // preallocated slot; the recorder's own thread encodes (deflate, Draco) and writes chunks, flushing
-// at least twice a second. The core never waits: a full ring loses the record and counts it.
+// at least every 0.75 s. The core never waits: a full ring loses the record and counts it.
 #pragma once
 
 #include <atomic>
@@ -25,13 +25,13 @@ struct RecorderSettings {
   std::size_t tick_ring = 1u << 15;     ///< ~34 s of ticks at 960 Hz
   std::size_t step_ring = 1u << 11;     ///< ~34 s of collision steps at 60 Hz
   std::size_t command_ring = 1024;
-  int keyframe_slots = 8;               ///< snapshots waiting for the encoder
+  int keyframe_slots = 32;              ///< snapshots waiting for the encoder (a batch run outpaces it)
   int keyframe_every_steps = 6;         ///< 60 Hz collision steps / 6 = 10 Hz keyframes
   int quantisation_bits = 11;           ///< 33 um steps over the 8640 gland's 68 mm grid
   KeyframeCodecSettings codec;
-  std::uint32_t ticks_per_chunk = 480;  ///< half a second at 960 Hz
-  std::uint32_t steps_per_chunk = 30;
-  double flush_interval_s = 0.5;        ///< a killed process loses at most this (plus a chunk in the making)
+  std::uint32_t ticks_per_chunk = 720;  ///< 0.75 s at 960 Hz: longer blocks deflate better
+  std::uint32_t steps_per_chunk = 45;
+  double flush_interval_s = 0.75;       ///< a killed process loses at most this (plus a keyframe being encoded)
 };
 
 /// What was recorded and lost; `rec info` shows the same from the summary chunk.
@@ -62,6 +62,8 @@ class Recorder {
   Result<RecorderCounters> finish(const nlohmann::ordered_json& extra = nullptr);
   /// Lost records so far (any thread).
   std::uint64_t lost() const;
+  /// The recorder thread, for raising its priority in real-time runs.
+  std::thread::native_handle_type native_handle() { return thread_.native_handle(); }
 
  private:
   Recorder(const RecorderSettings& settings, const Simulation& sim);

@@ -89,7 +89,7 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
   r.keyframes_.erase(std::unique(r.keyframes_.begin(), r.keyframes_.end(), same_tick), r.keyframes_.end());
   std::stable_sort(r.commands_.begin(), r.commands_.end(), [](const ParameterCommand& a, const ParameterCommand& b) { return a.apply_tick < b.apply_tick; });
   const double tick_s = r.header_.simulation.tick_s();
-  for (KeyframeInfo& k : r.keyframes_) k.time_s = static_cast<double>(k.tick + 1) * tick_s;
+  for (KeyframeInfo& k : r.keyframes_) k.time_s = static_cast<double>(k.tick) * tick_s;
 
   const auto start = static_cast<std::uint64_t>(r.header_.start_tick);
   std::uint64_t next = start;

@@ -25,7 +25,7 @@ namespace resecto::rec {
 /// A keyframe as the index lists it.
 struct KeyframeInfo {
   std::uint64_t tick = 0;        ///< the collision tick it shows (state after that tick ran)
-  double time_s = 0.0;           ///< (tick + 1) * tick_s: simulated time of that state
+  double time_s = 0.0;           ///< tick * tick_s: the collision step's time, as the run counts it
   std::uint64_t topology_version = 0;
   bool topology_changed = false;
   bool has_node_ids = false;     ///< always, from this recorder

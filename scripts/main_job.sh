@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job of the README's first command: generate and validate the procedural models, then, where
 # there is a display (DISPLAY or WAYLAND_DISPLAY set), open the operator console on the built-in demo;
-# otherwise run the demo headless through the emulated device and print a summary of its report.
+# otherwise run the demo headless through the emulated device, recording it, print a summary of its
+# report, and replay the recording with every collision step's state hash verified.
 set -euo pipefail
 bin="$1"
 out="${RESECTO_OUT:-out}"
@@ -16,7 +17,12 @@ if [ -n "${DISPLAY:-}" ] || [ -n "${WAYLAND_DISPLAY:-}" ]; then
   echo "the console's report is in $out/console-report.json"
   exit 0
 fi
-"$bin" run --headless --procedure demo --report "$out/demo-report.json" --trace "$out/demo-trace.json"
+"$bin" run --headless --procedure demo --report "$out/demo-report.json" --trace "$out/demo-trace.json" \
+  --record "$out/demo.rsrec"
+echo
+# The recording re-simulated through the same core: every collision step's hash must match the run's.
+"$bin" replay "$out/demo.rsrec" --verify
+"$bin" rec info "$out/demo.rsrec" | sed -n '2,5p'
 echo
 # The same procedure against the clock: ten seconds at 960 Hz, every missed deadline counted.
 "$bin" run --headless --realtime --procedure demo --seconds 10 --report "$out/realtime-report.json" \
@@ -30,4 +36,4 @@ if [ -x "$floor" ]; then
   "$floor" --benchmark_filter='BM_DeadlineFloor/300/' 2>/dev/null | tail -3
 fi
 echo
-echo "models, reports and traces are in $out/ (open demo-trace.json or realtime-trace.json in https://ui.perfetto.dev)"
+echo "models, reports, traces and the recording are in $out/ (open demo-trace.json or realtime-trace.json in https://ui.perfetto.dev)"

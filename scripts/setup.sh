@@ -11,7 +11,7 @@ packages=(
   build-essential cmake pkg-config
   libglfw3-dev libglm-dev libopenmesh-dev libtet1.5-dev libhidapi-dev libdraco-dev libimgui-dev libstb-dev
   libgl-dev libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev libfcl-dev
-  xvfb xauth libgl1-mesa-dri
+  xvfb xauth libgl1-mesa-dri zlib1g-dev draco
 )
 
 missing=()

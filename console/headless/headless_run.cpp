@@ -164,11 +164,13 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   // both before any normal thread of the machine. Batch runs keep normal priority.
   std::optional<ScopedFifoPriority> core_priority;
   bool collision_raised = false;
+  bool recorder_raised = false;
   if (options.realtime) {
     core_priority.emplace(kCoreFifoPriority);
     if (core_priority->raised() && sim.collision_thread()) {
       collision_raised = raise_to_fifo(sim.collision_thread()->native_handle(), kCollisionFifoPriority);
     }
+    if (core_priority->raised() && recorder) recorder_raised = raise_to_fifo(recorder->native_handle(), kRecorderFifoPriority);
   }
   const auto wall_start = std::chrono::steady_clock::now();
   scheduler.run(0, ticks, [&](std::uint64_t tick) {
@@ -224,6 +226,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   r["collision_thread"] = config.collision_thread;
   r["scheduling"] = {{"core", core_raised ? "SCHED_FIFO " + std::to_string(kCoreFifoPriority) : std::string("normal")},
                      {"collision", collision_raised ? "SCHED_FIFO " + std::to_string(kCollisionFifoPriority) : std::string("normal")}};
+  if (recorder) r["scheduling"]["recorder"] = recorder_raised ? "SCHED_FIFO " + std::to_string(kRecorderFifoPriority) : std::string("normal");
   r["model"] = {{"surface_triangles", sim.prostate().surface.triangle_count()},
                 {"tetrahedra", sim.tetrahedron_count()},
                 {"nodes", sim.tissue().node_count()}};

@@ -15,6 +15,9 @@ namespace resecto {
 /// core first, the collision thread (which has a whole collision period) next.
 inline constexpr int kCoreFifoPriority = 45;
 inline constexpr int kCollisionFifoPriority = 40;
+/// The recorder thread (recordings/): below both, above every normal thread, so a loaded machine
+/// cannot starve the recording of a real-time run (it needs ~5% of a core).
+inline constexpr int kRecorderFifoPriority = 30;
 
 /// Puts `thread` under SCHED_FIFO at `priority` (1..99); false (nothing changed) if not permitted.
 bool raise_to_fifo(pthread_t thread, int priority);

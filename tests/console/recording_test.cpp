@@ -1,0 +1,213 @@
+// End to end through the command line: `run --record` in batch and real time, `replay --verify`,
+// `rec info/verify/recover/export`, an altered input found at its tick, a killed real-time run
+// recovered, and Draco's own decoder reading an exported keyframe.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "recordings/recording_writer.h"
+#include "recordings/replay.h"
+#include "rtcore/mesh/mesh_io.h"
+#include "tests/console/run_resecto.h"
+
+namespace resecto {
+namespace {
+
+using testing::run_resecto;
+using testing::scratch_directory;
+
+nlohmann::json json_of(const testing::CommandOutput& out) { return nlohmann::json::parse(out.out); }
+
+/// Records a short 1296-triangle demo; returns the run's report.
+nlohmann::json record(const std::filesystem::path& file, const std::string& extra) {
+  const testing::CommandOutput run =
+      run_resecto("run --headless --procedure demo --triangles 1296 --json --record " + file.string() + " " + extra);
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  return json_of(run);
+}
+
+TEST(RecordingCommands, BatchRecordingReplaysWithEveryHashVerified) {
+  const auto dir = scratch_directory("recording_batch");
+  const auto file = dir / "demo.rsrec";
+  const nlohmann::json report = record(file, "--seconds 2");
+  EXPECT_EQ(report["recording"]["lost"]["ticks"], 0);
+  EXPECT_EQ(report["recording"]["lost"]["keyframes"], 0);
+  const testing::CommandOutput replay = run_resecto("replay " + file.string() + " --verify --json");
+  ASSERT_EQ(replay.exit_code, 0) << replay.err;
+  const nlohmann::json r = json_of(replay);
+  EXPECT_EQ(r["ticks"], report["ticks"]);
+  EXPECT_EQ(r["verified_hashes"], report["collision_steps"]);
+  EXPECT_EQ(r["mismatches"], 0);
+  EXPECT_EQ(r["state_hash"], report["state_hash"]);
+
+  const testing::CommandOutput info = run_resecto("rec info " + file.string() + " --json");
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  const nlohmann::json i = json_of(info);
+  for (const char* key : {"duration_s", "ticks", "chunks", "keyframes", "bytes", "damaged_chunks", "index_present"}) EXPECT_TRUE(i.contains(key)) << key;
+  EXPECT_EQ(i["ticks"], report["ticks"]);
+  EXPECT_DOUBLE_EQ(i["duration_s"].get<double>(), 2.0);
+  EXPECT_EQ(i["keyframes"], 20);  // 10 Hz
+  EXPECT_EQ(i["damaged_chunks"], 0);
+  EXPECT_EQ(i["index_present"], true);
+  EXPECT_EQ(run_resecto("rec verify " + file.string()).exit_code, 0);
+}
+
+TEST(RecordingCommands, RealTimeRecordingReplaysToTheRunsHash) {
+  const auto dir = scratch_directory("recording_realtime");
+  const auto file = dir / "realtime.rsrec";
+  const nlohmann::json report = record(file, "--seconds 2 --realtime");
+  const testing::CommandOutput replay = run_resecto("replay " + file.string() + " --verify --json");
+  ASSERT_EQ(replay.exit_code, 0) << replay.err;
+  const nlohmann::json r = json_of(replay);
+  EXPECT_EQ(r["ticks"], report["ticks"]);
+  EXPECT_EQ(r["verified_hashes"], report["collision_steps"]);
+  EXPECT_EQ(r["state_hash"], report["state_hash"]);
+}
+
+TEST(RecordingCommands, AnInputAlteredAtOneTickIsReportedAtThatTick) {
+  const auto dir = scratch_directory("recording_altered");
+  const auto file = dir / "demo.rsrec";
+  record(file, "--seconds 1.5");
+  Result<rec::Recording> original = rec::Recording::open(file);
+  ASSERT_TRUE(original);
+  // Rewrite the file with one joint of tick 960 (a collision tick, in contact) nudged by 1 um.
+  const std::uint64_t altered_tick = 960;
+  rec::RecordingWriter writer;
+  const auto altered = dir / "altered.rsrec";
+  ASSERT_TRUE(writer.open(altered));
+  for (const rec::ChunkLocation& chunk : original->chunks()) {
+    if (chunk.type == static_cast<std::uint16_t>(rec::ChunkType::kIndex)) continue;
+    std::vector<std::uint8_t> payload(original->payload(chunk).begin(), original->payload(chunk).end());
+    if (chunk.type == static_cast<std::uint16_t>(rec::ChunkType::kTicks)) {
+      auto ticks = rec::decode_tick_block(payload);
+      ASSERT_TRUE(ticks);
+      for (rec::TickRecord& t : *ticks) {
+        if (t.tick == altered_tick) t.input.joints.insertion_m += 1e-6;
+      }
+      rec::encode_tick_block(*ticks, payload);
+    }
+    writer.add_chunk(static_cast<rec::ChunkType>(chunk.type), payload);
+  }
+  ASSERT_TRUE(writer.close());
+  const testing::CommandOutput replay = run_resecto("replay " + altered.string() + " --verify --json");
+  EXPECT_NE(replay.exit_code, 0);
+  EXPECT_EQ(json_of(replay)["first_mismatch_tick"], altered_tick);
+  EXPECT_NE(replay.err.find("first at tick 960"), std::string::npos) << replay.err;
+  // The unaltered file still verifies.
+  EXPECT_EQ(run_resecto("replay " + file.string() + " --verify").exit_code, 0);
+}
+
+TEST(RecordingCommands, VerifyNamesADamagedChunkAndRecoverRepairsIt) {
+  const auto dir = scratch_directory("recording_damaged");
+  const auto file = dir / "demo.rsrec";
+  record(file, "--seconds 1");
+  Result<rec::Recording> r = rec::Recording::open(file);
+  ASSERT_TRUE(r);
+  const rec::ChunkLocation victim = r->chunks()[5];
+  std::vector<std::uint8_t> bytes(r->bytes().begin(), r->bytes().end());
+  bytes[victim.payload_offset() + victim.payload_bytes / 2] ^= 0x04;
+  const auto damaged = dir / "damaged.rsrec";
+  std::ofstream(damaged, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  const testing::CommandOutput verify = run_resecto("rec verify " + damaged.string());
+  EXPECT_NE(verify.exit_code, 0);
+  EXPECT_NE(verify.err.find("at byte " + std::to_string(victim.offset)), std::string::npos) << verify.err;
+  const nlohmann::json info = json_of(run_resecto("rec info " + damaged.string() + " --json"));
+  EXPECT_EQ(info["damaged_chunks"], 1);
+  const auto recovered = dir / "recovered.rsrec";
+  ASSERT_EQ(run_resecto("rec recover " + damaged.string() + " " + recovered.string()).exit_code, 0);
+  EXPECT_EQ(run_resecto("rec verify " + recovered.string()).exit_code, 0);
+  // A lost ticks chunk ends the replay there; what precedes it still verifies.
+  const testing::CommandOutput replay = run_resecto("replay " + recovered.string() + " --verify --json");
+  EXPECT_EQ(replay.exit_code, 0) << replay.err;
+  EXPECT_EQ(json_of(replay)["mismatches"], 0);
+}
+
+TEST(RecordingCommands, ExportsKeyframesAndInputsThatOtherProgramsRead) {
+  const auto dir = scratch_directory("recording_export");
+  const auto file = dir / "demo.rsrec";
+  record(file, "--seconds 1");
+  for (const char* extension : {".drc", ".ply", ".obj", ".off", ".stl"}) {
+    const auto out = dir / (std::string("k5") + extension);
+    const testing::CommandOutput exported = run_resecto("rec export " + file.string() + " --keyframe 5 -o " + out.string());
+    ASSERT_EQ(exported.exit_code, 0) << exported.err;
+    EXPECT_GT(std::filesystem::file_size(out), 1000u) << extension;
+  }
+  EXPECT_EQ(run_resecto("rec export " + file.string() + " --time 0.55 -o " + (dir / "t.off").string()).exit_code, 0);
+  EXPECT_EQ(testing::read_text(dir / "t.off"), testing::read_text(dir / "k5.off"));  // keyframe 5 is at 0.5 s
+  EXPECT_NE(run_resecto("rec export " + file.string() + " --keyframe 999 -o " + (dir / "x.off").string()).exit_code, 0);
+  ASSERT_EQ(run_resecto("rec export " + file.string() + " --inputs -o " + (dir / "inputs.csv").string()).exit_code, 0);
+  const std::string csv = testing::read_text(dir / "inputs.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 961);  // header + 960 ticks
+
+  // Draco's own decoder reads the .drc: same vertex count, positions within the quantisation step of
+  // the surface the replayed core had at that tick.
+  if (std::system("command -v draco_decoder > /dev/null 2>&1") != 0) GTEST_SKIP() << "draco_decoder (Debian package draco) not installed";
+  const auto decoded = dir / "k5_draco.ply";
+  ASSERT_EQ(std::system(("draco_decoder -i " + (dir / "k5.drc").string() + " -o " + decoded.string() + " > /dev/null").c_str()), 0);
+  Result<TriangleMesh> mesh = read_surface_mesh(decoded, 1.0);
+  ASSERT_TRUE(mesh) << mesh.error();
+  Result<rec::Recording> r = rec::Recording::open(file);
+  ASSERT_TRUE(r);
+  const rec::KeyframeInfo& k = r->keyframes()[5];
+  ASSERT_EQ(mesh->positions.size(), k.vertex_count);
+  EXPECT_EQ(mesh->triangles.size(), k.triangle_count);
+  Result<rec::SurfaceFrame> ours = r->decode_keyframe(5);  // the same vertex order, with node ids
+  ASSERT_TRUE(ours);
+  auto replayer = rec::Replayer::create(*r);
+  ASSERT_TRUE(replayer);
+  (*replayer)->run_to(k.tick + 1);
+  const SimulationSnapshot truth = (*replayer)->simulation().make_snapshot();
+  const double step = r->header().grid.step_m();
+  double worst = 0.0;
+  for (std::size_t v = 0; v < mesh->positions.size(); ++v) {
+    const Vec3 d = mesh->positions[v] - truth.node_positions[ours->node_ids[v]];
+    worst = std::max({worst, std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+  }
+  std::printf("draco_decoder: %zu vertices, worst deviation %.2f um, quantisation step %.2f um\n", mesh->positions.size(), worst * 1e6, step * 1e6);
+  EXPECT_LE(worst, step) << "quantisation step " << step;
+}
+
+TEST(RecordingCommands, AKilledRealTimeRecordingRecoversAtLeastFourOfFiveSeconds) {
+  const auto dir = scratch_directory("recording_killed");
+  const auto file = dir / "killed.rsrec";
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::freopen("/dev/null", "w", stdout);
+    ::execl(RESECTO_EXE, RESECTO_EXE, "run", "--headless", "--realtime", "--procedure", "demo", "--seconds", "60", "--record", file.c_str(),
+            static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  // The recording starts when the model is built and the recorder has written its header.
+  for (int i = 0; i < 600 && !(std::filesystem::exists(file) && std::filesystem::file_size(file) > 100); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  std::this_thread::sleep_for(std::chrono::seconds(5));
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status));
+  const nlohmann::json info = json_of(run_resecto("rec info " + file.string() + " --json"));
+  EXPECT_EQ(info["index_present"], false);
+  const auto recovered = dir / "recovered.rsrec";
+  ASSERT_EQ(run_resecto("rec recover " + file.string() + " " + recovered.string()).exit_code, 0);
+  EXPECT_EQ(run_resecto("rec verify " + recovered.string()).exit_code, 0);
+  const testing::CommandOutput replay = run_resecto("replay " + recovered.string() + " --verify --json");
+  ASSERT_EQ(replay.exit_code, 0) << replay.err;
+  const nlohmann::json r = json_of(replay);
+  std::printf("killed after 5 s: %.2f s replayable, %d hashes verified\n", r["simulated_s"].get<double>(), r["verified_hashes"].get<int>());
+  EXPECT_GE(r["simulated_s"].get<double>(), 4.0);
+  EXPECT_EQ(r["mismatches"], 0);
+  EXPECT_GT(r["verified_hashes"].get<int>(), 4 * 60 - 1);
+}
+
+}  // namespace
+}  // namespace resecto
