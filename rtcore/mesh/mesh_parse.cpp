@@ -72,7 +72,11 @@ std::vector<std::string_view> split_words(std::string_view line, bool hash_comme
 }
 
 std::string quoted(std::string_view word) {
-  return "'" + std::string(word.substr(0, 24)) + (word.size() > 24 ? "...'" : "'");
+  // Appended, not `"'" + std::string(...)`: GCC 12 at -O3 warns falsely (-Wrestrict) on that form.
+  std::string text = "'";
+  text.append(word.substr(0, 24));
+  text += word.size() > 24 ? "...'" : "'";
+  return text;
 }
 
 /// A whole word as an integer; nullopt when it is not one (or does not fit 64 bits).

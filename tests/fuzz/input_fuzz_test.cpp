@@ -3,7 +3,7 @@
 // must give a value that keeps the reader's promises or one error line naming the source; a crash,
 // an out-of-bounds access or undefined behaviour is caught by the sanitizers (CI runs this suite
 // under the asan preset), an oversized allocation by the address-space cap set below.
-// RESECTO_FUZZ_INPUTS=100000 runs the full campaign; the everyday suite runs 3000 per target.
+// RESECTO_FUZZ_INPUTS=100000 runs the full campaign; the everyday suite runs 10,000 per target.
 #include <gtest/gtest.h>
 
 #include <sys/resource.h>
@@ -35,7 +35,7 @@
 namespace resecto::fuzz {
 namespace {
 
-constexpr std::size_t kEverydayInputs = 3000;
+constexpr std::size_t kEverydayInputs = 10000;
 
 /// Without a sanitizer, an allocation a header talked the reader into fails at 2 GiB of address
 /// space instead of exhausting the machine (ASan reserves terabytes, so it keeps its own checks).
