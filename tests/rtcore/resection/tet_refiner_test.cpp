@@ -462,6 +462,33 @@ TEST(TetRefiner, RandomMarksOverRepeatedRoundsStayConforming) {
   }
 }
 
+TEST(TetRefiner, RefiningWhileCuttingOnTheGland) {
+  // Resection's rhythm on the 1296 gland: each round some live slots die (cut away), then a random
+  // cluster around a random live slot is refined; every plan checked and applied, 12 rounds.
+  PlainMesh m = from_tet_mesh(tissue_model(1296).mesh);
+  m.manifold_boundary = false;  // cutting single slots can leave tissue touching along an edge
+  TetRefiner refiner(m.rest.size(), m.tets.size());
+  std::mt19937 rng(2026);
+  for (int round = 0; round < 12; ++round) {
+    SCOPED_TRACE(::testing::Message() << "round " << round);
+    std::vector<std::uint32_t> live;
+    for (std::uint32_t s = 0; s < m.tets.size(); ++s) {
+      if (m.alive[s]) live.push_back(s);
+    }
+    auto any_live = [&] { return live[std::uniform_int_distribution<std::size_t>(0, live.size() - 1)(rng)]; };
+    for (int k = 0; k < 15; ++k) m.alive[any_live()] = 0;
+    live.erase(std::remove_if(live.begin(), live.end(), [&](std::uint32_t s) { return !m.alive[s]; }), live.end());
+    const Tetrahedron& centre = m.tets[any_live()];
+    std::vector<std::uint32_t> marked = slots_near(m, (m.rest[centre[0]] + m.rest[centre[1]] + m.rest[centre[2]] + m.rest[centre[3]]) * 0.25,
+                                                   std::uniform_int_distribution<std::size_t>(1, 30)(rng));
+    marked.push_back(static_cast<std::uint32_t>(m.tets.size()));  // out of range: ignored
+    const std::size_t nodes_before = m.rest.size();
+    const RefinementEdit& edit = refine_and_check(refiner, m, marked);
+    EXPECT_EQ(edit.first_new_node, nodes_before);
+    if (::testing::Test::HasFailure()) return;
+  }
+}
+
 TEST(TetRefiner, FlatMeshStaysLocal) {
   // The TetGen box squashed to a twelfth of its height: every tetrahedron is flat, no green closure
   // passes the dihedral floor, and quality upgrades are capped per mark, so red stays near the marks
