@@ -288,6 +288,14 @@ PlainMesh tetgen_box() {
   return m;
 }
 
+std::vector<std::uint32_t> live_slots(const PlainMesh& m) {
+  std::vector<std::uint32_t> live;
+  for (std::uint32_t s = 0; s < m.tets.size(); ++s) {
+    if (m.alive[s]) live.push_back(s);
+  }
+  return live;
+}
+
 /// The `count` live slots whose centroids lie nearest `point`, ascending by distance then slot.
 std::vector<std::uint32_t> slots_near(const PlainMesh& m, const Vec3& point, std::size_t count) {
   std::vector<std::pair<double, std::uint32_t>> by_distance;
@@ -451,10 +459,7 @@ TEST(TetRefiner, RandomMarksOverRepeatedRoundsStayConforming) {
   std::mt19937 rng(13);
   for (int round = 0; round < 5; ++round) {
     SCOPED_TRACE(::testing::Message() << "round " << round);
-    std::vector<std::uint32_t> live;
-    for (std::uint32_t s = 0; s < m.tets.size(); ++s) {
-      if (m.alive[s]) live.push_back(s);
-    }
+    const std::vector<std::uint32_t> live = live_slots(m);
     std::vector<std::uint32_t> marked;
     for (int k = 0; k < 6; ++k) marked.push_back(live[std::uniform_int_distribution<std::size_t>(0, live.size() - 1)(rng)]);
     refine_and_check(refiner, m, marked);
@@ -471,10 +476,7 @@ TEST(TetRefiner, RefiningWhileCuttingOnTheGland) {
   std::mt19937 rng(2026);
   for (int round = 0; round < 12; ++round) {
     SCOPED_TRACE(::testing::Message() << "round " << round);
-    std::vector<std::uint32_t> live;
-    for (std::uint32_t s = 0; s < m.tets.size(); ++s) {
-      if (m.alive[s]) live.push_back(s);
-    }
+    std::vector<std::uint32_t> live = live_slots(m);
     auto any_live = [&] { return live[std::uniform_int_distribution<std::size_t>(0, live.size() - 1)(rng)]; };
     for (int k = 0; k < 15; ++k) m.alive[any_live()] = 0;
     live.erase(std::remove_if(live.begin(), live.end(), [&](std::uint32_t s) { return !m.alive[s]; }), live.end());
