@@ -374,14 +374,30 @@ TEST(TetRefiner, EveryTetrahedronOfBothCubesAsTheMarkedOne) {
 }
 
 TEST(TetRefiner, OppositeSplitEdgesUpgradeToRed) {
-  // In the cube of five, refining two corner tetrahedra splits two faces of the central one, five of
-  // its edges (0-3 and 5-6 among them, opposite): no green pattern closes that, so it goes red.
-  PlainMesh m = cube_of_five();
+  // The middle tetrahedron (a, b, c, d) shares only edge a-b with one marked tetrahedron and only
+  // the opposite edge c-d with another: no green pattern closes two opposite edges, so it goes red.
+  PlainMesh m = make_mesh({{0, 0, 0},
+                           {0.001, 0, 0},
+                           {0.0005, 0.0008, 0},
+                           {0.0005, 0.0003, 0.0008},
+                           {0.0005, -0.0008, 0},
+                           {0.0005, -0.0003, -0.0008},
+                           {0.0005, 0.0016, 0.0008},
+                           {0.0012, 0.0012, 0.0006}},
+                          {{0, 1, 2, 3}, {0, 1, 4, 5}, {2, 3, 6, 7}});
+  m.manifold_boundary = false;  // they touch along edges only
   TetRefiner refiner(64, 64);
-  const std::uint32_t marked[] = {1, 4};  // {1, 0, 3, 5} holds 0-3; {4, 0, 5, 6} holds 5-6
+  const std::uint32_t marked[] = {1, 2};
   const RefinementEdit& edit = refine_and_check(refiner, m, marked);
-  EXPECT_EQ(edit.removed_tetrahedra.size(), 5u);
-  EXPECT_GE(edit.red_tetrahedra, 3);
+  EXPECT_EQ(edit.removed_tetrahedra, (std::vector<std::uint32_t>{0, 1, 2}));
+  EXPECT_EQ(edit.red_tetrahedra, 3);
+  EXPECT_EQ(edit.closure_tetrahedra, 0);
+
+  // In the cube of five, two marked corners split five edges of the central one: red again.
+  PlainMesh cube = cube_of_five();
+  const std::uint32_t corners[] = {1, 4};
+  const RefinementEdit& cube_edit = refine_and_check(refiner, cube, corners);
+  EXPECT_EQ(std::count(cube_edit.added_parent.begin(), cube_edit.added_parent.end(), 0u), 8);
 }
 
 TEST(TetRefiner, FlatNeighboursGoRedAndTheClosureReachesFarNodes) {
