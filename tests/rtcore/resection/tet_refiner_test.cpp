@@ -288,6 +288,14 @@ PlainMesh tetgen_box() {
   return m;
 }
 
+std::vector<std::uint32_t> live_slots(const PlainMesh& m) {
+  std::vector<std::uint32_t> live;
+  for (std::uint32_t s = 0; s < m.tets.size(); ++s) {
+    if (m.alive[s]) live.push_back(s);
+  }
+  return live;
+}
+
 /// The `count` live slots whose centroids lie nearest `point`, ascending by distance then slot.
 std::vector<std::uint32_t> slots_near(const PlainMesh& m, const Vec3& point, std::size_t count) {
   std::vector<std::pair<double, std::uint32_t>> by_distance;
@@ -366,14 +374,30 @@ TEST(TetRefiner, EveryTetrahedronOfBothCubesAsTheMarkedOne) {
 }
 
 TEST(TetRefiner, OppositeSplitEdgesUpgradeToRed) {
-  // In the cube of five, refining two corner tetrahedra splits two faces of the central one, five of
-  // its edges (0-3 and 5-6 among them, opposite): no green pattern closes that, so it goes red.
-  PlainMesh m = cube_of_five();
+  // The middle tetrahedron (a, b, c, d) shares only edge a-b with one marked tetrahedron and only
+  // the opposite edge c-d with another: no green pattern closes two opposite edges, so it goes red.
+  PlainMesh m = make_mesh({{0, 0, 0},
+                           {0.001, 0, 0},
+                           {0.0005, 0.0008, 0},
+                           {0.0005, 0.0003, 0.0008},
+                           {0.0005, -0.0008, 0},
+                           {0.0005, -0.0003, -0.0008},
+                           {0.0005, 0.0016, 0.0008},
+                           {0.0012, 0.0012, 0.0006}},
+                          {{0, 1, 2, 3}, {0, 1, 4, 5}, {2, 3, 6, 7}});
+  m.manifold_boundary = false;  // they touch along edges only
   TetRefiner refiner(64, 64);
-  const std::uint32_t marked[] = {1, 4};  // {1, 0, 3, 5} holds 0-3; {4, 0, 5, 6} holds 5-6
+  const std::uint32_t marked[] = {1, 2};
   const RefinementEdit& edit = refine_and_check(refiner, m, marked);
-  EXPECT_EQ(edit.removed_tetrahedra.size(), 5u);
-  EXPECT_GE(edit.red_tetrahedra, 3);
+  EXPECT_EQ(edit.removed_tetrahedra, (std::vector<std::uint32_t>{0, 1, 2}));
+  EXPECT_EQ(edit.red_tetrahedra, 3);
+  EXPECT_EQ(edit.closure_tetrahedra, 0);
+
+  // In the cube of five, two marked corners split five edges of the central one: red again.
+  PlainMesh cube = cube_of_five();
+  const std::uint32_t corners[] = {1, 4};
+  const RefinementEdit& cube_edit = refine_and_check(refiner, cube, corners);
+  EXPECT_EQ(std::count(cube_edit.added_parent.begin(), cube_edit.added_parent.end(), 0u), 8);
 }
 
 TEST(TetRefiner, FlatNeighboursGoRedAndTheClosureReachesFarNodes) {
@@ -451,13 +475,34 @@ TEST(TetRefiner, RandomMarksOverRepeatedRoundsStayConforming) {
   std::mt19937 rng(13);
   for (int round = 0; round < 5; ++round) {
     SCOPED_TRACE(::testing::Message() << "round " << round);
-    std::vector<std::uint32_t> live;
-    for (std::uint32_t s = 0; s < m.tets.size(); ++s) {
-      if (m.alive[s]) live.push_back(s);
-    }
+    const std::vector<std::uint32_t> live = live_slots(m);
     std::vector<std::uint32_t> marked;
     for (int k = 0; k < 6; ++k) marked.push_back(live[std::uniform_int_distribution<std::size_t>(0, live.size() - 1)(rng)]);
     refine_and_check(refiner, m, marked);
+    if (::testing::Test::HasFailure()) return;
+  }
+}
+
+TEST(TetRefiner, RefiningWhileCuttingOnTheGland) {
+  // Resection's rhythm on the 1296 gland: each round some live slots die (cut away), then a random
+  // cluster around a random live slot is refined; every plan checked and applied, 12 rounds.
+  PlainMesh m = from_tet_mesh(tissue_model(1296).mesh);
+  m.manifold_boundary = false;  // cutting single slots can leave tissue touching along an edge
+  TetRefiner refiner(m.rest.size(), m.tets.size());
+  std::mt19937 rng(2026);
+  for (int round = 0; round < 12; ++round) {
+    SCOPED_TRACE(::testing::Message() << "round " << round);
+    std::vector<std::uint32_t> live = live_slots(m);
+    auto any_live = [&] { return live[std::uniform_int_distribution<std::size_t>(0, live.size() - 1)(rng)]; };
+    for (int k = 0; k < 15; ++k) m.alive[any_live()] = 0;
+    live.erase(std::remove_if(live.begin(), live.end(), [&](std::uint32_t s) { return !m.alive[s]; }), live.end());
+    const Tetrahedron& centre = m.tets[any_live()];
+    std::vector<std::uint32_t> marked = slots_near(m, (m.rest[centre[0]] + m.rest[centre[1]] + m.rest[centre[2]] + m.rest[centre[3]]) * 0.25,
+                                                   std::uniform_int_distribution<std::size_t>(1, 30)(rng));
+    marked.push_back(static_cast<std::uint32_t>(m.tets.size()));  // out of range: ignored
+    const std::size_t nodes_before = m.rest.size();
+    const RefinementEdit& edit = refine_and_check(refiner, m, marked);
+    EXPECT_EQ(edit.first_new_node, nodes_before);
     if (::testing::Test::HasFailure()) return;
   }
 }
