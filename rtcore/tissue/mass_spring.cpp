@@ -59,6 +59,7 @@ MassSpringTissue::MassSpringTissue(OrderedMesh&& ordered_mesh, const TissueParam
   }
   tool_.set_clearance_skipping(config_.clearance_certificates);
   surface_ = boundary_surface(mesh);
+  surface_tree_.set_slabs(false);  // its one query is the contact's, on spheres (ToolContacts)
   surface_tree_.build(surface_);
   topology_hash_ = topology_hash();
   update_material();
