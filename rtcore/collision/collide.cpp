@@ -235,7 +235,7 @@ bool Collider::begin_query(const SphereTree& tissue_tree, const SphereTree& tool
       defect = std::max(defect, std::abs(rtr - (i == j ? 1.0 : 0.0)));
     }
   }
-  slabs_ = slabs_wanted_ && defect <= 1e-12;
+  slabs_ = slabs_wanted_ && tissue_tree.has_slabs() && tool_tree.has_slabs() && defect <= 1e-12;
   slab_slack_ = 4.0 * slack_ + 4.0 * defect * magnitude;
   if (slabs_) {
     const std::vector<Slab>& rest_slabs = tool_tree.slabs();

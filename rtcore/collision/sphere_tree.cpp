@@ -202,7 +202,7 @@ void SphereTree::add_triangle_leaves(const TriangleMesh& mesh, std::uint32_t t, 
     const std::int32_t leaf = allocate_node();
     pieces_[leaf] = {t, static_cast<std::uint16_t>(s), static_cast<std::uint16_t>(slices), apex};
     spheres_[leaf] = piece_sphere(mesh, pieces_[leaf]);
-    slabs_[leaf] = triangle_slab(mesh, t, spheres_[leaf]);
+    if (slabs_kept_) slabs_[leaf] = triangle_slab(mesh, t, spheres_[leaf]);
     next_leaf_[leaf] = first_leaf_[t];
     first_leaf_[t] = leaf;
     ++leaf_count_;
@@ -228,6 +228,7 @@ void SphereTree::rebuild(const TriangleMesh& mesh) {
 
 void SphereTree::build_over(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles) {
   ++structure_version_;
+  slabs_kept_ = slabs_wanted_;
   spheres_.clear();
   slabs_.clear();
   leans_.clear();
@@ -381,6 +382,7 @@ void SphereTree::cover_leaves(std::int32_t node, const std::int32_t* first, cons
   const Sphere direct = inflated(center, radius);
   const Sphere merged = merge(spheres_[links_[node].left], spheres_[links_[node].right]);
   spheres_[node] = direct.radius < merged.radius ? direct : merged;
+  if (!slabs_kept_) return;
   // The slab likewise from the leaves' triangles directly, along their area-weighted mean normal:
   // exact at the build, where merging the children's slabs (as refit does) widens it at every level.
   Vec3 normal{0.0};
@@ -427,8 +429,10 @@ void SphereTree::set_child_leans(std::int32_t node) {
 void SphereTree::refit_node(std::int32_t node) {
   const SphereTreeLinks& l = links_[node];
   spheres_[node] = merge(spheres_[l.left], spheres_[l.right]);
-  slabs_[node] = merge_slabs(spheres_[l.left], slabs_[l.left], spheres_[l.right], slabs_[l.right]);
-  set_child_leans(node);
+  if (slabs_kept_) {
+    slabs_[node] = merge_slabs(spheres_[l.left], slabs_[l.left], spheres_[l.right], slabs_[l.right]);
+    set_child_leans(node);
+  }
   links_[node].height = 1 + std::max(links_[l.left].height, links_[l.right].height);
 }
 
@@ -475,6 +479,7 @@ void SphereTree::refit_leaf(const TriangleMesh& mesh, std::int32_t leaf) {
   const Vec3& c = mesh.positions[tri[2]];
   const Sphere sphere = piece.slices == 1 ? centroid_sphere(a, b, c) : piece_sphere(mesh, piece);
   spheres_[leaf] = sphere;
+  if (!slabs_kept_) return;
   // The triangle's plane (triangle_slab, with the pad taken from the sphere: every corner is within
   // |centre| + radius of the origin).
   const Vec3 n = cross(b - a, c - a);
@@ -497,6 +502,7 @@ void SphereTree::refit_leaf(const TriangleMesh& mesh, std::int32_t leaf) {
 void SphereTree::refit_internal(const TriangleMesh& mesh, std::int32_t node) {
   const SphereTreeLinks& l = links_[node];
   spheres_[node] = merge(spheres_[l.left], spheres_[l.right]);
+  if (!slabs_kept_) return;
   const Vec3 axis = slabs_[node].normal;
   double lo = INFINITY;
   double hi = -INFINITY;

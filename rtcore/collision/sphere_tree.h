@@ -100,6 +100,14 @@ class SphereTree {
   void set_slice_aspect(double aspect) { slice_aspect_ = aspect < 0.25 ? 0.25 : aspect; }
   double slice_aspect() const { return slice_aspect_; }
 
+  /// Whether the tree keeps a slab beside every sphere (the default). Off, build, refit, insert and
+  /// remove skip them (a refit costs about half) and queries use the spheres alone: for a tree
+  /// whose queries need the spheres' semantics anyway (the contact's margin search). Takes effect
+  /// at the next build.
+  void set_slabs(bool enabled) { slabs_wanted_ = enabled; }
+  /// Whether slabs() holds current slabs (set_slabs(true) at the last build).
+  bool has_slabs() const { return slabs_kept_; }
+
   /// Builds top-down over every triangle of `mesh`, splitting at the middle of the principal
   /// component of the leaf centres (median split when one side would be empty).
   void build(const TriangleMesh& mesh);
@@ -193,6 +201,8 @@ class SphereTree {
   std::int32_t live_nodes_ = 0;
   const TriangleMesh* build_mesh_ = nullptr;  // the mesh of the build under way
   bool order_dirty_ = true;
+  bool slabs_wanted_ = true;
+  bool slabs_kept_ = false;
   bool preorder_ = false;  // every child's index is above its parent's: refit sweeps the array backwards
   std::uint64_t structure_version_ = 0;
   double slice_aspect_ = kSliceAspect;

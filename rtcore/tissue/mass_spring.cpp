@@ -74,6 +74,7 @@ MassSpringTissue::MassSpringTissue(OrderedMesh&& ordered_mesh, const TissueParam
   }
   tool_.set_clearance_skipping(config_.clearance_certificates);
   surface_ = boundary_surface(mesh);
+  surface_tree_.set_slabs(false);  // its one query is the contact's, on spheres (ToolContacts)
   surface_tree_.build(surface_);
   reserve_topology(topology_.node_capacity(), topology_.tetrahedron_capacity());
   map_initial_surface();

@@ -170,6 +170,9 @@ int ToolContacts::add_part(const TriangleMesh& mesh) {
   }
   part.tree.build(part.inflated);
   part.collider.set_pairs_wanted(false);  // the response reads only the leaf lists
+  // Spheres alone: a tissue triangle lying inside the margin's shell, parallel to it, meets no shell
+  // triangle, and the slabs would drop it; the spheres keep it a candidate.
+  part.collider.set_slabs(false);
   parts_.push_back(std::move(part));
   std::size_t max_triangles = 0;
   for (const Part& p : parts_) max_triangles = std::max(max_triangles, p.mesh.triangle_count());

@@ -2,6 +2,7 @@
 // against brute force on the same files), and one-line errors naming the poses line or the face.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -88,6 +89,52 @@ TEST(CollideCommand, PairsCsvEqualsBruteForceOnTheSameFiles) {
   EXPECT_EQ(report["pairs"], total);
   EXPECT_GE(report["build_ms"].get<double>(), 0.0);
   EXPECT_LE(report["query_us"]["median"].get<double>(), report["query_us"]["p95"].get<double>());
+}
+
+// --sequence on consecutive frames (the tool advancing 0.2 mm a frame along the channel, pressed
+// into the wall, turning slowly): the same pairs CSV as independent queries, and brute force's.
+TEST(CollideCommand, SequenceGivesThePairsOfIndependentQueries) {
+  Files f = make_files("collide_sequence");
+  f.poses = f.dir / "frames.txt";
+  std::vector<RigidTransform> frames;
+  {
+    std::ofstream out(f.poses);
+    out.precision(17);
+    for (int k = 0; k < 40; ++k) {
+      const double a = 0.01 * k;
+      RigidTransform pose;
+      pose.rotation[0][0] = std::cos(a), pose.rotation[0][1] = -std::sin(a);
+      pose.rotation[1][0] = std::sin(a), pose.rotation[1][1] = std::cos(a);
+      pose.translation = Vec3{1.6, 0.3, 15.0 + 0.2 * k};
+      frames.push_back(pose);
+      for (int i = 0; i < 3; ++i) {
+        out << pose.rotation[i][0] << ' ' << pose.rotation[i][1] << ' ' << pose.rotation[i][2] << ' ' << pose.translation[i]
+            << (i == 2 ? '\n' : ' ');
+      }
+    }
+  }
+  const auto independent = f.dir / "independent.csv";
+  const auto sequence = f.dir / "sequence.csv";
+  ASSERT_EQ(run_resecto(common_args(f) + " --pairs " + independent.string()).exit_code, 0);
+  const auto run = run_resecto(common_args(f) + " --sequence --repeat 2 --json --pairs " + sequence.string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(nlohmann::json::parse(run.out)["sequence"], true);
+  EXPECT_EQ(read_text(sequence), read_text(independent));
+
+  const auto tissue = read_surface_mesh(f.tissue, 1.0);
+  const auto tool = read_surface_mesh(f.tool, 1.0);
+  ASSERT_TRUE(tissue.ok() && tool.ok());
+  std::ostringstream expected;
+  expected << "pose,tissue_face,tool_face\n";
+  std::size_t total = 0;
+  for (std::size_t p = 0; p < frames.size(); ++p) {
+    for (const TrianglePair& pair : collide_brute_force(*tissue, *tool, frames[p])) {
+      expected << p << ',' << pair.tissue << ',' << pair.tool << '\n';
+      ++total;
+    }
+  }
+  EXPECT_GT(total, 100u) << "the frames must press into the wall";
+  EXPECT_EQ(read_text(sequence), expected.str());
 }
 
 TEST(CollideCommand, MalformedPosesLineIsNamed) {

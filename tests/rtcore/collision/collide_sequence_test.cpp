@@ -150,3 +150,39 @@ TEST(CollideSequence, SlabsChangeTheWorkNotThePairs) {
 
 }  // namespace
 }  // namespace resecto
+
+namespace resecto {
+namespace {
+
+// A tree built without slabs (the contact's surface tree) refits and answers on its spheres alone:
+// the same pairs as brute force, fresh and in a sequence, after deformation.
+TEST(CollideSequence, TreesWithoutSlabsUseTheSpheres) {
+  ProstateModel gland = generate_prostate(1296);
+  TriangleMesh& surface = gland.surface;
+  const TriangleMesh tool = combined_resectoscope_mesh(generate_resectoscope());
+  SphereTree tissue_tree, tool_tree;
+  tissue_tree.set_slabs(false);
+  tissue_tree.build(surface);
+  tool_tree.build(tool);
+  EXPECT_FALSE(tissue_tree.has_slabs());
+  EXPECT_TRUE(tool_tree.has_slabs());
+  const std::vector<Vec3> rest = surface.positions;
+  Collider fresh, sequence;
+  for (int f = 0; f < 40; ++f) {
+    for (std::size_t v = 0; v < rest.size(); ++v) {
+      const Vec3& p = rest[v];
+      surface.positions[v] = p + 0.0004 * std::sin(0.2 * f) * Vec3(std::sin(150 * p.z), std::cos(120 * p.x), 0.0);
+    }
+    tissue_tree.refit(surface);
+    const RigidTransform pose = sweep_pose(f, 0.9);
+    const auto expected = collide_brute_force(surface, tool, pose);
+    ASSERT_TRUE(fresh.collide(tissue_tree, surface, tool_tree, tool, pose));
+    ASSERT_TRUE(sequence.collide_sequence(tissue_tree, surface, tool_tree, tool, pose, 0.0004 * f));
+    ASSERT_EQ(pairs_of(fresh), expected) << "frame " << f;
+    ASSERT_EQ(pairs_of(sequence), expected) << "frame " << f;
+  }
+  testing::expect_tree_invariants(tissue_tree);
+}
+
+}  // namespace
+}  // namespace resecto
