@@ -38,6 +38,15 @@ void row(const char* label, const char* format, Args... args) {
   ImGui::Text(format, args...);
 }
 
+/// Resection's figures, where this build's metrics carry them (a template so the panel compiles
+/// before and after resection joins the core).
+template <class Metrics>
+void resection_rows(const Metrics& m) {
+  if constexpr (requires { m.resected_total_g; m.resected_adenoma_g; m.resected_capsule_g; }) {
+    row("resected", "%.2f g (adenoma %.2f g, capsule %.2f g)", m.resected_total_g, m.resected_adenoma_g, m.resected_capsule_g);
+  }
+}
+
 }  // namespace
 
 void draw_simulation_panel(ConsoleController& console) {
@@ -181,6 +190,7 @@ void draw_metrics_panel(ConsoleController& console) {
   } else {
     row("verumontanum margin", "%.1f mm (%" PRIu64 " violations)", m.distal_margin_mm, m.verumontanum_violations);
   }
+  resection_rows(m);
   row("faults", "%" PRIu64 " non-finite, %" PRIu64 " contact overflows", m.non_finite_steps, m.contact_overflows);
   row("fast motion", "%" PRIu64 " ticks beyond the contact margin", m.contact_margin_exceeded_ticks);
   row("surface", "%u triangles, topology v%" PRIu64, f.snapshot.surface_triangle_count, f.snapshot.topology_version);
