@@ -16,11 +16,9 @@
 #include <cinttypes>
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <system_error>
 #include <thread>
 
+#include "console/gui/atomic_file.h"
 #include "console/gui/console_controller.h"
 #include "console/gui/console_panels.h"
 #include "console/gui/scene_renderer.h"
@@ -524,15 +522,7 @@ Result<ordered_json> run_console(const ConsoleOptions& options) {
   glfwDestroyWindow(window);
   if (!ran) return Error{ran.error()};
   if (!options.report_path.empty()) {
-    const std::string temporary = options.report_path + ".tmp";
-    {
-      std::ofstream out(temporary, std::ios::binary);
-      out << report.dump(2) << "\n";
-      if (!out.flush()) return Error{options.report_path + ": cannot write the report"};
-    }
-    std::error_code error;
-    std::filesystem::rename(temporary, options.report_path, error);
-    if (error) return Error{options.report_path + ": cannot move the report into place: " + error.message()};
+    if (Status written = write_text_atomically(options.report_path, report.dump(2) + "\n", "report"); !written) return Error{written.error()};
   }
   return report;
 }
