@@ -29,6 +29,13 @@ for tri in 8640 34560; do
   printf '%-9s %-26s %8s %8s %8s %8s %9s %9s %8.3f\n' "$tri" "headless --realtime" - - - - "$(field "$h" 'r["deadlines"]["ticks"]')" \
     "$(field "$h" 'r["deadlines"]["misses"]')" "$(field "$h" '100*r["deadlines"]["miss_fraction"]')"
 done
+# Frame pacing: every frame made 100 ms slower on purpose; the core's misses should not move.
+xvfb-run -a -s '-screen 0 1920x1200x24' "$bin" console --device emulator --procedure demo --triangles 8640 --frames 40 \
+  --slow-frame-ms 100 --report "$out/slow.json" >/dev/null
+r="$out/slow.json"
+printf '%-9s %-26s %8s %8.1f %8.1f %8.1f %9s %9s %8.3f\n' 8640 "console, frames +100 ms" "$(field "$r" 'r["frames"]')" \
+  "$(field "$r" 'r["frame_ms"]["median"]')" "$(field "$r" 'r["frame_ms"]["p99"]')" "$(field "$r" 'r["input_to_photon_ms"]["median"]')" \
+  "$(field "$r" 'r["core"]["ticks"]')" "$(field "$r" 'r["core"]["deadline_misses"]')" "$(field "$r" '100*r["core"]["miss_fraction"]')"
 if [ -x "$floor" ]; then
   echo "the machine's floor (same schedule, each tick 300 us of busy waiting, 10 s):"
   "$floor" --benchmark_filter='BM_DeadlineFloor/300/' 2>/dev/null | tail -2

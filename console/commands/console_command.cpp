@@ -30,7 +30,8 @@ void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_r
       ->check(CLI::IsMember({"emulator", "keyboard", "hid"}))
       ->capture_default_str();
   cmd.add_option("--preset", o.preset, "Tissue parameter preset (JSON) to start from");
-  cmd.add_option("--replay", o.replay, "Open this recording in the replay panel");
+  cmd.add_option("--replay", o.replay, "Open this recording in the replay panel and show it in the views");
+  if (!shared_with_run) cmd.add_option("--record", o.record, "Record the session from its first tick to this file (replayable and verifiable)");
   cmd.add_option("--actions", o.actions, "Scripted UI actions, one 'frame N VERB ...' per line (README, \"Operator console\")");
   CLI::Option* frames = cmd.add_option("--frames", o.frames, "Quit after this many frames")->check(CLI::Range(1, 100000000));
   cmd.add_option("--screenshot", o.screenshot, "Write a PNG of the whole window after the last of --frames")->needs(frames);
@@ -50,7 +51,6 @@ void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_r
 }
 
 void open_console(const ConsoleCliOptions& o) {
-  if (!o.replay.empty()) throw std::runtime_error("--replay " + o.replay + ": recordings not available in this build");
   if (!gui::display_available()) {
     throw std::runtime_error("no display (neither DISPLAY nor WAYLAND_DISPLAY is set): run the console under X or Wayland, "
                              "or use `resecto run --headless`");
@@ -87,6 +87,8 @@ void open_console(const ConsoleCliOptions& o) {
   options.screenshot_path = o.screenshot;
   options.frames = o.frames;
   options.report_path = o.report;
+  options.record_path = o.record;
+  options.replay_path = o.replay;
   options.slow_frame_ms = o.slow_frame_ms;
   options.vsync = !o.no_vsync;
   options.view_scale = o.view_scale;

@@ -18,6 +18,7 @@ struct ConsoleCliOptions {
   int triangles = 8640;
   std::string preset;
   std::string replay;
+  std::string record;
   std::string actions;
   std::string screenshot;
   std::uint64_t frames = 0;

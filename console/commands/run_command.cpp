@@ -54,6 +54,7 @@ void run(const RunOptions& o) {
     console.seed = o.seed;
     console.calibration = o.calibration;
     console.report = o.report;
+    console.record = o.record;
     open_console(console);
     return;
   }

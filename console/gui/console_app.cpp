@@ -16,11 +16,9 @@
 #include <cinttypes>
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <system_error>
 #include <thread>
 
+#include "console/gui/atomic_file.h"
 #include "console/gui/console_controller.h"
 #include "console/gui/console_panels.h"
 #include "console/gui/scene_renderer.h"
@@ -56,6 +54,7 @@ class ConsoleWindow {
       : window_(window), options_(options), session_(session), renderer_(renderer), settings_(options.settings),
         controller_(session, ui_, settings_), actions_(std::move(actions)) {
     ui_.manual = ManualMotion(options.core.device.manual_start);
+    if (!options.record_path.empty()) controller_.start_recording(options.record_path);
     for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
       ui_.slider_values[static_cast<std::size_t>(spec.id)] = settings_.parameters.get(spec.id);
     }
@@ -63,11 +62,15 @@ class ConsoleWindow {
 
   /// Runs frames until the window closes, a quit action, or --frames; an error from a bad action.
   Status run();
+  /// Opens --replay's recording before the first frame.
+  Status open_initial_replay() { return options_.replay_path.empty() ? Status(Ok{}) : controller_.open_replay(options_.replay_path); }
   ConsoleUi& ui() { return ui_; }
 
  private:
   Status apply_action(const Action& action);
   void read_manual_input(double dt_s);
+  /// Chooses what the views show and brings its renderer up to date.
+  Status choose_shown(bool fresh_live_frame);
   void layout_and_draw();
   void draw_endoscope_window(const ImVec2& pos, const ImVec2& size);
   void draw_outside_window(const ImVec2& pos, const ImVec2& size);
@@ -83,6 +86,11 @@ class ConsoleWindow {
   std::vector<Action> actions_;
   std::size_t next_action_ = 0;
   RenderTarget endoscope_target_, outside_target_;
+  // What the views show this frame: the live core's snapshot, or the replay's.
+  const SimulationSnapshot* shown_ = nullptr;
+  SceneRenderer* scene_ = nullptr;
+  std::unique_ptr<SceneRenderer> replay_renderer_;
+  std::string replay_renderer_path_;
   std::vector<std::string> screenshots_due_;
   bool quit_ = false;
   bool have_frame_ = false;
@@ -117,7 +125,19 @@ Status ConsoleWindow::apply_action(const Action& a) {
     case ActionVerb::kResume: controller_.resume(); break;
     case ActionVerb::kStep: controller_.step(static_cast<std::uint32_t>(a.value)); break;
     case ActionVerb::kRecord:
-    case ActionVerb::kReplay: return fail("recordings not available in this build");
+      if (a.words[0] == "stop") {
+        controller_.stop_recording();
+      } else {
+        controller_.start_recording(a.words[0]);
+      }
+      break;
+    case ActionVerb::kReplay:
+      if (a.words[0] == "open") {
+        if (Status opened = controller_.open_replay(a.words[1]); !opened) return fail(opened.error());
+      } else if (Status done = controller_.replay_operation(a.words[0], a.value); !done) {
+        return fail(done.error());
+      }
+      break;
     case ActionVerb::kScreenshot: screenshots_due_.push_back(a.words[0]); break;
     case ActionVerb::kPreset:
       if (Status done = a.words[0] == "save" ? controller_.save_preset(a.words[1]) : controller_.load_preset(a.words[1]); !done) {
@@ -167,8 +187,8 @@ void ConsoleWindow::draw_endoscope_window(const ImVec2& pos, const ImVec2& size)
   const int w = std::max(16, static_cast<int>(avail.x)), h = std::max(16, static_cast<int>(avail.y));
   endoscope_target_.resize(scaled(w), scaled(h), 0);
   const LiveFrame& f = controller_.frame();
-  const CameraView camera = endoscope_camera(f.snapshot.tool.sheath, ui_.lens, static_cast<float>(w) / static_cast<float>(h));
-  renderer_.draw_endoscope(endoscope_target_, camera);
+  const CameraView camera = endoscope_camera(shown_->tool.sheath, ui_.lens, static_cast<float>(w) / static_cast<float>(h));
+  scene_->draw_endoscope(endoscope_target_, camera);
   const ImVec2 origin = ImGui::GetCursorScreenPos();
   ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(endoscope_target_.texture())), ImVec2(float(w), float(h)),
                ImVec2(0, 1), ImVec2(1, 0));
@@ -182,11 +202,19 @@ void ConsoleWindow::draw_endoscope_window(const ImVec2& pos, const ImVec2& size)
   }
   ImDrawList* draw = ImGui::GetWindowDrawList();
   char text[160];
-  std::snprintf(text, sizeof text, "roll %+.0f deg  insertion %.1f mm  loop %.1f mm", units::rad_to_deg(f.status.joints.roll_rad),
-                units::m_to_mm(f.status.joints.insertion_m), units::m_to_mm(f.status.joints.loop_travel_m));
-  draw->AddText(ImVec2(origin.x + 8, origin.y + 6), IM_COL32(230, 230, 230, 255), text);
-  if (f.status.pedals & kPedalCut) draw->AddText(ImVec2(origin.x + 8, origin.y + 24), IM_COL32(255, 200, 40, 255), "CUT");
-  if (f.status.pedals & kPedalCoagulate) draw->AddText(ImVec2(origin.x + 48, origin.y + 24), IM_COL32(80, 160, 255, 255), "COAG");
+  if (shown_ != &f.snapshot) {
+    // The replay's pose, as the recording has it (the live core keeps running behind it).
+    const Vec3 tip = shown_->tool.sheath.translation;
+    std::snprintf(text, sizeof text, "REPLAY %.2f s (keyframe %zu)   sheath tip %.1f %.1f %.1f mm", ui_.replay.time_s(),
+                  ui_.replay.keyframe_shown().value_or(0) + 1, units::m_to_mm(tip.x), units::m_to_mm(tip.y), units::m_to_mm(tip.z));
+    draw->AddText(ImVec2(origin.x + 8, origin.y + 6), IM_COL32(120, 220, 255, 255), text);
+  } else {
+    std::snprintf(text, sizeof text, "roll %+.0f deg  insertion %.1f mm  loop %.1f mm", units::rad_to_deg(f.status.joints.roll_rad),
+                  units::m_to_mm(f.status.joints.insertion_m), units::m_to_mm(f.status.joints.loop_travel_m));
+    draw->AddText(ImVec2(origin.x + 8, origin.y + 6), IM_COL32(230, 230, 230, 255), text);
+    if (f.status.pedals & kPedalCut) draw->AddText(ImVec2(origin.x + 8, origin.y + 24), IM_COL32(255, 200, 40, 255), "CUT");
+    if (f.status.pedals & kPedalCoagulate) draw->AddText(ImVec2(origin.x + 48, origin.y + 24), IM_COL32(80, 160, 255, 255), "COAG");
+  }
   if (f.status.paused) draw->AddText(ImVec2(origin.x + 8, origin.y + float(h) - 22), IM_COL32(255, 255, 255, 255), "PAUSED");
   ImGui::End();
   ImGui::PopStyleVar();
@@ -202,7 +230,7 @@ void ConsoleWindow::draw_outside_window(const ImVec2& pos, const ImVec2& size) {
   const int w = std::max(16, static_cast<int>(avail.x)), h = std::max(16, static_cast<int>(avail.y));
   outside_target_.resize(scaled(w), scaled(h), 0);
   const CameraView camera = ui_.orbit.view(static_cast<float>(w) / static_cast<float>(h));
-  renderer_.draw_outside(outside_target_, camera);
+  scene_->draw_outside(outside_target_, camera);
   const ImVec2 origin = ImGui::GetCursorScreenPos();
   ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(outside_target_.texture())), ImVec2(float(w), float(h)),
                ImVec2(0, 1), ImVec2(1, 0));
@@ -213,7 +241,7 @@ void ConsoleWindow::draw_outside_window(const ImVec2& pos, const ImVec2& size) {
     if (io.MouseWheel != 0.0f) ui_.orbit.zoom(io.MouseWheel);
   }
   ImDrawList* draw = ImGui::GetWindowDrawList();
-  for (const Landmark& l : renderer_.landmarks()) {
+  for (const Landmark& l : scene_->landmarks()) {
     const ProjectedPoint p = SceneRenderer::project(camera, l.position, float(w), float(h));
     if (!p.visible) continue;
     draw->AddText(ImVec2(origin.x + p.x + 8, origin.y + p.y - 7), IM_COL32(255, 255, 255, 230), l.name.c_str());
@@ -246,6 +274,27 @@ void ConsoleWindow::layout_and_draw() {
   ImGui::End();
 }
 
+Status ConsoleWindow::choose_shown(bool fresh_live_frame) {
+  const LiveFrame& f = controller_.frame();
+  if (ui_.show_replay && ui_.replay.is_open()) {
+    if (!replay_renderer_ || replay_renderer_path_ != ui_.replay.path()) {
+      Result<std::unique_ptr<SceneRenderer>> created = SceneRenderer::create(ui_.replay.prostate());
+      if (!created) return Error{created.error()};
+      replay_renderer_ = std::move(*created);
+      replay_renderer_path_ = ui_.replay.path();
+    }
+    const SimulationSnapshot& replayed = ui_.replay.snapshot();
+    replay_renderer_->update(replayed, false);
+    shown_ = &replayed;
+    scene_ = replay_renderer_.get();
+    return Ok{};
+  }
+  if (fresh_live_frame || scene_ != &renderer_) renderer_.update(f.snapshot, (f.status.pedals & kPedalCut) != 0);
+  shown_ = &f.snapshot;
+  scene_ = &renderer_;
+  return Ok{};
+}
+
 Status ConsoleWindow::run() {
   std::int64_t last_frame_ns = now_ns();
   Status failure = Ok{};
@@ -262,9 +311,11 @@ Status ConsoleWindow::run() {
     const bool fresh = controller_.refresh() || !have_frame_;
     have_frame_ = true;
     const LiveFrame& f = controller_.frame();
-    if (fresh) {
-      renderer_.update(f.snapshot, (f.status.pedals & kPedalCut) != 0);
-      controller_.track_changes();
+    if (fresh) controller_.track_changes();
+    ui_.replay.advance(dt_s);
+    if (Status chosen = choose_shown(fresh); !chosen) {
+      failure = chosen;
+      quit_ = true;
     }
 
     ImGui_ImplOpenGL3_NewFrame();
@@ -317,7 +368,7 @@ Status ConsoleWindow::run() {
   return failure;
 }
 
-ordered_json make_report(CoreSession& session, const ConsoleUi& ui, double wall_s, int width, int height) {
+ordered_json make_report(CoreSession& session, ConsoleUi& ui, double wall_s, int width, int height) {
   ordered_json r;
   r["frames"] = ui.frame;
   r["wall_s"] = wall_s;
@@ -367,6 +418,21 @@ ordered_json make_report(CoreSession& session, const ConsoleUi& ui, double wall_
   }
   r["parameter_changes"] = changes;
   r["screenshots"] = ui.screenshots;
+  const CoreStatus& status = session.frames().read_slot().status;
+  r["recording"] = {{"active", status.recording}, {"path", std::string(status.recording_path.data())},
+                    {"finished", status.recordings_finished}, {"bytes", status.recorded_bytes}, {"ticks", status.recorded_ticks},
+                    {"keyframes", status.recorded_keyframes}, {"lost", status.recording_lost},
+                    {"message", std::string(status.recording_message.data())}};
+  if (ui.replay.is_open()) {
+    ordered_json replay = {{"path", ui.replay.path()}, {"time_s", ui.replay.time_s()}, {"step_tick", ui.replay.step_tick_shown()}};
+    if (ui.replay.keyframe_shown()) replay["keyframe"] = *ui.replay.keyframe_shown();
+    const RigidPose& sheath = ui.replay.shown_tool().sheath;
+    replay["sheath_tip_m"] = {sheath.translation.x, sheath.translation.y, sheath.translation.z};
+    if (const ReplayVerification* v = ui.replay.verification()) {
+      replay["verification"] = {{"error", v->error}, {"ticks", v->ticks}, {"verified", v->verified}, {"mismatches", v->mismatches}};
+    }
+    r["replay"] = replay;
+  }
   ordered_json hashes = ordered_json::array();
   for (const auto& [tick, hash] : session.collision_hashes()) hashes.push_back({tick, hex_hash(hash)});
   r["collision_hashes"] = hashes;
@@ -439,8 +505,11 @@ Result<ordered_json> run_console(const ConsoleOptions& options) {
   ordered_json report;
   {
     ConsoleWindow console(window, resolved, session, **renderer, std::move(actions));
-    ran = console.run();
+    ran = console.open_initial_replay();
+    if (ran) ran = console.run();
     session.stop();
+    session.frames().update();  // the core's last frame: the recording's final figures
+    console.ui().replay.wait_for_verification();
     int w = 0, h = 0;
     glfwGetFramebufferSize(window, &w, &h);
     report = make_report(session, console.ui(), std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count(), w, h);
@@ -453,15 +522,7 @@ Result<ordered_json> run_console(const ConsoleOptions& options) {
   glfwDestroyWindow(window);
   if (!ran) return Error{ran.error()};
   if (!options.report_path.empty()) {
-    const std::string temporary = options.report_path + ".tmp";
-    {
-      std::ofstream out(temporary, std::ios::binary);
-      out << report.dump(2) << "\n";
-      if (!out.flush()) return Error{options.report_path + ": cannot write the report"};
-    }
-    std::error_code error;
-    std::filesystem::rename(temporary, options.report_path, error);
-    if (error) return Error{options.report_path + ": cannot move the report into place: " + error.message()};
+    if (Status written = write_text_atomically(options.report_path, report.dump(2) + "\n", "report"); !written) return Error{written.error()};
   }
   return report;
 }

@@ -22,6 +22,8 @@ struct ConsoleOptions {
   std::string screenshot_path;  ///< --screenshot: written after frame `frames`
   std::uint64_t frames = 0;     ///< --frames: quit after this many frames (0: run until closed)
   std::string report_path;      ///< --report: the session's JSON report
+  std::string record_path;      ///< --record: record the session from its first tick
+  std::string replay_path;      ///< --replay: open this recording in the replay panel
   double slow_frame_ms = 0.0;   ///< every frame takes this much longer (tests of frame pacing)
   bool vsync = true;
   /// The views' resolution relative to their panels (drawn smaller and scaled up when below 1);

@@ -69,10 +69,46 @@ Status ConsoleController::set_by_key(const std::string& key, double value) {
   return Ok{};
 }
 
-void ConsoleController::pause() { send({CoreControlKind::kPause, {}, 0, 0, 1.0}); }
-void ConsoleController::resume() { send({CoreControlKind::kResume, {}, 0, 0, 1.0}); }
-void ConsoleController::step(std::uint32_t ticks) { send({CoreControlKind::kStep, {}, 0, ticks, 1.0}); }
-void ConsoleController::set_speed(double speed) { send({CoreControlKind::kSpeed, {}, 0, 0, speed}); }
+void ConsoleController::start_recording(const std::string& path) {
+  CoreControl control;
+  control.kind = CoreControlKind::kRecordStart;
+  control.path = path;
+  if (send(control)) ui_.recording_started_ns = FrameProfiler::now_ns();
+}
+
+void ConsoleController::stop_recording() { send({CoreControlKind::kRecordStop, {}, 0, 0, 1.0, {}}); }
+
+Status ConsoleController::open_replay(const std::string& path) {
+  if (Status opened = ui_.replay.open(path); !opened) {
+    ui_.replay_message = opened.error();
+    return opened;
+  }
+  ui_.replay_path = path;
+  ui_.show_replay = true;
+  ui_.replay_message = "opened " + path;
+  return Ok{};
+}
+
+Status ConsoleController::replay_operation(const std::string& op, double argument) {
+  ReplayBrowser& r = ui_.replay;
+  if (!r.is_open()) return Error{"replay " + op + ": no recording is open (replay open FILE first)"};
+  ui_.show_replay = true;
+  if (op == "play") r.play();
+  else if (op == "pause") r.pause();
+  else if (op == "step") r.step();
+  else if (op == "seek") r.seek(argument);
+  else if (op == "speed") {
+    if (!(argument > 0.0 && argument <= 16.0)) return Error{"replay speed " + std::to_string(argument) + " is outside (0, 16]"};
+    r.set_speed(argument);
+  } else if (op == "verify") r.start_verification();
+  else return Error{"replay: unknown operation '" + op + "'"};
+  return Ok{};
+}
+
+void ConsoleController::pause() { send({CoreControlKind::kPause, {}, 0, 0, 1.0, {}}); }
+void ConsoleController::resume() { send({CoreControlKind::kResume, {}, 0, 0, 1.0, {}}); }
+void ConsoleController::step(std::uint32_t ticks) { send({CoreControlKind::kStep, {}, 0, ticks, 1.0, {}}); }
+void ConsoleController::set_speed(double speed) { send({CoreControlKind::kSpeed, {}, 0, 0, speed, {}}); }
 
 Status ConsoleController::save_preset(const std::string& path) {
   Status saved = gui::save_preset(path, frame().status.parameters);

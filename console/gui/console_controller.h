@@ -35,6 +35,13 @@ class ConsoleController {
   /// Moves the hand-driven device's yaw and pitch as a mouse drag across the endoscope image would.
   void drag_endoscope(float dx_pixels, float dy_pixels);
   bool manual_device() const;
+  /// Starts recording the live session to `path` (the core creates the file at its next tick).
+  void start_recording(const std::string& path);
+  void stop_recording();
+  /// Opens a recording in the replay panel and shows it in the views.
+  Status open_replay(const std::string& path);
+  /// `replay OP [ARG]` as the action script writes it: play, pause, step, seek S, speed X, verify.
+  Status replay_operation(const std::string& op, double argument);
 
   /// Follows queued parameter changes to the frame that shows them (call once per new frame).
   void track_changes();

@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <cinttypes>
 #include <cstdio>
+#include <filesystem>
 #include <string>
+#include <system_error>
 
 #include "rtcore/base/units.h"
 
@@ -34,6 +36,15 @@ void row(const char* label, const char* format, Args... args) {
   ImGui::TextUnformatted(label);
   ImGui::TableSetColumnIndex(1);
   ImGui::Text(format, args...);
+}
+
+/// Resection's figures, where this build's metrics carry them (a template so the panel compiles
+/// before and after resection joins the core).
+template <class Metrics>
+void resection_rows(const Metrics& m) {
+  if constexpr (requires { m.resected_total_g; m.resected_adenoma_g; m.resected_capsule_g; }) {
+    row("resected", "%.2f g (adenoma %.2f g, capsule %.2f g)", m.resected_total_g, m.resected_adenoma_g, m.resected_capsule_g);
+  }
 }
 
 }  // namespace
@@ -179,6 +190,7 @@ void draw_metrics_panel(ConsoleController& console) {
   } else {
     row("verumontanum margin", "%.1f mm (%" PRIu64 " violations)", m.distal_margin_mm, m.verumontanum_violations);
   }
+  resection_rows(m);
   row("faults", "%" PRIu64 " non-finite, %" PRIu64 " contact overflows", m.non_finite_steps, m.contact_overflows);
   row("fast motion", "%" PRIu64 " ticks beyond the contact margin", m.contact_margin_exceeded_ticks);
   row("surface", "%u triangles, topology v%" PRIu64, f.snapshot.surface_triangle_count, f.snapshot.topology_version);
@@ -223,26 +235,92 @@ void draw_profiler_panel(ConsoleController& console) {
                    std::max(50.0f, *std::max_element(frames.begin(), frames.end())), ImVec2(ImGui::GetContentRegionAvail().x, 60.0f));
 }
 
-void draw_recording_panel(ConsoleController&) {
-  ImGui::TextDisabled("recordings not available in this build");
-  ImGui::TextWrapped("The recording format (recordings/) is not part of this build yet: there is nothing to record with.");
+void draw_recording_panel(ConsoleController& console) {
+  const CoreStatus& s = console.frame().status;
+  ConsoleUi& ui = console.ui();
+  if (s.recording) {
+    // The file grows as the recorder thread flushes (twice a second); its size is the disk's word.
+    std::error_code error;
+    const auto bytes = std::filesystem::file_size(s.recording_path.data(), error);
+    if (!error) ui.recording_bytes_seen = bytes;
+    const double seconds = static_cast<double>(FrameProfiler::now_ns() - ui.recording_started_ns) * 1e-9;
+    const double simulated_s = static_cast<double>(s.next_tick - s.recording_start_tick) * console.session().simulation().config().tick_s();
+    ImGui::TextColored(ImVec4(1.0f, 0.3f, 0.3f, 1.0f), "REC");
+    ImGui::SameLine();
+    ImGui::Text("%s", s.recording_path.data());
+    ImGui::Text("%.2f MB, %.0f kB/s, %.1f s simulated since tick %" PRIu64 ", %" PRIu64 " records lost",
+                static_cast<double>(ui.recording_bytes_seen) / 1e6, seconds > 0 ? static_cast<double>(ui.recording_bytes_seen) / seconds / 1e3 : 0.0,
+                simulated_s, s.recording_start_tick, s.recording_lost);
+    if (ImGui::Button("Stop recording")) console.stop_recording();
+  } else {
+    char path[512];
+    std::snprintf(path, sizeof path, "%s", ui.record_path.c_str());
+    ImGui::SetNextItemWidth(260);
+    if (ImGui::InputText("file##record", path, sizeof path)) ui.record_path = path;
+    ImGui::SameLine();
+    if (ImGui::Button("Record")) console.start_recording(ui.record_path);
+    if (s.recordings_finished > 0) {
+      ImGui::TextDisabled("last: %s, %.2f MB, %" PRIu64 " ticks, %" PRIu64 " keyframes, %" PRIu64 " lost", s.recording_path.data(),
+                          static_cast<double>(s.recorded_bytes) / 1e6, s.recorded_ticks, s.recorded_keyframes, s.recording_lost);
+    }
+  }
+  if (s.recording_message[0] != '\0') ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.3f, 1.0f), "%s", s.recording_message.data());
 }
 
-void draw_replay_panel(ConsoleController&) {
-  ImGui::TextDisabled("recordings not available in this build");
-  ImGui::BeginDisabled();
-  ImGui::Button("Open...");
+void draw_replay_panel(ConsoleController& console) {
+  ConsoleUi& ui = console.ui();
+  ReplayBrowser& replay = ui.replay;
+  char path[512];
+  std::snprintf(path, sizeof path, "%s", ui.replay_path.c_str());
+  ImGui::SetNextItemWidth(260);
+  if (ImGui::InputText("file##replay", path, sizeof path)) ui.replay_path = path;
   ImGui::SameLine();
-  ImGui::Button("Play");
+  if (ImGui::Button("Open")) (void)console.open_replay(ui.replay_path);
+  if (!ui.replay_message.empty()) ImGui::TextDisabled("%s", ui.replay_message.c_str());
+  if (!replay.is_open()) return;
+  const rec::Recording& r = replay.recording();
+  ImGui::Text("%s: %s, %.1f s, %zu keyframes, %zu steps, procedure '%s'", replay.path().c_str(), r.header().mode.c_str(), replay.duration_s(),
+              r.keyframes().size(), r.steps().size(), r.header().procedure.c_str());
+  ImGui::Checkbox("show the replay in the views", &ui.show_replay);
+  if (replay.playing()) {
+    if (ImGui::Button("Pause##replay")) replay.pause();
+  } else {
+    if (ImGui::Button("Play##replay")) {
+      replay.play();
+      ui.show_replay = true;
+    }
+  }
   ImGui::SameLine();
-  ImGui::Button("Pause");
+  if (ImGui::Button("Step##replay")) replay.step();
   ImGui::SameLine();
-  ImGui::Button("Step");
+  float speed = static_cast<float>(replay.speed());
+  ImGui::SetNextItemWidth(100);
+  if (ImGui::SliderFloat("speed##replay", &speed, 0.1f, 4.0f, "%.2fx", ImGuiSliderFlags_Logarithmic)) replay.set_speed(speed);
   ImGui::SameLine();
-  ImGui::Button("Verify");
-  float t = 0.0f;
-  ImGui::SliderFloat("timeline (s)", &t, 0.0f, 1.0f);
+  ImGui::BeginDisabled(replay.verifying());
+  if (ImGui::Button(replay.verifying() ? "Verifying..." : "Verify")) replay.start_verification();
   ImGui::EndDisabled();
+  float t = static_cast<float>(replay.time_s());
+  ImGui::SetNextItemWidth(-1);
+  if (ImGui::SliderFloat("##timeline", &t, 0.0f, static_cast<float>(replay.duration_s()), "%.2f s")) {
+    replay.seek(t);
+    ui.show_replay = true;
+  }
+  if (replay.keyframe_shown()) {
+    ImGui::TextDisabled("keyframe %zu of %zu, tool at collision step tick %" PRIu64, *replay.keyframe_shown() + 1, r.keyframes().size(),
+                        replay.step_tick_shown());
+  }
+  if (const ReplayVerification* v = replay.verification()) {
+    if (!v->error.empty()) {
+      ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.3f, 1.0f), "verify: %s", v->error.c_str());
+    } else if (v->mismatches == 0) {
+      ImGui::TextColored(ImVec4(0.4f, 1.0f, 0.4f, 1.0f), "verified: %" PRIu64 " of %" PRIu64 " hashes match (%" PRIu64 " ticks)", v->verified,
+                         v->verified, v->ticks);
+    } else {
+      ImGui::TextColored(ImVec4(1.0f, 0.3f, 0.3f, 1.0f), "%" PRIu64 " hashes differ, first at tick %" PRIu64, v->mismatches,
+                         v->first_mismatch_tick.value_or(0));
+    }
+  }
 }
 
 }  // namespace resecto::gui

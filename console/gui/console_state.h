@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "console/gui/action_script.h"
+#include "console/gui/replay_browser.h"
 #include "console/gui/view_cameras.h"
 #include "console/live/core_session.h"
 #include "device/input/manual_motion.h"
@@ -68,6 +69,14 @@ struct ConsoleUi {
   std::array<float, 4> endoscope_rect{}, outside_rect{};
   std::vector<std::string> screenshots;
   std::string message;  ///< the last error a person should see (bad preset file, ...)
+  // Recording and replay.
+  std::string record_path = "session.resecto";
+  std::string replay_path;
+  std::string replay_message;
+  ReplayBrowser replay;
+  bool show_replay = false;  ///< the views show the replay instead of the live core
+  std::int64_t recording_started_ns = 0;
+  std::uint64_t recording_bytes_seen = 0;
 };
 
 }  // namespace resecto::gui

@@ -198,10 +198,17 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const ProstateModel
 
 void SceneRenderer::classify_faces(const SimulationSnapshot& s) {
   const std::size_t nodes = s.node_count;
-  if (initial_surface_node_.empty()) {
+  const bool first = initial_surface_node_.empty();
+  if (nodes > initial_surface_node_.size()) {
+    // Nodes refinement creates later are never original surface; their detail is painted where they
+    // first appear.
+    const std::size_t known = initial_surface_node_.size();
+    initial_surface_node_.resize(nodes, 0);
+    rest_.insert(rest_.end(), s.node_positions.begin() + static_cast<std::ptrdiff_t>(known),
+                 s.node_positions.begin() + static_cast<std::ptrdiff_t>(nodes));
+  }
+  if (first) {
     // The first surface seen is the uncut gland: its nodes are the original lining and capsule.
-    initial_surface_node_.assign(nodes, 0);
-    rest_.assign(s.node_positions.begin(), s.node_positions.begin() + static_cast<std::ptrdiff_t>(nodes));
     for (std::uint32_t f = 0; f < s.surface_triangle_count; ++f)
       for (int c = 0; c < 3; ++c) initial_surface_node_[s.surface_triangles[f][c]] = 1;
   }
@@ -235,7 +242,7 @@ void SceneRenderer::classify_faces(const SimulationSnapshot& s) {
 }
 
 void SceneRenderer::update(const SimulationSnapshot& s, bool cutting) {
-  if (s.topology_version != topology_version_ || s.surface_triangle_count != triangle_count_) {
+  if (s.topology_version != topology_version_ || s.surface_triangle_count != triangle_count_ || s.node_count > rest_.size()) {
     classify_faces(s);
     topology_version_ = s.topology_version;
     triangle_count_ = s.surface_triangle_count;

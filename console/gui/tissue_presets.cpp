@@ -3,9 +3,10 @@
 
 #include <fstream>
 #include <string>
-#include <system_error>
 
 #include <nlohmann/json.hpp>
+
+#include "console/gui/atomic_file.h"
 
 namespace resecto::gui {
 
@@ -15,16 +16,7 @@ Status save_preset(const std::filesystem::path& path, const TissueParameters& pa
   for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
     preset["parameters"][std::string(spec.key)] = parameters.get(spec.id);
   }
-  const std::filesystem::path temporary = path.string() + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary);
-    out << preset.dump(2) << "\n";
-    if (!out.flush()) return Error{path.string() + ": cannot write the preset"};
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) return Error{path.string() + ": cannot move the preset into place: " + error.message()};
-  return Ok{};
+  return write_text_atomically(path, preset.dump(2) + "\n", "preset");
 }
 
 Result<TissueParameters> load_preset(const std::filesystem::path& path, const TissueParameters& base) {

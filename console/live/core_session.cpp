@@ -5,8 +5,11 @@
 #include <algorithm>
 #include <optional>
 
+#include "console/headless/headless_run.h"
 #include "console/headless/lockstep_device.h"
+#include "device/calibration/calibration.h"
 #include "device/link/calibration_adapter.h"
+#include "recordings/recorder.h"
 #include "rtcore/core/thread_priority.h"
 
 namespace resecto {
@@ -23,6 +26,14 @@ SchedulerConfig schedule_for(const CoreSessionOptions& options) {
   schedule.realtime = true;
   schedule.spin_ns = options.spin_us * 1000;
   return schedule;
+}
+
+/// Copies `text` into a fixed buffer, cut to fit.
+template <std::size_t N>
+void copy_text(std::array<char, N>& out, const std::string& text) {
+  const std::size_t n = std::min(text.size(), N - 1);
+  std::copy_n(text.data(), n, out.data());
+  out[n] = '\0';
 }
 
 }  // namespace
@@ -121,7 +132,48 @@ void CoreSession::run_core() {
     if (status_.paused != was_paused) publish();
     return true;
   });
+  if (recorder_) finish_recording();
   priority.reset();
+}
+
+void CoreSession::start_recording(const std::string& path) {
+  if (recorder_) return;
+  rec::SessionHeader description;
+  description.procedure = options_.device.procedure.name;
+  description.mode = "console";
+  description.seed = options_.device.seed;
+  description.calibration = nlohmann::ordered_json::parse(device::calibration_to_json(options_.device.calibration));
+  Result<std::unique_ptr<rec::Recorder>> started = rec::Recorder::start(path, std::move(description), *sim_);
+  if (!started) {
+    copy_text(status_.recording_message, "recording " + path + ": " + started.error());
+  } else {
+    recorder_ = std::move(*started);
+    status_.recording = true;
+    status_.recording_start_tick = sim_->tick();
+    status_.recording_lost = 0;
+    copy_text(status_.recording_path, path);
+    status_.recording_message[0] = '\0';
+  }
+  publish();
+}
+
+void CoreSession::finish_recording() {
+  if (!recorder_) return;
+  Result<rec::RecorderCounters> finished =
+      recorder_->finish({{"ticks", sim_->tick()}, {"state_hash", hex_hash(sim_->state_hash())}});
+  recorder_.reset();
+  status_.recording = false;
+  ++status_.recordings_finished;
+  if (!finished) {
+    copy_text(status_.recording_message, "recording: " + finished.error());
+  } else {
+    status_.recorded_bytes = finished->bytes;
+    status_.recorded_ticks = finished->ticks;
+    status_.recorded_keyframes = finished->keyframes;
+    status_.recording_lost = finished->ticks_lost + finished->steps_lost + finished->commands_lost + finished->keyframes_lost;
+    if (!finished->write_error.empty()) copy_text(status_.recording_message, "recording: " + finished->write_error);
+  }
+  publish();
 }
 
 void CoreSession::take_controls() {
@@ -143,6 +195,8 @@ void CoreSession::take_controls() {
         if (status_.paused) status_.pending_steps += control.steps;
         break;
       case CoreControlKind::kSpeed: status_.speed = std::clamp(control.speed, 1.0 / 64.0, 1.0); break;
+      case CoreControlKind::kRecordStart: start_recording(control.path); break;
+      case CoreControlKind::kRecordStop: finish_recording(); break;
     }
   }
 }
@@ -184,6 +238,7 @@ void CoreSession::step_once() {
     pending_.resize(kept);
     pending_ids_.resize(kept);
   }
+  if (recorder_) recorder_->record_tick(tick, input, due_);
   sim_->step(input, due_, &profiler_);
   status_.joints = input.joints;
   status_.pedals = tool_input_.pedals();
@@ -197,6 +252,10 @@ void CoreSession::step_once() {
   next_tick_.store(sim_->tick(), std::memory_order_release);
   if (sim_->is_collision_tick(tick)) {
     if (hashes_.size() < hashes_.capacity()) hashes_.emplace_back(tick, sim_->state_hash());
+    if (recorder_) {
+      recorder_->record_step(*sim_);
+      status_.recording_lost = recorder_->lost();
+    }
     // One history entry per collision step: the worst tick of each stage since the last entry.
     for (std::size_t s = 0; s < static_cast<std::size_t>(kStageCount); ++s) {
       status_.history_us[s][status_.history_next] = since_publish_max_us_[s];

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -23,6 +24,9 @@
 namespace resecto {
 
 class LockstepDevice;
+namespace rec {
+class Recorder;
+}
 
 struct CoreSessionOptions {
   SimulationConfig simulation;
@@ -42,6 +46,8 @@ enum class CoreControlKind : std::uint8_t {
   kResume,
   kStep,       ///< while paused: run `steps` ticks as fast as the core's spare time allows
   kSpeed,      ///< slow motion: `speed` in (0, 1] of real time
+  kRecordStart,  ///< start recording to `path` (the core creates the file: one late tick at most)
+  kRecordStop,   ///< finish the recording (summary and index written)
 };
 
 struct CoreControl {
@@ -50,6 +56,7 @@ struct CoreControl {
   std::uint64_t id = 0;     ///< the console's number for it, echoed back when applied
   std::uint32_t steps = 0;
   double speed = 1.0;
+  std::string path;         ///< kRecordStart
 };
 
 /// Per-stage timings of the last seconds, one entry per collision step (the largest over its ticks).
@@ -79,6 +86,15 @@ struct CoreStatus {
   std::uint32_t history_next = 0;   ///< where the next entry goes (the oldest when full)
   /// Lockstep runs: the board's counters as the core saw them.
   std::uint64_t lockstep_reports = 0, lockstep_lost = 0;
+  /// Recording: whether one is running, since which tick, records lost so far, and the last
+  /// finished one's figures (fixed-size text so publishing never allocates).
+  bool recording = false;
+  std::uint64_t recording_start_tick = 0;
+  std::uint64_t recording_lost = 0;
+  std::uint64_t recordings_finished = 0;
+  std::uint64_t recorded_bytes = 0, recorded_ticks = 0, recorded_keyframes = 0;
+  std::array<char, 512> recording_path{};
+  std::array<char, 512> recording_message{};  ///< the last recording error, empty when none
 };
 
 /// One published frame of the core.
@@ -125,6 +141,8 @@ class CoreSession {
   void take_controls();
   void step_once();
   void publish();
+  void start_recording(const std::string& path);
+  void finish_recording();
 
   CoreSessionOptions options_;
   std::unique_ptr<Simulation> sim_;
@@ -146,6 +164,7 @@ class CoreSession {
   double speed_credit_ = 0.0;
   std::uint64_t publishes_ = 0;
   std::vector<std::pair<std::uint64_t, std::uint64_t>> hashes_;
+  std::unique_ptr<rec::Recorder> recorder_;
   bool have_held_sample_ = false;
 
   std::atomic<std::uint64_t> next_tick_{0};

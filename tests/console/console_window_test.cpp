@@ -2,7 +2,9 @@
 // a screenshot of the size asked; the endoscope shows tissue with the sheath in the urethra and its
 // image turns when the sheath rolls; a scripted `set stiffness` becomes a command the core applies at
 // its next tick, the first frame after shows it, and the state hashes differ from that tick on
-// (against the headless run of the same procedure); slow frames never hold the core back. Each test
+// (against the headless run of the same procedure); slow frames never hold the core back; a session
+// recorded in the console replays in it, showing the recorded tool pose at a scrubbed time, and
+// verifies hash for hash. Each test
 // skips, saying why, where no X server can be started.
 #include <gtest/gtest.h>
 #include <stb_image.h>
@@ -10,11 +12,13 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <iomanip>
 #include <memory>
 
 #include <nlohmann/json.hpp>
 
 #include "console/headless/headless_run.h"
+#include "recordings/recording_reader.h"
 #include "tests/console/run_resecto.h"
 
 namespace resecto {
@@ -224,7 +228,57 @@ TEST(ConsoleWindow, RunWithoutHeadlessOpensTheConsole) {
   EXPECT_GT(load_png(dir / "run.png").width, 0);
 }
 
-TEST(ConsoleWindow, BadActionsAndUnavailableReplayAreClearErrors) {
+TEST(ConsoleWindow, RecordedSessionReplaysAtAScrubbedTimeWithTheRecordedToolPoseAndVerifies) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_replay");
+  const auto recording = dir / "session.resecto";
+  const auto procedure = write_in_gland_procedure(dir);
+  std::ofstream(dir / "record.actions") << "frame 3 set stiffness 90\nframe 20 quit\n";
+  const CommandOutput recorded = run_in_xvfb("console --lockstep --procedure " + procedure.string() + " --triangles 1296 --record " +
+                                                 recording.string() + " --actions " + (dir / "record.actions").string() + " --report " +
+                                                 (dir / "record.json").string(),
+                                             dir);
+  ASSERT_EQ(recorded.exit_code, 0) << recorded.err;
+  const nlohmann::json record_report = load_json(dir / "record.json");
+  EXPECT_EQ(record_report.at("recording").at("finished"), 1);
+  EXPECT_EQ(record_report.at("recording").at("lost"), 0);
+  Result<rec::Recording> opened = rec::Recording::open(recording);
+  ASSERT_TRUE(opened) << opened.error();
+  const double scrub_s = 0.6 * opened->duration_s();
+
+  std::ofstream(dir / "replay.actions") << std::setprecision(17) << "frame 2 replay seek " << scrub_s << "\n"
+                                        << "frame 3 replay verify\n"
+                                        << "frame 5 screenshot " << (dir / "replay.png").string() << "\n"
+                                        << "frame 6 quit\n";
+  const CommandOutput replayed = run_in_xvfb("console --triangles 1296 --replay " + recording.string() + " --actions " +
+                                                 (dir / "replay.actions").string() + " --report " + (dir / "replay.json").string(),
+                                             dir);
+  ASSERT_EQ(replayed.exit_code, 0) << replayed.err;
+  const nlohmann::json replay = load_json(dir / "replay.json").at("replay");
+  EXPECT_NEAR(replay.at("time_s").get<double>(), scrub_s, 1e-9);
+  // The tool shown is the recorded pose of the collision step at or before the scrubbed time.
+  const double tick_s = opened->header().simulation.tick_s();
+  const auto step_tick = replay.at("step_tick").get<std::uint64_t>();
+  const rec::StepRecord* step = nullptr;
+  for (const rec::StepRecord& s : opened->steps())
+    if (s.tick == step_tick) step = &s;
+  ASSERT_NE(step, nullptr);
+  EXPECT_LE(static_cast<double>(step_tick + 1) * tick_s, scrub_s + 1e-9);
+  EXPECT_GT(static_cast<double>(step_tick + 17) * tick_s, scrub_s) << "the newest step at or before the time";
+  const auto& tip = replay.at("sheath_tip_m");
+  EXPECT_EQ(tip[0].get<double>(), step->tool.sheath.translation.x);
+  EXPECT_EQ(tip[1].get<double>(), step->tool.sheath.translation.y);
+  EXPECT_EQ(tip[2].get<double>(), step->tool.sheath.translation.z);
+  EXPECT_GT(tip[2].get<double>(), 0.0) << "inside the gland, past the apex";
+  // Verification re-simulated the recording (with its stiffness change) and every hash matched.
+  const auto& verification = replay.at("verification");
+  EXPECT_EQ(verification.at("error"), "");
+  EXPECT_EQ(verification.at("mismatches"), 0);
+  EXPECT_EQ(verification.at("verified").get<std::size_t>(), opened->steps().size());
+  EXPECT_GT(load_png(dir / "replay.png").width, 0);
+}
+
+TEST(ConsoleWindow, BadActionsAreClearErrors) {
   REQUIRE_X_SERVER();
   const auto dir = scratch_directory("console_errors");
   std::ofstream(dir / "bad.actions") << "frame 1 pause\nframe 2 fly away\n";

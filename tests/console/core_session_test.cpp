@@ -54,11 +54,11 @@ TEST(CoreSession, PauseHoldsAndStepsRunExactlyTheTicksAsked) {
   CoreSession& session = **created;
   session.start();
   wait_for(session, [](const CoreStatus& s) { return s.next_tick > 200; });
-  ASSERT_TRUE(session.send({CoreControlKind::kPause, {}, 0, 0, 1.0}));
+  ASSERT_TRUE(session.send({CoreControlKind::kPause, {}, 0, 0, 1.0, {}}));
   const CoreStatus paused = wait_for(session, [](const CoreStatus& s) { return s.paused; });
   std::this_thread::sleep_for(std::chrono::milliseconds(50));
   EXPECT_EQ(session.next_tick(), paused.next_tick) << "a paused core runs no tick";
-  ASSERT_TRUE(session.send({CoreControlKind::kStep, {}, 0, 1000, 1.0}));
+  ASSERT_TRUE(session.send({CoreControlKind::kStep, {}, 0, 1000, 1.0, {}}));
   const CoreStatus stepped = wait_for(session, [&](const CoreStatus& s) { return s.next_tick >= paused.next_tick + 1000 && s.pending_steps == 0; });
   EXPECT_EQ(stepped.next_tick, paused.next_tick + 1000);
   EXPECT_TRUE(stepped.paused);
@@ -73,7 +73,7 @@ TEST(CoreSession, LockstepRunIsTheHeadlessRunAndAStampedChangeAppliesAtItsTick) 
   session.start();
   // Past the apex (demo: 1.1 s), where the sheath presses the tissue and stiffness matters.
   wait_for(session, [](const CoreStatus& s) { return s.next_tick > 1700; });
-  ASSERT_TRUE(session.send({CoreControlKind::kPause, {}, 0, 0, 1.0}));
+  ASSERT_TRUE(session.send({CoreControlKind::kPause, {}, 0, 0, 1.0, {}}));
   const CoreStatus paused = wait_for(session, [](const CoreStatus& s) { return s.paused; });
   const auto stamped = static_cast<std::int64_t>(session.next_tick());
   CoreControl change;
@@ -81,7 +81,7 @@ TEST(CoreSession, LockstepRunIsTheHeadlessRunAndAStampedChangeAppliesAtItsTick) 
   change.id = 7;
   change.parameter = {stamped, TissueParameter::kStiffness, 200.0};
   ASSERT_TRUE(session.send(change));
-  ASSERT_TRUE(session.send({CoreControlKind::kStep, {}, 0, 320, 1.0}));
+  ASSERT_TRUE(session.send({CoreControlKind::kStep, {}, 0, 320, 1.0, {}}));
   const CoreStatus after = wait_for(session, [](const CoreStatus& s) { return s.applied_id[0] == 7 && s.pending_steps == 0; });
   session.stop();
   EXPECT_EQ(after.applied_tick[0], stamped) << "paused at the stamped tick, the change applies exactly there";
