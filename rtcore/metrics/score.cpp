@@ -16,6 +16,9 @@ constexpr const char* kLobeLandmarks[kLobeCount] = {"median_lobe", "lateral_lobe
 constexpr double kLobeReachedFraction = 0.25;
 // The heat map's grid: about 2 mm cells across the gland, six axial slices apex to bladder neck.
 constexpr int kGridXY = 26, kGridZ = 6;
+// Until the device reports, the core parks the tool a metre away (withdrawn_pose()); a sheath tip
+// further than this from the gland's origin is parked, and its jump in and out is not path.
+constexpr double kParkedBeyondM = 0.5;
 
 std::size_t cell_of(const ResectionHeatMap& grid, const Vec3& p) {
   auto index = [](double v, double o, double c, int n) { return std::clamp(static_cast<int>(std::floor((v - o) / c)), 0, n - 1); };
@@ -88,9 +91,10 @@ void ScoreTracker::observe(const Simulation& sim) {
   const double time_s = static_cast<double>(sim.tick()) * tick_s_;
   const ToolPoses& poses = sim.tool_poses();
   const Vec3 tip = poses.loop.apply_point(wire_middle_tool_);
-  if (have_tip_) path_m_ += length(tip - last_tip_);
+  const bool placed = length(poses.sheath.translation) < kParkedBeyondM;
+  if (placed && have_tip_) path_m_ += length(tip - last_tip_);
   last_tip_ = tip;
-  have_tip_ = true;
+  have_tip_ = placed;
 
   // Adenoma removed in this step goes to the lobe whose crest lies nearest the wire in angle around the
   // channel axis (the lobes differ by side: median posterior, laterals left and right; along the
@@ -114,7 +118,8 @@ void ScoreTracker::observe(const Simulation& sim) {
   ScoreSample s;
   s.time_s = time_s;
   s.force_n = length(sim.reaction().force_n);
-  s.insertion_mm = units::m_to_mm(poses.sheath.translation.z);
+  s.tool_placed = placed;
+  s.insertion_mm = placed ? units::m_to_mm(poses.sheath.translation.z) : 0.0;
   s.resected_g = m.resected_total_g;
   s.cutting = m.cut_pedal_time_s > last_cut_pedal_s_;
   s.contact = sim.tissue().tool().stats().penetrating > 0;

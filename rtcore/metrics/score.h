@@ -25,7 +25,8 @@ inline constexpr const char* kLobeNames[kLobeCount] = {"median", "left_lateral",
 struct ScoreSample {
   double time_s = 0.0;
   double force_n = 0.0;         ///< reaction force of the tissue on the tool
-  double insertion_mm = 0.0;    ///< sheath tip past the apex along the channel (negative: outside the gland)
+  double insertion_mm = 0.0;    ///< sheath tip past the apex along the channel (negative: outside the gland); 0 while withdrawn
+  bool tool_placed = false;     ///< the device had placed the tool (else it waits withdrawn, far from the gland)
   double resected_g = 0.0;      ///< total removed so far
   bool cutting = false;         ///< the cutting pedal was down during the step
   bool contact = false;         ///< some tool part pressed into tissue
