@@ -12,6 +12,7 @@ packages=(
   libglfw3-dev libglm-dev libopenmesh-dev libtet1.5-dev libhidapi-dev libdraco-dev libimgui-dev libstb-dev
   libgl-dev libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev libfcl-dev
   xvfb xauth libgl1-mesa-dri zlib1g-dev draco
+  chromium parallel
 )
 
 missing=()

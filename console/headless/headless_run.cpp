@@ -12,6 +12,7 @@
 
 #include "console/headless/lockstep_device.h"
 #include "console/live/live_device.h"
+#include "console/score/rescore.h"
 #include "device/link/calibration_adapter.h"
 #include "device/calibration/calibration.h"
 #include "device/link/tool_input.h"
@@ -154,6 +155,9 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   TripleBuffer<SimulationSnapshot> snapshots(sim.make_snapshot());
   SnapshotConsumer consumer(snapshots, options.consumer_delay_ms);
 
+  // The score, live: the same tracker `resecto score` runs over a recording's re-simulation.
+  ScoreTracker score(sim);
+  score.reserve(ticks / static_cast<std::uint64_t>(config.physics_per_collision) + 2);
   HeadlessResult result;
   result.collision_hashes.reserve(ticks / static_cast<std::uint64_t>(config.physics_per_collision) + 2);
   TimingHistogram input_to_snapshot_us;
@@ -194,6 +198,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
       sim.fill_snapshot(snapshots.write_slot());
       snapshots.publish();
       if (recorder) recorder->record_step(sim);
+      score.observe(sim);
       if (live && newest_sample_host_ns > published_sample_host_ns) {
         input_to_snapshot_us.add(static_cast<double>(FrameProfiler::now_ns() - newest_sample_host_ns) * 1e-3);
         published_sample_host_ns = newest_sample_host_ns;
@@ -259,6 +264,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   }
   r["snapshots"] = {{"published", result.collision_hashes.size()}, {"received", consumer.received()}};
   r["metrics"] = metrics_json(sim.metrics());
+  r["score"] = score_metrics_json(score.finish(sim).metrics);
   if (recorder) {
     Result<rec::RecorderCounters> recorded = recorder->finish({{"ticks", result.ticks}, {"state_hash", hex_hash(result.final_hash)}});
     if (!recorded) return Error{"recording " + options.record_path + ": " + recorded.error()};

@@ -1,0 +1,151 @@
+// Re-scoring by re-simulation, and the metrics' JSON and CSV forms.
+#include "console/score/rescore.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+
+#include "recordings/replay.h"
+
+namespace resecto {
+namespace {
+
+using nlohmann::ordered_json;
+
+std::string lobe_order_text(const ScoreMetrics& m, const char* separator) {
+  std::string text;
+  for (std::size_t i = 0; i < m.lobe_order.size(); ++i) {
+    if (i) text += separator;
+    text += kLobeNames[m.lobe_order[i]];
+  }
+  return text;
+}
+
+// One place lists the scalar metrics, for JSON and CSV alike.
+template <typename Visit>
+void for_each_scalar(const ScoreMetrics& m, Visit&& visit) {
+  visit("procedure_time_s", m.procedure_time_s);
+  visit("resected_total_g", m.resected_total_g);
+  visit("resected_adenoma_g", m.resected_adenoma_g);
+  visit("resected_capsule_g", m.resected_capsule_g);
+  visit("remaining_adenoma_fraction", m.remaining_adenoma_fraction);
+  visit("grams_per_minute", m.grams_per_minute);
+  visit("grams_per_cut", m.grams_per_cut);
+  visit("cuts", static_cast<double>(m.cuts));
+  visit("chips", static_cast<double>(m.chips));
+  visit("perforations", static_cast<double>(m.perforations));
+  visit("sphincter_zone_violations", static_cast<double>(m.sphincter_zone_violations));
+  visit("sphincter_zone_cut_s", m.sphincter_zone_cut_s);
+  visit("loop_on_idle_s", m.loop_on_idle_s);
+  visit("tool_path_mm", m.tool_path_mm);
+  visit("tool_mean_speed_mm_s", m.tool_mean_speed_mm_s);
+  visit("contact_time_s", m.contact_time_s);
+  visit("peak_force_n", m.peak_force_n);
+  visit("mean_contact_force_n", m.mean_contact_force_n);
+  visit("cut_pedal_time_s", m.cut_pedal_time_s);
+  for (int lobe = 0; lobe < kLobeCount; ++lobe) {
+    static const char* kNames[kLobeCount] = {"median_lobe_adenoma_g", "left_lateral_lobe_adenoma_g", "right_lateral_lobe_adenoma_g"};
+    visit(kNames[lobe], m.lobe_adenoma_g[static_cast<std::size_t>(lobe)]);
+  }
+}
+
+bool is_count(const char* name) {
+  const std::string n = name;
+  return n == "cuts" || n == "chips" || n == "perforations" || n == "sphincter_zone_violations";
+}
+
+}  // namespace
+
+ordered_json score_metrics_json(const ScoreMetrics& m) {
+  ordered_json out = ordered_json::object();
+  for_each_scalar(m, [&](const char* name, double v) {
+    if (is_count(name)) {
+      out[name] = static_cast<std::uint64_t>(v);
+    } else {
+      out[name] = v;
+    }
+  });
+  ordered_json order = ordered_json::array();
+  for (int lobe : m.lobe_order) order.push_back(kLobeNames[lobe]);
+  out["lobe_order"] = order;
+  out["blood_loss_ml_per_g"] = {{"value", nullptr}, {"available", ScoreMetrics::kBloodLossAvailable},
+                                {"why", "bleeding is not simulated yet"}};
+  out["irrigant_l_per_g"] = {{"value", nullptr}, {"available", ScoreMetrics::kIrrigantAvailable},
+                             {"why", "irrigation is not simulated yet"}};
+  return out;
+}
+
+std::string score_csv_header() {
+  std::string line = "file,procedure,ticks";
+  for_each_scalar(ScoreMetrics{}, [&](const char* name, double) { line += std::string(",") + name; });
+  return line + ",lobe_order,blood_loss_ml_per_g,irrigant_l_per_g\n";
+}
+
+std::string score_csv_row(const RecordingScore& s) {
+  // Paths and names go in quotes with quotes doubled (RFC 4180).
+  auto quoted = [](const std::string& text) {
+    std::string out = "\"";
+    for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return out + "\"";
+  };
+  std::string line = quoted(s.file) + "," + quoted(s.procedure) + "," + std::to_string(s.ticks);
+  for_each_scalar(s.score.metrics, [&](const char* name, double v) {
+    char number[64];
+    if (is_count(name)) {
+      std::snprintf(number, sizeof number, ",%llu", static_cast<unsigned long long>(v));
+    } else {
+      std::snprintf(number, sizeof number, ",%.17g", v);
+    }
+    line += number;
+  });
+  return line + "," + lobe_order_text(s.score.metrics, ">") + ",,\n";  // unavailable: empty cells
+}
+
+Result<RecordingScore> score_recording(const std::filesystem::path& path, const ScoreProgress& progress) {
+  const std::string name = path.string();
+  Result<rec::Recording> recording = rec::Recording::open(path);
+  if (!recording) return Error{name + ": " + recording.error()};
+  if (!recording->damaged().empty()) {
+    const rec::DamagedRange& d = recording->damaged().front();
+    return Error{name + ": damaged (" + std::to_string(recording->damaged().size()) + " damaged byte ranges, the first at byte " +
+                 std::to_string(d.offset) + "); a score from part of a procedure would mislead"};
+  }
+  if (!recording->content_errors().empty()) return Error{name + ": " + recording->content_errors().front()};
+  if (recording->replayable_ticks() == 0) return Error{name + ": no recorded input to replay"};
+  if (recording->replayable_ticks() != recording->ticks().size()) {
+    return Error{name + ": recorded input breaks at tick " + std::to_string(recording->replayable_ticks())};
+  }
+  Result<std::unique_ptr<rec::Replayer>> created = rec::Replayer::create(*recording);
+  if (!created) return Error{name + ": " + created.error()};
+  rec::Replayer& replayer = **created;
+  const Simulation& sim = replayer.simulation();
+  ScoreTracker tracker(sim);
+  const std::uint64_t end = replayer.end_tick();
+  const std::uint64_t period = static_cast<std::uint64_t>(sim.config().physics_per_collision);
+  const std::uint64_t report_every = std::max<std::uint64_t>(period, end / 50);
+  std::uint64_t next_report = report_every;
+  // Collision ticks are the multiples of the period; observe after each has run.
+  for (std::uint64_t tick = 0; tick < end; tick += period) {
+    replayer.run_to(tick + 1);
+    tracker.observe(sim);
+    if (progress && tick >= next_report) {
+      progress(tick, end);
+      next_report += report_every;
+    }
+  }
+  replayer.run_to(end);
+  if (replayer.mismatches() > 0) {
+    return Error{name + ": re-simulation differs from the recording first at tick " + std::to_string(*replayer.first_mismatch_tick()) +
+                 " (recorded hash " + std::to_string(replayer.first_mismatch_recorded()) + "); recorded by a different build?"};
+  }
+  if (progress) progress(end, end);
+  RecordingScore out;
+  out.file = name;
+  out.procedure = recording->header().procedure;
+  out.ticks = sim.tick();
+  out.verified_hashes = replayer.verified_hashes();
+  out.score = tracker.finish(sim);
+  return out;
+}
+
+}  // namespace resecto

@@ -1,0 +1,212 @@
+// `resecto score` end to end: re-scoring equals the live run's score, a careless procedure scores
+// worse on exactly its faults, a cohort CSV with a damaged recording skipped, the HTML debrief
+// rendered by headless Chromium with the heat map showing the cut.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <vector>
+#include <stb_image.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <regex>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/console/run_resecto.h"
+
+namespace resecto::testing {
+namespace {
+
+using nlohmann::json;
+
+// The small gland keeps the end-to-end runs short; the scoring is the same at any size.
+const std::string kModel = " --triangles 1296";
+
+json run_and_record(const std::string& procedure, const std::filesystem::path& file, const std::string& extra = "") {
+  const CommandOutput run = run_resecto("run --headless --json --procedure " + procedure + kModel + extra + " --record " + file.string());
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  return json::parse(run.out);
+}
+
+json score_json(const std::string& files, int expected_exit = 0) {
+  const CommandOutput scored = run_resecto("score --quiet --json " + files);
+  EXPECT_EQ(scored.exit_code, expected_exit) << scored.err;
+  return json::parse(scored.out);
+}
+
+// A procedure a careless trainee might perform: the loop on before reaching tissue, a stroke that
+// ends distal to the verumontanum (the sphincter zone), and a stroke tilted through the capsule.
+constexpr const char* kCarelessProcedure = R"(# careless: idle loop, sphincter zone, perforation
+0.0     0.0  0.0    0.0  125.0   0.0  0 0
+0.8     0.0  0.0    0.0  135.0  10.0  0 0
+0.9     0.0  0.0    0.0  135.0  10.0  1 0
+6.4     0.0  0.0    0.0  140.0  10.0  1 0
+6.5     0.0  0.0    0.0  140.0   0.0  0 0
+7.5     0.0  0.0   90.0  153.0   0.0  0 0
+8.0     1.0  0.0   90.0  153.0   8.0  0 0
+8.1     1.0  0.0   90.0  153.0   8.0  1 0
+9.3     1.0  0.0   90.0  153.0   0.0  1 0
+9.4     1.0  0.0   90.0  153.0   0.0  0 0
+10.0    0.0  0.0  -90.0  168.0   0.0  0 0
+10.6   -6.0  0.0  -90.0  168.0  14.0  0 0
+10.7   -6.0  0.0  -90.0  168.0  14.0  1 0
+12.2   -6.0  0.0  -90.0  168.0   1.0  1 0
+12.3   -6.0  0.0  -90.0  168.0   1.0  0 0
+13.0    0.0  0.0    0.0  160.0   0.0  0 0
+14.0   0.0  0.0    0.0  125.0   0.0  0 0
+)";
+
+void expect_rescore_equals_live(const std::string& procedure, const std::string& extra) {
+  SCOPED_TRACE(procedure + extra);
+  const auto dir = scratch_directory("score_equal_" + procedure);
+  const json live = run_and_record(procedure, dir / "run.resecto", extra);
+  const json scored = score_json((dir / "run.resecto").string());
+  ASSERT_EQ(scored.at("scored").size(), 1u);
+  EXPECT_TRUE(scored.at("skipped").empty());
+  const json& rescored = scored.at("scored")[0].at("metrics");
+  std::printf("%s: live score %s\n", procedure.c_str(), live.at("score").dump().c_str());
+  // Every metric, bit for bit: the same module over the same deterministic simulation.
+  EXPECT_EQ(rescored.dump(), live.at("score").dump());
+  // And the core's own totals the live report carries.
+  EXPECT_EQ(rescored.at("resected_total_g"), live.at("metrics").at("resected_g").at("total"));
+  EXPECT_EQ(rescored.at("cuts"), live.at("metrics").at("cuts"));
+  EXPECT_GT(rescored.at("resected_adenoma_g").get<double>(), 0.1);
+  EXPECT_EQ(scored.at("scored")[0].at("ticks"), live.at("ticks"));
+  EXPECT_FALSE(rescored.at("blood_loss_ml_per_g").at("available").get<bool>());
+  EXPECT_TRUE(rescored.at("blood_loss_ml_per_g").at("value").is_null());
+}
+
+TEST(ScoreCommand, RescoringTheDemoEqualsTheLiveRunsScore) { expect_rescore_equals_live("demo", ""); }
+
+// The full `turp` is 81 simulated seconds (minutes of CPU, twice over, on the test machine); its
+// first 14 s hold six of the median lobe's nine strokes, every kind of step the full run has.
+TEST(ScoreCommand, RescoringTurpEqualsTheLiveRunsScore) { expect_rescore_equals_live("turp", " --seconds 14"); }
+
+TEST(ScoreCommand, CarelessProcedureScoresWorseOnItsFaults) {
+  const auto dir = scratch_directory("score_careless");
+  {
+    std::ofstream(dir / "careless.txt") << kCarelessProcedure;
+  }
+  run_and_record((dir / "careless.txt").string(), dir / "careless.resecto");
+  run_and_record("turp", dir / "turp.resecto", " --seconds 14");
+  const json scored = score_json((dir / "careless.resecto").string() + " " + (dir / "turp.resecto").string());
+  ASSERT_EQ(scored.at("scored").size(), 2u);
+  const json& careless = scored.at("scored")[0].at("metrics");
+  const json& careful = scored.at("scored")[1].at("metrics");
+  std::printf("careless: %s\ncareful: %s\n", careless.dump().c_str(), careful.dump().c_str());
+  EXPECT_GT(careless.at("perforations").get<int>(), careful.at("perforations").get<int>());
+  EXPECT_GT(careless.at("sphincter_zone_violations").get<int>(), careful.at("sphincter_zone_violations").get<int>());
+  EXPECT_GT(careless.at("sphincter_zone_cut_s").get<double>(), careful.at("sphincter_zone_cut_s").get<double>());
+  EXPECT_GT(careless.at("loop_on_idle_s").get<double>(), careful.at("loop_on_idle_s").get<double>());
+  EXPECT_GT(careless.at("resected_capsule_g").get<double>(), careful.at("resected_capsule_g").get<double>());
+  EXPECT_EQ(careful.at("perforations").get<int>(), 0);
+  EXPECT_EQ(careful.at("sphincter_zone_violations").get<int>(), 0);
+}
+
+TEST(ScoreCommand, CohortCsvSkipsTheDamagedRecording) {
+  const auto dir = scratch_directory("score_cohort");
+  constexpr int kCohort = 20;
+  std::string files;
+  for (int i = 0; i < kCohort; ++i) {
+    const auto file = dir / ("r" + std::to_string(i) + ".resecto");
+    run_and_record("demo", file, " --seconds 1.2 --seed " + std::to_string(i + 1));
+    files += " " + file.string();
+  }
+  // A 21st recording, damaged in the middle: copied from the first with bytes overwritten.
+  std::string bytes = read_text(dir / "r0.resecto");
+  ASSERT_GT(bytes.size(), 4096u);
+  for (std::size_t i = bytes.size() / 2; i < bytes.size() / 2 + 64; ++i) bytes[i] = static_cast<char>(0x5a);
+  {
+    std::ofstream(dir / "damaged.resecto", std::ios::binary) << bytes;
+  }
+  files += " " + (dir / "damaged.resecto").string();
+  const CommandOutput scored = run_resecto("score --quiet --csv " + (dir / "cohort.csv").string() + files);
+  EXPECT_EQ(scored.exit_code, 1) << "a skipped recording makes the exit status 1";
+  EXPECT_NE(scored.err.find("skipped: " + (dir / "damaged.resecto").string() + ": damaged"), std::string::npos) << scored.err;
+  EXPECT_NE(scored.err.find("1 of 21 recordings skipped"), std::string::npos) << scored.err;
+  std::istringstream csv(read_text(dir / "cohort.csv"));
+  std::string line;
+  std::vector<std::string> rows;
+  while (std::getline(csv, line)) rows.push_back(line);
+  ASSERT_EQ(rows.size(), 1u + kCohort);
+  EXPECT_EQ(rows[0].rfind("file,procedure,ticks,procedure_time_s,", 0), 0u) << rows[0];
+  const auto columns = std::count(rows[0].begin(), rows[0].end(), ',');
+  for (int i = 1; i <= kCohort; ++i) {
+    EXPECT_EQ(std::count(rows[static_cast<std::size_t>(i)].begin(), rows[static_cast<std::size_t>(i)].end(), ','), columns) << rows[static_cast<std::size_t>(i)];
+    EXPECT_NE(rows[static_cast<std::size_t>(i)].find("r" + std::to_string(i - 1) + ".resecto"), std::string::npos);
+  }
+  EXPECT_EQ(read_text(dir / "cohort.csv").find("damaged"), std::string::npos);
+}
+
+TEST(ScoreCommand, BadArgumentsAreNamed) {
+  const CommandOutput none = run_resecto("score");
+  EXPECT_NE(none.exit_code, 0);
+  EXPECT_NE(none.err.find("no recording given"), std::string::npos) << none.err;
+  const CommandOutput missing = run_resecto("score --quiet /nonexistent/x.resecto");
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("skipped: /nonexistent/x.resecto"), std::string::npos) << missing.err;
+  const CommandOutput compare = run_resecto("score --compare a b");
+  EXPECT_NE(compare.exit_code, 0);
+  EXPECT_NE(compare.err.find("needs --html"), std::string::npos) << compare.err;
+}
+
+/// Counts the pixels of colour `rgb` in a PNG file (stb_image, as the console's screenshot tests), or
+/// -1 when it does not decode.
+long count_pixels(const std::filesystem::path& path, unsigned rgb) {
+  int width = 0, height = 0, channels = 0;
+  std::unique_ptr<stbi_uc, void (*)(void*)> pixels(stbi_load(path.string().c_str(), &width, &height, &channels, 3), stbi_image_free);
+  if (!pixels) return -1;
+  long count = 0;
+  const std::size_t bytes = static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3;
+  for (std::size_t i = 0; i < bytes; i += 3) {
+    const stbi_uc* p = pixels.get() + i;
+    if (p[0] == ((rgb >> 16) & 0xff) && p[1] == ((rgb >> 8) & 0xff) && p[2] == (rgb & 0xff)) ++count;
+  }
+  return count;
+}
+
+TEST(ScoreCommand, HtmlDebriefRendersInHeadlessChromiumWithTheCutOnTheHeatMap) {
+  const auto dir = scratch_directory("score_html");
+  run_and_record("demo", dir / "demo.resecto");
+  const CommandOutput scored = run_resecto("score --quiet " + (dir / "demo.resecto").string() + " --html " + (dir / "debrief.html").string());
+  ASSERT_EQ(scored.exit_code, 0) << scored.err;
+  const std::string html = read_text(dir / "debrief.html");
+  // Self-contained: nothing fetched.
+  EXPECT_EQ(html.find("src="), std::string::npos);
+  EXPECT_EQ(html.find("href="), std::string::npos);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  for (const char* part : {"Reaction force", "Cutting pedal", "Insertion depth", "Resected tissue", "id=\"heatmap\"", "UroSim", "Sweet 2004"}) {
+    EXPECT_NE(html.find(part), std::string::npos) << part;
+  }
+  // The heat map shows removed adenoma (the demo cut both lateral lobes).
+  EXPECT_NE(html.find("fill=\"#d62828\""), std::string::npos);
+
+  const CommandOutput compare = run_resecto("score --quiet --compare " + (dir / "demo.resecto").string() + " " + (dir / "demo.resecto").string() +
+                                            " --html " + (dir / "compare.html").string());
+  ASSERT_EQ(compare.exit_code, 0) << compare.err;
+  const std::string side_by_side = read_text(dir / "compare.html");
+  std::size_t heat_maps = 0;
+  for (std::size_t at = side_by_side.find("id=\"heatmap\""); at != std::string::npos; at = side_by_side.find("id=\"heatmap\"", at + 1)) ++heat_maps;
+  EXPECT_EQ(heat_maps, 2u);
+
+  if (std::system("command -v chromium >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "chromium is not installed (Debian package `chromium`, in scripts/setup.sh): the screenshot is not taken";
+  }
+  const auto png = dir / "debrief.png";
+  const std::string command = "chromium --headless --no-sandbox --disable-gpu --hide-scrollbars --window-size=1400,2400 --screenshot=" +
+                              png.string() + " file://" + (dir / "debrief.html").string() + " >/dev/null 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  const long removed = count_pixels(png, 0xd62828);
+  const long remaining = count_pixels(png, 0xe9c46a);
+  std::printf("screenshot %s: %ld removed-adenoma pixels, %ld remaining-adenoma pixels\n", png.c_str(), removed, remaining);
+  ASSERT_GE(removed, 0) << "the screenshot does not decode";
+  EXPECT_GT(removed, 49 * 4) << "the heat map shows no resected cell";
+  EXPECT_GT(remaining, removed) << "the demo removes a small part of the adenoma";
+}
+
+}  // namespace
+}  // namespace resecto::testing
