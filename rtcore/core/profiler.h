@@ -54,6 +54,8 @@ class FrameProfiler {
   void record(Stage stage, std::uint64_t tick, std::int64_t begin_ns, std::int64_t end_ns);
 
   StageStatistics statistics(Stage stage) const;
+  /// Sum of every recorded duration of a stage, microseconds (its mean is this over the samples).
+  double total_us(Stage stage) const { return total_us_[static_cast<int>(stage)]; }
   double budget_us(Stage stage) const { return budgets_us_[static_cast<int>(stage)]; }
   /// Stage timings recorded so far that the trace ring no longer holds.
   std::uint64_t trace_dropped() const { return trace_written_ > trace_.size() ? trace_written_ - trace_.size() : 0; }
@@ -63,6 +65,7 @@ class FrameProfiler {
 
  private:
   std::array<double, kStageCount> budgets_us_;
+  std::array<double, kStageCount> total_us_{};
   std::array<TimingHistogram, kStageCount> histograms_;
   std::array<std::uint64_t, kStageCount> over_budget_{};
   std::vector<StageTiming> trace_;
