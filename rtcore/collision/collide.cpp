@@ -65,6 +65,13 @@ void Collider::next_stamp() {
   }
 }
 
+void Collider::reserve_tissue_nodes(std::int32_t max_nodes) {
+  const auto nodes = static_cast<std::size_t>(std::max(max_nodes, 1));
+  l1_stamp_.reserve(nodes);
+  l1_.reserve(nodes);
+  stack_.reserve(1024);  // the descent needs about the tree's height
+}
+
 void Collider::prepare(const SphereTree& tissue_tree, const SphereTree& tool_tree, const TriangleMesh& tool) {
   // resize() allocates only when a tree has grown past every size seen before.
   const auto tissue_nodes = static_cast<std::size_t>(tissue_tree.node_capacity());

@@ -51,6 +51,9 @@ class Collider {
 
   /// Room for `max_pairs` intersecting pairs and `max_tested_pairs` distinct triangle pairs tested.
   void reserve(std::int32_t max_pairs, std::int32_t max_tested_pairs);
+  /// Room for tissue trees of up to `max_nodes` nodes (a tree that resection grows), so a query on
+  /// one allocates nothing.
+  void reserve_tissue_nodes(std::int32_t max_nodes);
 
   /// Finds every pair of intersecting closed triangles between the tissue and the tool placed at
   /// `tool_pose` (the tool tree is in tool coordinates; its spheres move with the pose, never

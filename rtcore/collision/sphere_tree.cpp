@@ -226,6 +226,18 @@ void SphereTree::rebuild(const TriangleMesh& mesh) {
   build_over(mesh, present);
 }
 
+void SphereTree::reserve(std::int32_t max_nodes, std::uint32_t max_triangles) {
+  const auto nodes = static_cast<std::size_t>(std::max(max_nodes, 1));
+  spheres_.reserve(nodes);
+  links_.reserve(nodes);
+  pieces_.reserve(nodes);
+  next_leaf_.reserve(nodes);
+  refit_leaves_.reserve(nodes);
+  refit_internal_.reserve(nodes);
+  stack_.reserve(nodes);
+  first_leaf_.reserve(max_triangles);
+}
+
 void SphereTree::build_over(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles) {
   ++structure_version_;
   slabs_kept_ = slabs_wanted_;

@@ -127,6 +127,9 @@ class SphereTree {
   /// ancestors are refitted, and the two freed nodes go to the free list (3.5).
   void remove_triangle(std::uint32_t t);
 
+  /// Reserves room for `max_nodes` nodes over up to `max_triangles` triangle slots, so insertions
+  /// and refits within it allocate nothing (a tissue that resection grows reserves its room at start).
+  void reserve(std::int32_t max_nodes, std::uint32_t max_triangles);
   /// The current shape and how far it has drifted from the last build.
   SphereTreeQuality quality() const;
   /// True when the tree is taller than the policy tolerates (over 2 log2(n) + 4) or its internal

@@ -46,6 +46,7 @@ void FrameProfiler::record(Stage stage, std::uint64_t tick, std::int64_t begin_n
   const double us = static_cast<double>(end_ns - begin_ns) * 1e-3;
   histograms_[s].add(us);
   last_us_[s] = us;
+  total_us_[s] += us;
   if (us > budgets_us_[s]) ++over_budget_[s];
   trace_[trace_written_ % trace_.size()] = {begin_ns, end_ns - begin_ns, tick, stage};
   ++trace_written_;

@@ -54,6 +54,8 @@ class FrameProfiler {
   void record(Stage stage, std::uint64_t tick, std::int64_t begin_ns, std::int64_t end_ns);
 
   StageStatistics statistics(Stage stage) const;
+  /// Sum of every recorded duration of a stage, microseconds (its mean is this over the samples).
+  double total_us(Stage stage) const { return total_us_[static_cast<int>(stage)]; }
   double budget_us(Stage stage) const { return budgets_us_[static_cast<int>(stage)]; }
   /// The stage's most recent duration, microseconds (what a live plot samples).
   double last_us(Stage stage) const { return last_us_[static_cast<int>(stage)]; }
@@ -65,6 +67,7 @@ class FrameProfiler {
 
  private:
   std::array<double, kStageCount> budgets_us_;
+  std::array<double, kStageCount> total_us_{};
   std::array<TimingHistogram, kStageCount> histograms_;
   std::array<std::uint64_t, kStageCount> over_budget_{};
   std::array<double, kStageCount> last_us_{};

@@ -202,7 +202,7 @@ int Resection::refine_near(const SweptVolume& sweep) {
       const double longest = longest_rest_edge(t);
       if (longest <= target) continue;
       // Only where the cut surface will run: a centroid within a quarter edge of the volume's rim.
-      if (sweep.path_distance(centroid(t)) <= sweep.radius() + 0.25 * longest) marked_.push_back(t);
+      if (sweep.within(centroid(t), sweep.radius() + 0.25 * longest)) marked_.push_back(t);
     }
     if (marked_.empty()) break;
     const TetMeshView view{tissue_.rest_positions(), topo.tetrahedra(), topo.alive_flags(), topo.regions()};

@@ -47,6 +47,23 @@ double SweptVolume::path_distance(const Vec3& p) const {
   return std::sqrt(best2);
 }
 
+bool SweptVolume::within(const Vec3& p, double reach) const {
+  // The box holds the path grown by the radius; grown further by what reach exceeds it.
+  const double grow = std::max(0.0, reach - radius_m_);
+  if (p.x < bounds_.min.x - grow || p.y < bounds_.min.y - grow || p.z < bounds_.min.z - grow || p.x > bounds_.max.x + grow ||
+      p.y > bounds_.max.y + grow || p.z > bounds_.max.z + grow) {
+    return false;
+  }
+  const double reach2 = reach * reach;
+  for (const Quad& q : quads_) {
+    if (length(p - q.centre) - q.reach > reach) continue;
+    for (const Vec3& c : {closest_point_on_triangle(p, q.a0, q.a1, q.b1), closest_point_on_triangle(p, q.a0, q.b1, q.b0)}) {
+      if (length_squared(p - c) <= reach2) return true;
+    }
+  }
+  return false;
+}
+
 double SweptVolume::straight_stroke_volume(double span_m, double travel_m, double radius_m) {
   // Minkowski sum of a span x travel rectangle with a ball: the slab 2 r s t, half-cylinders along the
   // four sides pi r^2 (s + t), and the four quarter... corners, which together make one ball 4/3 pi r^3.

@@ -23,7 +23,10 @@ class SweptVolume {
   void set(std::span<const Vec3> from, std::span<const Vec3> to, double radius_m);
   /// Distance from p to the wire's path (0 on it); p is inside the volume when this is <= radius().
   double path_distance(const Vec3& p) const;
-  bool contains(const Vec3& p) const { return path_distance(p) <= radius_m_; }
+  bool contains(const Vec3& p) const { return within(p, radius_m_); }
+  /// Whether p is within `reach` of the wire's path (path_distance(p) <= reach), answered early: a
+  /// box test first, then the first ribbon that close.
+  bool within(const Vec3& p, double reach) const;
   double radius() const { return radius_m_; }
   /// The volume's bounding box (the path's, grown by the radius).
   const Aabb& bounds() const { return bounds_; }

@@ -82,8 +82,11 @@ std::vector<ProcedureKeyframe> turp_keyframes() {
   }
   // Lateral lobes, left then right, layer by layer from the channel outward.
   for (double side : {1.0, -1.0}) {
-    for (double tilt : {0.0, 1.0, 2.0, 3.0}) {
-      for (double roll : {40.0, 65.0, 90.0, 115.0}) stroke(side * roll, tilt, plan.far_loop_mm, plan.near_loop_mm);
+    for (double tilt : {0.0, 1.0, 2.0, 3.0, 3.6}) {
+      // The deepest layer spares the anterolateral roll, where the capsule is nearest.
+      for (double roll : {20.0, 45.0, 70.0, 95.0, 115.0}) {
+        if (tilt < 3.5 || roll < 100.0) stroke(side * roll, tilt, plan.far_loop_mm, plan.near_loop_mm);
+      }
     }
   }
   add(0.5, 0.0, 0.0, 0.0, plan.insertion_mm, 0.0, false);

@@ -144,6 +144,9 @@ class MassSpringTissue {
   std::size_t surface_face_count() const { return surface_faces_; }
   std::size_t surface_face_capacity() const { return surface_face_capacity_; }
   std::size_t node_capacity() const { return topology_.node_capacity(); }
+  /// Rebuilds of the surface's sphere tree after edits decayed it (SphereTree::should_rebuild); the
+  /// only part of an edit that allocates (the tree's build scratch).
+  std::int64_t surface_tree_rebuilds() const { return surface_tree_rebuilds_; }
   /// Bumped by every edit that changed the surface.
   std::uint64_t topology_version() const { return topology_version_; }
   /// The live surface, compacted (free slots skipped, in slot order) over the tissue's nodes.
@@ -235,6 +238,7 @@ class MassSpringTissue {
   SphereTree surface_tree_;
   std::uint64_t topology_hash_ = 0;  // of the live tetrahedra and the surface's faces, kept per edit
   std::uint64_t topology_version_ = 0;
+  std::int64_t surface_tree_rebuilds_ = 0;
   TetTopology topology_;
   // Surface bookkeeping: per face slot, its owner 4 t + f (-1 free); per tetrahedron face, its slot.
   std::vector<std::int64_t> face_owner_;

@@ -90,6 +90,7 @@ void MassSpringTissue::reserve_topology(std::size_t node_capacity, std::size_t t
   changed_face_.assign(surface_face_capacity_, 0);
   changed_faces_.reserve(surface_face_capacity_);
   tool_.reserve_tissue(node_capacity, surface_face_capacity_);
+  surface_tree_.reserve(static_cast<std::int32_t>(4 * surface_face_capacity_), static_cast<std::uint32_t>(surface_face_capacity_));
 }
 
 void MassSpringTissue::map_initial_surface() {
@@ -439,7 +440,10 @@ TopologyChange MassSpringTissue::edit_tetrahedra(std::span<const std::uint32_t> 
   for (std::uint32_t n : touched_nodes_) dead_node_[n] = 0;
   if (change.surface_faces_added + change.surface_faces_removed > 0) {
     ++topology_version_;
-    if (surface_tree_.should_rebuild()) surface_tree_.rebuild(surface_);
+    if (surface_tree_.should_rebuild()) {
+      surface_tree_.rebuild(surface_);
+      ++surface_tree_rebuilds_;
+    }
   }
   return change;
 }

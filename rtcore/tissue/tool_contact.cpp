@@ -174,6 +174,7 @@ int ToolContacts::add_part(const TriangleMesh& mesh) {
   // triangle, and the slabs would drop it; the spheres keep it a candidate.
   part.collider.set_slabs(false);
   parts_.push_back(std::move(part));
+  if (reserved_tree_nodes_ > 0) parts_.back().collider.reserve_tissue_nodes(reserved_tree_nodes_);
   std::size_t max_triangles = 0;
   for (const Part& p : parts_) max_triangles = std::max(max_triangles, p.mesh.triangle_count());
   triangle_stamp_.assign(max_triangles, 0);
@@ -458,6 +459,10 @@ void ToolContacts::invalidate_tissue(std::span<const std::uint8_t> changed_face,
 void ToolContacts::reserve_tissue(std::size_t max_nodes, std::size_t max_faces) {
   if (node_stamp_.size() < max_nodes) node_stamp_.assign(max_nodes, 0);
   if (tissue_triangle_stamp_.size() < max_faces) tissue_triangle_stamp_.assign(max_faces, 0);
+  // A tissue tree has about two nodes per leaf and a leaf or two per face.
+  reserved_tree_nodes_ = static_cast<std::int32_t>(4 * max_faces);
+  stack_.reserve(static_cast<std::size_t>(reserved_tree_nodes_));
+  for (Part& part : parts_) part.collider.reserve_tissue_nodes(reserved_tree_nodes_);
 }
 
 }  // namespace resecto

@@ -174,6 +174,7 @@ class ToolContacts {
   std::vector<std::uint32_t> node_stamp_, tool_vertex_stamp_, triangle_stamp_, tissue_triangle_stamp_;
   std::uint32_t stamp_ = 0;
   std::vector<std::int32_t> stack_;
+  std::int32_t reserved_tree_nodes_ = 0;  // reserve_tissue()'s room, for parts added after it
   ToolContactStats stats_;
 };
 

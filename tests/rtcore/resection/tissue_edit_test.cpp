@@ -1,0 +1,177 @@
+// The tissue after resection's edits against brute force: springs, volumes and surface equal a fresh
+// build from the live tetrahedra; the sphere tree covers exactly the live faces; the collision pairs
+// equal the brute-force pairs. Refinement alone preserves mass and the uniform-strain stiffness.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <set>
+
+#include "rtcore/anatomy/resectoscope.h"
+#include "rtcore/collision/collide.h"
+#include "rtcore/resection/resection.h"
+#include "rtcore/tissue/springs.h"
+#include "tests/support/tissue_models.h"
+
+namespace resecto {
+namespace {
+
+TetMesh live_mesh(const MassSpringTissue& tissue) {
+  TetMesh mesh;
+  mesh.positions.assign(tissue.rest_positions().begin(), tissue.rest_positions().end());
+  const TetTopology& topo = tissue.topology();
+  for (std::uint32_t t = 0; t < topo.slot_count(); ++t) {
+    if (!topo.alive(t)) continue;
+    mesh.tetrahedra.push_back(topo.tetrahedron(t));
+    mesh.regions.push_back(topo.region(t));
+  }
+  return mesh;
+}
+
+std::array<std::uint32_t, 3> canonical(const Triangle& t) {
+  // The rotation that starts at the smallest corner keeps the winding.
+  const int m = t[0] < t[1] ? (t[0] < t[2] ? 0 : 2) : (t[1] < t[2] ? 1 : 2);
+  return {t[static_cast<std::size_t>(m)], t[static_cast<std::size_t>((m + 1) % 3)], t[static_cast<std::size_t>((m + 2) % 3)]};
+}
+
+void expect_matches_fresh_build(const MassSpringTissue& tissue) {
+  const TetMesh fresh = live_mesh(tissue);
+  const SpringNetwork net = build_spring_network(fresh);
+  std::map<std::uint64_t, double> fresh_share;
+  for (std::size_t s = 0; s < net.spring_count(); ++s) {
+    fresh_share[static_cast<std::uint64_t>(net.spring_nodes[2 * s]) << 32 | net.spring_nodes[2 * s + 1]] = net.volume_share_m3[s];
+  }
+  const SpringNetwork& live = tissue.network();
+  std::size_t live_springs = 0;
+  for (std::size_t s = 0; s < live.spring_count(); ++s) {
+    if (!(live.volume_share_m3[s] > 0.0)) continue;
+    ++live_springs;
+    const std::uint32_t a = std::min(live.spring_nodes[2 * s], live.spring_nodes[2 * s + 1]);
+    const std::uint32_t b = std::max(live.spring_nodes[2 * s], live.spring_nodes[2 * s + 1]);
+    const auto it = fresh_share.find(static_cast<std::uint64_t>(a) << 32 | b);
+    ASSERT_NE(it, fresh_share.end()) << "a spring no live tetrahedron holds: " << a << "-" << b;
+    EXPECT_NEAR(live.volume_share_m3[s], it->second, 1e-12 * it->second);
+    EXPECT_GT(tissue.network().volume_share_m3[s], 0.0);
+  }
+  EXPECT_EQ(live_springs, fresh_share.size());
+  for (std::size_t n = 0; n < fresh.node_count(); ++n) EXPECT_NEAR(live.node_volume_m3[n], net.node_volume_m3[n], 1e-12 * net.node_volume_m3[n] + 1e-30);
+
+  std::multiset<std::array<std::uint32_t, 3>> expected, actual;
+  for (const Triangle& t : boundary_surface(fresh).triangles) expected.insert(canonical(t));
+  const SphereTree& tree = tissue.surface_tree();
+  for (std::size_t s = 0; s < tissue.surface().triangles.size(); ++s) {
+    const bool live_face = tissue.surface_face_owner(s) >= 0;
+    if (live_face) actual.insert(canonical(tissue.surface().triangles[s]));
+    EXPECT_EQ(tree.first_leaf_of_triangle(static_cast<std::uint32_t>(s)) != SphereTree::kNoNode, live_face) << "face slot " << s;
+  }
+  EXPECT_EQ(actual, expected);
+}
+
+void expect_tree_covers_its_leaves(const SphereTree& tree) {
+  // Every internal node's sphere holds its children's (hence every leaf below it).
+  for (std::int32_t n = 0; n < tree.node_capacity(); ++n) {
+    const SphereTreeLinks& link = tree.links()[static_cast<std::size_t>(n)];
+    if (tree.is_leaf(n) || link.right < 0) continue;
+    bool live = false;
+    for (std::int32_t r = n; r >= 0; r = tree.links()[static_cast<std::size_t>(r)].parent) live = live || r == tree.root();
+    if (!live) continue;
+    const Sphere& s = tree.spheres()[static_cast<std::size_t>(n)];
+    for (std::int32_t c : {link.left, link.right}) {
+      const Sphere& child = tree.spheres()[static_cast<std::size_t>(c)];
+      EXPECT_LE(length(child.center - s.center) + child.radius, s.radius * (1.0 + 1e-9) + 1e-12) << "node " << n;
+    }
+  }
+}
+
+/// Cuts a few sweeps through the 1296 gland with the wire at the channel wall.
+void cut_through_gland(Resection& resection, int steps) {
+  const std::vector<Vec3> arc = loop_cutting_arc();
+  SweptVolume sweep(arc.size());
+  std::vector<Vec3> from, to;
+  for (int step = 0; step < steps; ++step) {
+    from.clear();
+    to.clear();
+    // Wire in the plane z = const, hanging to the patient's left, drawn back from 30 to 14 mm.
+    for (const Vec3& p : arc) {
+      const Vec3 q{-p.y + 0.001, p.x, 0.0};
+      from.push_back(q + Vec3(0.0, 0.0, 0.030 - 0.001 * step));
+      to.push_back(q + Vec3(0.0, 0.0, 0.029 - 0.001 * step));
+    }
+    sweep.set(from, to, 0.0012);
+    (void)resection.step(&sweep, true, false, 1.0 / 60.0);
+  }
+}
+
+TEST(TissueEdits, AfterCutsTheTissueEqualsAFreshBuildAndTheTreeItsSurface) {
+  const ProstateTissueModel& model = tissue_model(1296);
+  MassSpringTissue tissue(model.mesh);
+  Resection resection(tissue);
+  cut_through_gland(resection, 12);
+  ASSERT_GT(resection.stats().removed_tetrahedra, 10);
+  ASSERT_GT(resection.stats().refined_tetrahedra, 10);
+  expect_matches_fresh_build(tissue);
+  tissue.collision_step();  // refit to the current positions
+  expect_tree_covers_its_leaves(tissue.surface_tree());
+}
+
+TEST(TissueEdits, CollisionPairsAfterCutsEqualBruteForce) {
+  const ProstateTissueModel& model = tissue_model(1296);
+  MassSpringTissue tissue(model.mesh);
+  Resection resection(tissue);
+  cut_through_gland(resection, 12);
+  tissue.collision_step();
+  const ResectoscopeModel tool = generate_resectoscope();
+  SphereTree tool_tree;
+  tool_tree.build(tool.loop);
+  Collider collider;
+  int poses_with_pairs = 0;
+  for (int k = 0; k < 24; ++k) {
+    // The loop swept along the cut, where new faces are.
+    RigidTransform pose;
+    const double rotation[3][3] = {{0.0, -1.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 0.0, 1.0}};  // the loop hangs toward +x
+    std::copy(&rotation[0][0], &rotation[0][0] + 9, &pose.rotation[0][0]);
+    pose.translation = Vec3(0.0005 * (k % 4), 0.0, 0.010 + 0.001 * k);
+    ASSERT_TRUE(collider.collide(tissue.surface_tree(), tissue.surface(), tool_tree, tool.loop, pose));
+    std::vector<TrianglePair> expected;
+    for (const TrianglePair& p : collide_brute_force(tissue.surface(), tool.loop, pose)) {
+      if (tissue.surface_face_owner(p.tissue) >= 0) expected.push_back(p);  // free slots hold no face
+    }
+    const std::vector<TrianglePair> found(collider.pairs().begin(), collider.pairs().end());
+    EXPECT_EQ(found, expected) << "pose " << k;
+    poses_with_pairs += !expected.empty();
+  }
+  EXPECT_GT(poses_with_pairs, 0);
+}
+
+TEST(TissueEdits, RefinementAlonePreservesMassAndUniformStrainStiffness) {
+  const ProstateTissueModel& model = tissue_model(1296);
+  MassSpringTissue tissue(model.mesh);
+  auto stiffness_sum = [&] {  // sum k L0^2 = E * volume for any refinement (springs.h)
+    double sum = 0.0;
+    for (std::size_t i = 0; i < tissue.network().spring_count(); ++i) {
+      const double share = tissue.network().volume_share_m3[i];
+      if (share > 0.0) sum += edge_spring_constant(tissue.parameters().si(TissueParameter::kStiffness), share, tissue.network().rest_length_m[i]) *
+                              tissue.network().rest_length_m[i] * tissue.network().rest_length_m[i];
+    }
+    return sum;
+  };
+  const double mass0 = tissue.total_mass_kg(), stiffness0 = stiffness_sum();
+  TetRefiner refiner(tissue.node_capacity(), tissue.topology().tetrahedron_capacity());
+  std::vector<std::uint32_t> marked;
+  for (std::uint32_t t = 0; t < 400; t += 7) marked.push_back(t);
+  for (int round = 0; round < 2; ++round) {
+    const TetTopology& topo = tissue.topology();
+    const RefinementEdit& edit = refiner.plan({tissue.rest_positions(), topo.tetrahedra(), topo.alive_flags(), topo.regions()}, marked);
+    ASSERT_TRUE(tissue.can_edit(edit.new_node_parents.size(), edit.added_tetrahedra.size(), edit.removed_tetrahedra.size()));
+    tissue.add_midpoint_nodes(edit.new_node_parents);
+    ASSERT_FALSE(tissue.edit_tetrahedra(edit.removed_tetrahedra, edit.added_tetrahedra, edit.added_regions).refused);
+    marked.assign(tissue.added_slots().begin(), tissue.added_slots().begin() + 40);
+  }
+  EXPECT_GT(tissue.node_count(), model.mesh.node_count());
+  EXPECT_NEAR(tissue.total_mass_kg(), mass0, 1e-12 * mass0);
+  EXPECT_NEAR(stiffness_sum(), stiffness0, 1e-12 * stiffness0);
+  expect_matches_fresh_build(tissue);
+}
+
+}  // namespace
+}  // namespace resecto
