@@ -57,7 +57,7 @@ void BM_TopologyUpdateWhileCutting(benchmark::State& state) {
     for (std::uint64_t tick = 0; tick < ticks; ++tick) {
       const TickInput input = procedure_input(procedure, tick, tick_s);
       // Only collision ticks with the pedal down reach the profiler: those are the cutting updates.
-      const bool cutting_tick = sim->is_collision_tick(tick) && (input.pedals & kPedalCut) != 0;
+      const bool cutting_tick = sim->is_collision_tick(tick) && input.cut;
       if (!cutting_tick) {
         sim->step(input, {});
         continue;

@@ -209,7 +209,7 @@ TEST(Simulation, SteadyStateTickAllocatesNothingAndTakesNoLock) {
   // a decayed sphere tree's rebuild at a collision tick does).
   auto pressing = [h](std::uint64_t tick) {
     TickInput input = input_at(tick, h);
-    input.pedals = 0;
+    input.cut = false;
     return input;
   };
   // Warm up: the first contacts size the buffers that later ticks reuse.
