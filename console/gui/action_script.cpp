@@ -60,9 +60,11 @@ Result<std::vector<Action>> parse_actions(const std::string& text, const std::st
     a.line = number;
     a.words.assign(words.begin() + 3, words.end());
     if (a.words.size() < spec->min_words || a.words.size() > spec->max_words) {
-      return Error{where + "'" + words[2] + "' takes " + std::to_string(spec->min_words) +
-                   (spec->max_words != spec->min_words ? "-" + std::to_string(spec->max_words) : std::string()) + " argument(s), got " +
-                   std::to_string(a.words.size())};
+      // Appended piece by piece: `"-" + std::to_string(n)` trips GCC 12's -Wrestrict false positive at -O3.
+      std::string message = where + "'" + words[2] + "' takes " + std::to_string(spec->min_words);
+      if (spec->max_words != spec->min_words) message.append("-").append(std::to_string(spec->max_words));
+      message.append(" argument(s), got ").append(std::to_string(a.words.size()));
+      return Error{message};
     }
     switch (a.verb) {
       case ActionVerb::kSet:
