@@ -30,20 +30,37 @@ std::size_t cell_of(const ResectionHeatMap& grid, const Vec3& p) {
 
 }  // namespace
 
+/// Adds `volume` to the cells of the tetrahedron (a, b, c, d) as its red refinement `depth` levels
+/// down would hold it: Bey's eight equal children (four corners, the octahedron's four around its
+/// m02-m13 diagonal), each binned at its centroid at the last level.
+void spread_tetrahedron(const ResectionHeatMap& grid, std::vector<double>& cells, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
+                        double volume, int depth) {
+  if (depth == 0) {
+    cells[cell_of(grid, 0.25 * (a + b + c + d))] += volume;
+    return;
+  }
+  const Vec3 ab = 0.5 * (a + b), ac = 0.5 * (a + c), ad = 0.5 * (a + d), bc = 0.5 * (b + c), bd = 0.5 * (b + d), cd = 0.5 * (c + d);
+  const double eighth = 0.125 * volume;
+  spread_tetrahedron(grid, cells, a, ab, ac, ad, eighth, depth - 1);
+  spread_tetrahedron(grid, cells, ab, b, bc, bd, eighth, depth - 1);
+  spread_tetrahedron(grid, cells, ac, bc, c, cd, eighth, depth - 1);
+  spread_tetrahedron(grid, cells, ad, bd, cd, d, eighth, depth - 1);
+  const Vec3 equator[4] = {ab, ad, cd, bc};
+  for (int k = 0; k < 4; ++k) spread_tetrahedron(grid, cells, ac, bd, equator[k], equator[(k + 1) % 4], eighth, depth - 1);
+}
+
 void rasterize_tissue(const MassSpringTissue& tissue, const ResectionHeatMap& grid, std::vector<double>& adenoma_m3, std::vector<double>& capsule_m3) {
+  // Each tetrahedron spread as two levels of red refinement would split it (64 equal parts), so the
+  // refinement near the loop, which splits the same way down to two levels, moves almost nothing
+  // between cells, where one point per tetrahedron would move whole coarse tetrahedra.
+  constexpr int kSpreadDepth = 2;
   const TetTopology& topology = tissue.topology();
   const std::span<const Vec3> rest = tissue.rest_positions();
   for (std::uint32_t t = 0; t < topology.slot_count(); ++t) {
     if (!topology.alive(t)) continue;
     const Tetrahedron& tet = topology.tetrahedron(t);
     std::vector<double>& cells = topology.region(t) == TissueRegion::kAdenoma ? adenoma_m3 : capsule_m3;
-    const double volume = tissue.rest_volume_m3(t);
-    // A tetrahedron is spread as its 1:8 split would be: each corner child (an eighth) at its centroid,
-    // the central octahedron (half) at the tetrahedron's centroid. Refinement then moves almost nothing
-    // between cells, where one point per tetrahedron would move whole coarse tetrahedra.
-    const Vec3 sum = rest[tet[0]] + rest[tet[1]] + rest[tet[2]] + rest[tet[3]];
-    cells[cell_of(grid, 0.25 * sum)] += 0.5 * volume;
-    for (int corner = 0; corner < 4; ++corner) cells[cell_of(grid, (4.0 * rest[tet[static_cast<std::size_t>(corner)]] + sum) / 8.0)] += 0.125 * volume;
+    spread_tetrahedron(grid, cells, rest[tet[0]], rest[tet[1]], rest[tet[2]], rest[tet[3]], tissue.rest_volume_m3(t), kSpreadDepth);
   }
 }
 

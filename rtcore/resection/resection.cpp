@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
 
 namespace resecto {
 namespace {
@@ -26,10 +28,13 @@ Resection::Resection(MassSpringTissue& tissue, const ResectionConfig& config)
   const TetTopology& topo = tissue_.topology();
   const std::size_t slots = topo.tetrahedron_capacity();
   const std::size_t nodes = tissue_.node_capacity();
+  slot_longest_.assign(slots, 0.0);
+  node_reach_.assign(nodes, 0.0);
   for (std::uint32_t t = 0; t < topo.slot_count(); ++t) {
     if (!topo.alive(t)) continue;
     stats_.initial_m3[static_cast<std::size_t>(topo.region(t))] += tissue_.rest_volume_m3(t);
-    reach_m_ = std::max(reach_m_, longest_rest_edge(t));
+    slot_longest_[t] = longest_rest_edge(t);
+    for (std::uint32_t n : topo.tetrahedron(t)) node_reach_[n] = std::max(node_reach_[n], slot_longest_[t]);
   }
   // The outer surface: initial faces not facing the channel's axis; its nodes, less the rim's.
   outer_node_.assign(nodes, 0);
@@ -47,6 +52,50 @@ Resection::Resection(MassSpringTissue& tissue, const ResectionConfig& config)
     for (std::uint32_t v : tri) (channel ? on_channel[v] : outer_node_[v]) = 1;
   }
   for (std::size_t v = 0; v < nodes; ++v) outer_node_[v] = outer_node_[v] && !on_channel[v];
+
+  // Dijkstra from every anchored node over the springs at rest length, ties by node: deterministic.
+  anchor_distance_.assign(nodes, std::numeric_limits<double>::infinity());
+  {
+    const SpringNetwork& network = tissue_.network();
+    std::vector<std::uint32_t> first(rest.size() + 1, 0), other;  // each node's springs' other ends
+    std::vector<double> length;
+    for (std::size_t s = 0; s < network.spring_count(); ++s) {
+      ++first[network.spring_nodes[2 * s] + 1];
+      ++first[network.spring_nodes[2 * s + 1] + 1];
+    }
+    for (std::size_t n = 0; n < rest.size(); ++n) first[n + 1] += first[n];
+    other.resize(first.back());
+    length.resize(first.back());
+    std::vector<std::uint32_t> cursor(first.begin(), first.end() - 1);
+    for (std::size_t s = 0; s < network.spring_count(); ++s) {
+      const std::uint32_t a = network.spring_nodes[2 * s], b = network.spring_nodes[2 * s + 1];
+      other[cursor[a]] = b, length[cursor[a]++] = network.rest_length_m[s];
+      other[cursor[b]] = a, length[cursor[b]++] = network.rest_length_m[s];
+    }
+    std::vector<std::pair<double, std::uint32_t>> heap;
+    for (std::uint32_t n = 0; n < rest.size(); ++n) {
+      if (tissue_.anchored(n)) {
+        anchor_distance_[n] = 0.0;
+        heap.push_back({0.0, n});
+      }
+    }
+    std::make_heap(heap.begin(), heap.end(), std::greater<>());
+    auto relax = [&](std::uint32_t to, double d) {
+      if (d < anchor_distance_[to]) {
+        anchor_distance_[to] = d;
+        heap.push_back({d, to});
+        std::push_heap(heap.begin(), heap.end(), std::greater<>());
+      }
+    };
+    while (!heap.empty()) {
+      std::pop_heap(heap.begin(), heap.end(), std::greater<>());
+      const auto [d, n] = heap.back();
+      heap.pop_back();
+      if (d > anchor_distance_[n]) continue;
+      for (std::uint32_t e = first[n]; e < first[n + 1]; ++e) relax(other[e], d + length[e]);
+    }
+  }
+  frontier_.reserve(slots);
 
   candidates_.reserve(slots);
   marked_.reserve(slots);
@@ -167,26 +216,43 @@ ResectionStep Resection::step(const SweptVolume* sweep, bool pedal_down, bool di
 }
 
 void Resection::gather_candidates(const SweptVolume& sweep) {
-  // Every live tetrahedron with a node within the largest edge of the volume's box: a tetrahedron
-  // whose centroid is inside the box has all its nodes that close (deformation aside, which the
-  // initial longest edge covers many times over for the loop's small region).
+  // Every live tetrahedron whose centroid may be within a quarter of its longest edge of the path
+  // (refine_near marks within that, and the cut needs the centroid inside). A centroid lies within
+  // 3/4 of the tetrahedron's longest current edge of each of its nodes, so the nodes to start from
+  // are those within kNodeReach times their reach (the longest rest edge around them) of the path:
+  // exact while no edge is stretched past 1.5 times its rest length, far beyond what the penalty
+  // contact lets the tissue do. Only those nodes' stars are read, so the cost follows the loop's
+  // neighbourhood, not the gland's size.
+  constexpr double kNodeReach = 0.25 + 0.75 * 1.5;
   candidates_.clear();
   const std::uint32_t stamp = next_stamp();
-  Aabb box = sweep.bounds();
-  box.min -= Vec3(reach_m_);
-  box.max += Vec3(reach_m_);
   const TetTopology& topo = tissue_.topology();
   std::span<const Vec3> x = tissue_.positions();
+  const double radius = sweep.radius();
   for (std::uint32_t n = 0; n < x.size(); ++n) {
-    const Vec3& p = x[n];
-    if (p.x < box.min.x || p.y < box.min.y || p.z < box.min.z || p.x > box.max.x || p.y > box.max.y || p.z > box.max.z) continue;
+    if (!sweep.may_be_within(x[n], radius + kNodeReach * node_reach_[n])) continue;
     topo.for_each_tetrahedron_of(n, [&](std::uint32_t t) {
       if (slot_stamp_[t] == stamp) return;
       slot_stamp_[t] = stamp;
-      candidates_.push_back(t);
+      if (sweep.may_be_within(centroid(t), radius + 0.25 * slot_longest_[t])) candidates_.push_back(t);
     });
   }
   std::sort(candidates_.begin(), candidates_.end());
+}
+
+void Resection::note_refinement(std::span<const std::uint32_t> added_slots) {
+  const TetTopology& topo = tissue_.topology();
+  for (std::uint32_t t : added_slots) slot_longest_[t] = longest_rest_edge(t);
+  const std::uint32_t stamp = next_stamp();
+  for (std::uint32_t t : added_slots) {
+    for (std::uint32_t n : topo.tetrahedron(t)) {
+      if (node_stamp_[n] == stamp) continue;
+      node_stamp_[n] = stamp;
+      double reach = 0.0;
+      topo.for_each_tetrahedron_of(n, [&](std::uint32_t s) { reach = std::max(reach, slot_longest_[s]); });
+      node_reach_[n] = reach;
+    }
+  }
 }
 
 int Resection::refine_near(const SweptVolume& sweep) {
@@ -199,7 +265,7 @@ int Resection::refine_near(const SweptVolume& sweep) {
       // A closure's children are not refined again (their parent's split is not regular; splitting
       // them spreads closures outward without end), nor tetrahedra already at the deepest level.
       if (!topo.alive(t) || slot_closure_[t] || slot_level_[t] >= config_.max_refinement_levels) continue;
-      const double longest = longest_rest_edge(t);
+      const double longest = slot_longest_[t];
       if (longest <= target) continue;
       // Only where the cut surface will run: a centroid within a quarter edge of the volume's rim.
       if (sweep.within(centroid(t), sweep.radius() + 0.25 * longest)) marked_.push_back(t);
@@ -224,6 +290,7 @@ int Resection::refine_near(const SweptVolume& sweep) {
     for (std::size_t k = 0; k < edit.new_node_parents.size(); ++k) {
       const auto& [a, b] = edit.new_node_parents[k];
       outer_node_[edit.first_new_node + k] = outer_node_[a] && outer_node_[b];
+      anchor_distance_[edit.first_new_node + k] = 0.5 * (anchor_distance_[a] + anchor_distance_[b]);
     }
     const TopologyChange change = tissue_.edit_tetrahedra(edit.removed_tetrahedra, edit.added_tetrahedra, edit.added_regions);
     if (change.refused) {
@@ -231,6 +298,7 @@ int Resection::refine_near(const SweptVolume& sweep) {
       break;
     }
     refined += edit.red_tetrahedra + edit.closure_tetrahedra;
+    note_refinement(tissue_.added_slots());
     for (std::size_t k = 0; k < tissue_.added_slots().size(); ++k) {
       const std::uint32_t t = tissue_.added_slots()[k];
       slot_level_[t] = static_cast<std::uint8_t>(child_info_[k] & 0x7f);
@@ -398,30 +466,55 @@ void Resection::remove_hanging(ResectionStep& out) {
 }
 
 bool Resection::remove_chips(ResectionStep& out) {
-  // From each live neighbour of what was removed, by slot: flood through faces until an anchored
-  // node shows the component is held; a component that runs out first is a chip.
+  // From each live neighbour of what was removed, by slot: a best-first walk through faces, nearest
+  // the anchors first, until an anchored node, or a tetrahedron an earlier walk of this pass found
+  // held, shows the component is held; a component that runs out first is a chip. The walk's order
+  // (distance, then slot) is fixed, so the result is the same every run; only the cost depends on
+  // the guide, and a held component usually shows itself within a few dozen tetrahedra.
   const TetTopology& topo = tissue_.topology();
   bool any = false;
   sort_unique(seeds_);
-  const std::uint32_t stamp = next_stamp();
+  if (stamp_ > 0xF0000000u) {  // each walk takes a stamp; keep this pass's stamps ordered
+    std::fill(slot_stamp_.begin(), slot_stamp_.end(), 0u);
+    std::fill(node_stamp_.begin(), node_stamp_.end(), 0u);
+    stamp_ = 0;
+  }
+  const std::uint32_t pass = stamp_ + 1;  // stamps of this pass's walks are >= pass
   next_nodes_.clear();  // the seeds, copied: remove() appends to seeds_
   for (std::uint32_t s : seeds_) next_nodes_.push_back(s);
   seeds_.clear();
+  auto priority = [&](std::uint32_t t) {
+    double d = std::numeric_limits<double>::infinity();
+    for (std::uint32_t n : topo.tetrahedron(t)) d = std::min(d, anchor_distance_[n]);
+    return std::pair<double, std::uint32_t>{d, t};
+  };
   for (std::uint32_t seed : next_nodes_) {
-    if (!topo.alive(seed) || slot_stamp_[seed] == stamp) continue;
-    queue_.clear();
+    if (!topo.alive(seed) || slot_stamp_[seed] >= pass) continue;
+    const std::uint32_t walk = next_stamp();
+    queue_.clear();  // every tetrahedron this walk reached
+    frontier_.clear();
+    slot_stamp_[seed] = walk;
     queue_.push_back(seed);
-    slot_stamp_[seed] = stamp;
+    frontier_.push_back(priority(seed));
     bool held = false;
-    for (std::size_t q = 0; q < queue_.size() && !held; ++q) {
-      const std::uint32_t t = queue_[q];
+    while (!frontier_.empty() && !held) {
+      std::pop_heap(frontier_.begin(), frontier_.end(), std::greater<>());
+      const std::uint32_t t = frontier_.back().second;
+      frontier_.pop_back();
       for (std::uint32_t n : topo.tetrahedron(t)) held = held || tissue_.anchored(n);
-      if (held) break;
-      for (int f = 0; f < 4; ++f) {
+      for (int f = 0; f < 4 && !held; ++f) {
         const std::int32_t n = topo.neighbor(t, f);
-        if (n == TetTopology::kNone || slot_stamp_[static_cast<std::uint32_t>(n)] == stamp) continue;
-        slot_stamp_[static_cast<std::uint32_t>(n)] = stamp;
-        queue_.push_back(static_cast<std::uint32_t>(n));
+        if (n == TetTopology::kNone) continue;
+        const auto u = static_cast<std::uint32_t>(n);
+        if (slot_stamp_[u] == walk) continue;
+        if (slot_stamp_[u] >= pass) {
+          held = true;  // an earlier walk's: every chip it found is gone, so this one was held
+          break;
+        }
+        slot_stamp_[u] = walk;
+        queue_.push_back(u);
+        frontier_.push_back(priority(u));
+        std::push_heap(frontier_.begin(), frontier_.end(), std::greater<>());
       }
     }
     if (held) continue;

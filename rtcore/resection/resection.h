@@ -19,6 +19,7 @@
 
 #include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "rtcore/resection/swept_volume.h"
@@ -107,6 +108,9 @@ class Resection {
   bool remove_chips(ResectionStep& out);
   Vec3 centroid(std::uint32_t t) const;
   double longest_rest_edge(std::uint32_t t) const;
+  /// Renews slot_longest_ for slots a refinement added and node_reach_ for every node they hold
+  /// (which includes every node of the slots it removed: children keep their parents' corners).
+  void note_refinement(std::span<const std::uint32_t> added_slots);
   std::uint32_t next_stamp();
 
   MassSpringTissue& tissue_;
@@ -114,7 +118,15 @@ class Resection {
   TetRefiner refiner_;
   ResectionStats stats_;
   std::vector<std::uint8_t> outer_node_;  // per node (capacity)
-  double reach_m_ = 0.0;                  // the largest rest edge at the start (candidate search margin)
+  // The candidate search's margins, kept for live slots and nodes as edits go: each slot's longest
+  // rest edge, and each node's longest rest edge over the slots around it.
+  std::vector<double> slot_longest_;  // per slot (capacity)
+  std::vector<double> node_reach_;    // per node (capacity)
+  // The chip search's guide: each node's rest path length along edges to the nearest anchored node
+  // at the start (a midpoint takes its parents' mean), so a held component shows itself after a
+  // short walk outward instead of a flood.
+  std::vector<double> anchor_distance_;  // per node (capacity)
+  std::vector<std::pair<double, std::uint32_t>> frontier_;  // best-first heap: (distance, slot)
   // Stroke state.
   bool in_stroke_ = false, stroke_cut_ = false, stroke_perforated_ = false, stroke_distal_ = false;
   // Scratch, reserved for the capacities.

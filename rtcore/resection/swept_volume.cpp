@@ -10,7 +10,10 @@
 
 namespace resecto {
 
-SweptVolume::SweptVolume(std::size_t max_points) { quads_.reserve(max_points); }
+SweptVolume::SweptVolume(std::size_t max_points) {
+  quads_.reserve(max_points);
+  groups_.reserve(max_points / kGroupSize + 1);
+}
 
 void SweptVolume::set(std::span<const Vec3> from, std::span<const Vec3> to, double radius_m) {
   quads_.clear();
@@ -31,6 +34,15 @@ void SweptVolume::set(std::span<const Vec3> from, std::span<const Vec3> to, doub
     q.centre = 0.25 * (q.a0 + q.a1 + q.b1 + q.b0);
     for (const Vec3& p : {q.a0, q.a1, q.b1, q.b0}) q.reach = std::max(q.reach, length(p - q.centre));
     quads_.push_back(q);
+  }
+  groups_.clear();
+  for (std::size_t first = 0; first < quads_.size(); first += kGroupSize) {
+    const std::size_t end = std::min(quads_.size(), first + kGroupSize);
+    Group g{Vec3(0.0), 0.0, static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(end)};
+    for (std::size_t k = first; k < end; ++k) g.centre += quads_[k].centre;
+    g.centre /= static_cast<double>(end - first);
+    for (std::size_t k = first; k < end; ++k) g.reach = std::max(g.reach, length(quads_[k].centre - g.centre) + quads_[k].reach);
+    groups_.push_back(g);
   }
 }
 
@@ -55,10 +67,33 @@ bool SweptVolume::within(const Vec3& p, double reach) const {
     return false;
   }
   const double reach2 = reach * reach;
-  for (const Quad& q : quads_) {
-    if (length(p - q.centre) - q.reach > reach) continue;
-    for (const Vec3& c : {closest_point_on_triangle(p, q.a0, q.a1, q.b1), closest_point_on_triangle(p, q.a0, q.b1, q.b0)}) {
-      if (length_squared(p - c) <= reach2) return true;
+  for (const Group& g : groups_) {
+    const double group_bound = g.reach + reach;
+    if (length_squared(p - g.centre) > group_bound * group_bound) continue;
+    for (std::uint32_t k = g.first; k < g.end; ++k) {
+      const Quad& q = quads_[k];
+      const double bound = q.reach + reach;
+      if (length_squared(p - q.centre) > bound * bound) continue;
+      for (const Vec3& c : {closest_point_on_triangle(p, q.a0, q.a1, q.b1), closest_point_on_triangle(p, q.a0, q.b1, q.b0)}) {
+        if (length_squared(p - c) <= reach2) return true;
+      }
+    }
+  }
+  return false;
+}
+
+bool SweptVolume::may_be_within(const Vec3& p, double reach) const {
+  const double grow = std::max(0.0, reach - radius_m_);
+  if (p.x < bounds_.min.x - grow || p.y < bounds_.min.y - grow || p.z < bounds_.min.z - grow || p.x > bounds_.max.x + grow ||
+      p.y > bounds_.max.y + grow || p.z > bounds_.max.z + grow) {
+    return false;
+  }
+  for (const Group& g : groups_) {
+    const double group_bound = g.reach + reach;
+    if (length_squared(p - g.centre) > group_bound * group_bound) continue;
+    for (std::uint32_t k = g.first; k < g.end; ++k) {
+      const double bound = quads_[k].reach + reach;
+      if (length_squared(p - quads_[k].centre) <= bound * bound) return true;
     }
   }
   return false;

@@ -27,6 +27,9 @@ class SweptVolume {
   /// Whether p is within `reach` of the wire's path (path_distance(p) <= reach), answered early: a
   /// box test first, then the first ribbon that close.
   bool within(const Vec3& p, double reach) const;
+  /// A cheap necessary condition for within(p, reach): p is inside some ribbon's bounding sphere grown
+  /// by `reach` (no closest-point work; for filtering many points before the exact test).
+  bool may_be_within(const Vec3& p, double reach) const;
   double radius() const { return radius_m_; }
   /// The volume's bounding box (the path's, grown by the radius).
   const Aabb& bounds() const { return bounds_; }
@@ -40,7 +43,15 @@ class SweptVolume {
     Vec3 centre;
     double reach;  // every point of the quad is within this of centre
   };
+  /// Consecutive quads in fours under one bounding sphere, so a far point costs a few tests.
+  struct Group {
+    Vec3 centre;
+    double reach;  // every point of its quads is within this of centre
+    std::uint32_t first, end;
+  };
+  static constexpr std::size_t kGroupSize = 4;
   std::vector<Quad> quads_;
+  std::vector<Group> groups_;
   double radius_m_ = 0.0;
   Aabb bounds_;
 };

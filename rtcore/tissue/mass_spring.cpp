@@ -153,7 +153,18 @@ void MassSpringTissue::begin_collision_step() {
   tool_.latch_query_poses(travel_m_);
 }
 
-void MassSpringTissue::refit_surface_tree() { surface_tree_.refit(surface_); }
+void MassSpringTissue::refit_surface_tree() {
+  // Edits insert and remove leaves in O(log n) each, which can unbalance the tree over many cuts;
+  // judging that (a pass over the tree) and rebuilding belong here, off the core's tick, once per
+  // collision step rather than once per edit. The refit after a rebuild makes every node's sphere
+  // hold its children's (a build bounds the triangles below, which a child's sphere may exceed).
+  if (surface_tree_edited_ && surface_tree_.should_rebuild()) {
+    surface_tree_.rebuild(surface_);
+    ++surface_tree_rebuilds_;
+  }
+  surface_tree_edited_ = false;
+  surface_tree_.refit(surface_);
+}
 
 void MassSpringTissue::search_contact_candidates() { tool_.search_candidates(surface_tree_, surface_); }
 

@@ -99,7 +99,8 @@ class MassSpringTissue {
   /// Takes the node positions and the tool's poses the refit and search will use. Call between
   /// physics steps while no refit or search runs.
   void begin_collision_step();
-  /// Refits the surface's sphere tree to the positions taken by begin_collision_step(). Reads and
+  /// Refits the surface's sphere tree to the positions taken by begin_collision_step(), or rebuilds
+  /// it when edits since the last search have decayed it (SphereTree::should_rebuild). Reads and
   /// writes nothing a physics step touches.
   void refit_surface_tree();
   /// Finds the tool's candidate pairs against the refitted tree, into the tool's back buffer.
@@ -128,7 +129,7 @@ class MassSpringTissue {
   /// Removes the live slots `removed`, then adds `added` (with their regions): springs whose edge no
   /// live tetrahedron holds go, new edges get springs, masses, spring constants and bounds are
   /// recomputed at the touched nodes and springs, faces leave and join the surface and its sphere
-  /// tree (insert/remove; rebuilt only when should_rebuild()), contact candidates on changed faces and
+  /// tree (insert/remove; the next search rebuilds it if that decayed it), contact candidates on changed faces and
   /// orphaned nodes are dropped and every clearance certificate voided, the topology hash renewed.
   /// Refused (nothing changes) when it does not fit the capacities. The added slots are listed by
   /// added_slots() until the next edit.
@@ -144,8 +145,9 @@ class MassSpringTissue {
   std::size_t surface_face_count() const { return surface_faces_; }
   std::size_t surface_face_capacity() const { return surface_face_capacity_; }
   std::size_t node_capacity() const { return topology_.node_capacity(); }
-  /// Rebuilds of the surface's sphere tree after edits decayed it (SphereTree::should_rebuild); the
-  /// only part of an edit that allocates (the tree's build scratch).
+  /// Rebuilds of the surface's sphere tree after edits decayed it (SphereTree::should_rebuild), done
+  /// by the search (refit_surface_tree), so on the collision thread where there is one; the rebuild
+  /// allocates its build scratch. Read it while no search runs.
   std::int64_t surface_tree_rebuilds() const { return surface_tree_rebuilds_; }
   /// Bumped by every edit that changed the surface.
   std::uint64_t topology_version() const { return topology_version_; }
@@ -239,6 +241,7 @@ class MassSpringTissue {
   std::uint64_t topology_hash_ = 0;  // of the live tetrahedra and the surface's faces, kept per edit
   std::uint64_t topology_version_ = 0;
   std::int64_t surface_tree_rebuilds_ = 0;
+  bool surface_tree_edited_ = false;  // an edit since the last search: the search judges the tree
   TetTopology topology_;
   // Surface bookkeeping: per face slot, its owner 4 t + f (-1 free); per tetrahedron face, its slot.
   std::vector<std::int64_t> face_owner_;

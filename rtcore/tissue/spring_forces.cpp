@@ -85,6 +85,44 @@ void SpringForces::rebuild_incidence(std::size_t nodes) {
   for (std::size_t s = 0; s < count; ++s) in.second_springs[fill_[arrays_.j[s]]++] = static_cast<std::uint32_t>(s);
 }
 
+void SpringForces::add_nodes(std::size_t count) {
+  // A new node holds no spring yet: empty ranges at the end.
+  for (std::size_t k = 0; k < count; ++k) {
+    incidence_.first_first.push_back(incidence_.first_first.back());
+    incidence_.second_first.push_back(incidence_.second_first.back());
+  }
+}
+
+void SpringForces::add_appended_to_incidence(std::size_t first_new) {
+  // Every appended spring's index exceeds every listed one, so it goes at the end of its nodes'
+  // lists and each list stays ascending: the same lists rebuild_incidence would make, formed by
+  // moving each node's block of the second lists once, back to front (no scattered writes).
+  SpringIncidence& in = incidence_;
+  const std::size_t count = arrays_.i.size();
+  const std::size_t nodes = in.first_first.size() - 1;
+  if (first_new >= count) return;
+  // First lists: the appended springs hold node i's above every earlier one's (append()).
+  std::size_t s = in.first_first[arrays_.i[first_new]];
+  for (std::size_t n = arrays_.i[first_new]; n < nodes; ++n) {
+    while (s < count && arrays_.i[s] == n) ++s;
+    in.first_first[n + 1] = static_cast<std::uint32_t>(s);
+  }
+  // Second lists: each node's block moves up by the appended springs of the nodes before it.
+  fill_.assign(nodes, 0);
+  for (std::size_t t = first_new; t < count; ++t) ++fill_[arrays_.j[t]];
+  const std::size_t old_total = in.second_springs.size();
+  in.second_springs.resize(old_total + (count - first_new));
+  std::size_t shift = count - first_new;
+  for (std::size_t n = nodes; n-- > 0 && shift > 0;) {
+    shift -= fill_[n];  // the appended springs of nodes [0, n)
+    const std::uint32_t begin = in.second_first[n], end = in.second_first[n + 1];
+    std::copy_backward(in.second_springs.begin() + begin, in.second_springs.begin() + end, in.second_springs.begin() + end + shift);
+    in.second_first[n + 1] = static_cast<std::uint32_t>(end + shift + fill_[n]);
+    fill_[n] = static_cast<std::uint32_t>(end + shift);  // where n's appended springs go
+  }
+  for (std::size_t t = first_new; t < count; ++t) in.second_springs[fill_[arrays_.j[t]]++] = static_cast<std::uint32_t>(t);
+}
+
 void SpringForces::add_compression_bounds(const Vec3* x, double* stiffness_bound, std::size_t count) const {
   // Spring order: each node's bound sums its springs' excesses in the same order every run.
   for (std::size_t listed = 0; listed < count; ++listed) {

@@ -42,9 +42,15 @@ class SpringForces {
   /// (refinement's springs all hold a node newer than any before, so i is that node); then the
   /// springs stay sorted by i and each node's i-range stays contiguous.
   void append(std::uint32_t i, std::uint32_t j, double rest_m);
-  /// Recounts the incidence over `node_count` nodes after appends (counting sort, no allocation
-  /// within the reserved room).
+  /// Recounts the incidence over `node_count` nodes (counting sort, no allocation within the
+  /// reserved room).
   void rebuild_incidence(std::size_t node_count);
+  /// Extends the incidence by `count` new nodes that hold no spring yet.
+  void add_nodes(std::size_t count);
+  /// Lists springs [first_new, spring_count()), appended since the incidence was last complete, in
+  /// their nodes' lists: the incidence rebuild_incidence would make, at the cost of moving the
+  /// second lists once rather than recounting every spring.
+  void add_appended_to_incidence(std::size_t first_new);
 
   /// Adds, in spring order, the Hessian-norm excess of each spring compressed below half its rest
   /// length to both its nodes' stiffness bounds (k |1 - L0/L| exceeds the k already counted): the

@@ -259,7 +259,7 @@ void MassSpringTissue::add_midpoint_nodes(std::span<const std::array<std::uint32
     }
     topology_.add_node();
   }
-  springs_.rebuild_incidence(x_.size());
+  springs_.add_nodes(parents.size());
 }
 
 TopologyChange MassSpringTissue::edit_tetrahedra(std::span<const std::uint32_t> removed, std::span<const Tetrahedron> added,
@@ -385,6 +385,7 @@ TopologyChange MassSpringTissue::edit_tetrahedra(std::span<const std::uint32_t> 
 
   // 3. New springs, sorted by (i, j) and appended: the springs stay sorted by node i.
   if (!new_springs_.empty()) {
+    const std::size_t first_new = springs_.spring_count();
     std::sort(new_springs_.begin(), new_springs_.end(), [](const NewSpring& x, const NewSpring& y) { return x.i != y.i ? x.i < y.i : x.j < y.j; });
     for (const NewSpring& ns : new_springs_) {
       const auto s = static_cast<std::uint32_t>(springs_.spring_count());
@@ -400,7 +401,7 @@ TopologyChange MassSpringTissue::edit_tetrahedra(std::span<const std::uint32_t> 
       insert_spring_key(ns.i, ns.j, s);
       touch_spring(s);
     }
-    springs_.rebuild_incidence(x_.size());
+    springs_.add_appended_to_incidence(first_new);
     change.springs_added = static_cast<std::int32_t>(new_springs_.size());
   }
 
@@ -440,10 +441,7 @@ TopologyChange MassSpringTissue::edit_tetrahedra(std::span<const std::uint32_t> 
   for (std::uint32_t n : touched_nodes_) dead_node_[n] = 0;
   if (change.surface_faces_added + change.surface_faces_removed > 0) {
     ++topology_version_;
-    if (surface_tree_.should_rebuild()) {
-      surface_tree_.rebuild(surface_);
-      ++surface_tree_rebuilds_;
-    }
+    surface_tree_edited_ = true;  // the search's refit judges its quality (refit_surface_tree)
   }
   return change;
 }

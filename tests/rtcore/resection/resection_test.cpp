@@ -196,11 +196,17 @@ TEST(Resection, TwoRunsWithCutsGiveTheSameHashAtEveryCollisionStep) {
 }
 
 TEST(Resection, PhysicsTicksWhileCuttingAllocateNothingAndNoTickLocks) {
-  // The physics ticks between collision ticks (with the search running on its thread) allocate
-  // nothing; no tick takes a lock. The collision ticks' topology updates are counted and printed: a
+  // The physics ticks between collision ticks allocate nothing; no tick takes a lock. The collision ticks' topology updates are counted and printed: a
   // decayed sphere tree's rebuild allocates its build scratch, and a few updates still allocate a
   // little (README "Resection", what is not done).
-  auto sim = small_simulation();
+  // The search runs inside the step (no collision thread), so an allocation, and a sphere-tree
+  // rebuild, land in the tick that caused them.
+  SimulationConfig config;
+  config.prostate_triangles = 1296;
+  config.collision_thread = false;
+  auto created = Simulation::create(config);
+  ASSERT_TRUE(created) << created.error();
+  auto sim = std::move(*created);
   const Procedure p = left_lobe_stroke(true, "1.0", true);
   const double tick_s = sim->config().tick_s();
   const auto ticks = static_cast<std::uint64_t>(std::llround(p.duration_s() / tick_s));

@@ -92,5 +92,46 @@ TEST(SpringKernel, NodeSumsAddEachSpringOnceWithOppositeSigns) {
   for (std::size_t n = 0; n < x.size(); ++n) ASSERT_EQ(summed[n], scattered[n]) << "node " << n;
 }
 
+TEST(SpringIncidence, AppendedSpringsListedAsARebuildListsThem) {
+  // Resection appends nodes, then springs whose node i is newer than any before (refinement's
+  // midpoints); the incremental listing must be exactly the counting sort's, list for list.
+  const ProstateTissueModel& model = tissue_model(1296);
+  const SpringNetwork network = build_spring_network(model.mesh);
+  SpringForces incremental(network), rebuilt(network);
+  std::size_t nodes = network.node_volume_m3.size();
+  incremental.reserve(network.spring_count() + 4000, nodes + 400);
+  rebuilt.reserve(network.spring_count() + 4000, nodes + 400);
+  std::mt19937_64 random(11);
+  for (int round = 0; round < 6; ++round) {
+    const std::size_t added_nodes = 10 + 7 * static_cast<std::size_t>(round);
+    incremental.add_nodes(added_nodes);
+    const std::size_t first_new = incremental.spring_count();
+    // Each new node gets springs to random older nodes (and some to new ones before it), by node i.
+    for (std::size_t n = nodes; n < nodes + added_nodes; ++n) {
+      std::uniform_int_distribution<std::uint32_t> older(0, static_cast<std::uint32_t>(n - 1));
+      std::vector<std::uint32_t> others;
+      for (int k = 0; k < 1 + static_cast<int>(n % 9); ++k) others.push_back(older(random));
+      std::sort(others.begin(), others.end());
+      others.erase(std::unique(others.begin(), others.end()), others.end());
+      for (std::uint32_t j : others) {
+        incremental.append(static_cast<std::uint32_t>(n), j, 1e-3);
+        rebuilt.append(static_cast<std::uint32_t>(n), j, 1e-3);
+      }
+    }
+    nodes += added_nodes;
+    incremental.add_appended_to_incidence(first_new);
+    rebuilt.rebuild_incidence(nodes);
+    EXPECT_EQ(incremental.incidence().first_first, rebuilt.incidence().first_first) << "round " << round;
+    EXPECT_EQ(incremental.incidence().second_first, rebuilt.incidence().second_first) << "round " << round;
+    EXPECT_EQ(incremental.incidence().second_springs, rebuilt.incidence().second_springs) << "round " << round;
+  }
+  // A round adding nodes but no spring leaves them empty.
+  incremental.add_nodes(3);
+  incremental.add_appended_to_incidence(incremental.spring_count());
+  rebuilt.rebuild_incidence(nodes + 3);
+  EXPECT_EQ(incremental.incidence().first_first, rebuilt.incidence().first_first);
+  EXPECT_EQ(incremental.incidence().second_first, rebuilt.incidence().second_first);
+}
+
 }  // namespace
 }  // namespace resecto
