@@ -212,6 +212,11 @@ ResectionStep Resection::step(const SweptVolume* sweep, bool pedal_down, bool di
     }
   }
   if (pedal_down && !removed) stats_.loop_on_idle_s += period_s;
+  const double springs = static_cast<double>(tissue_.network().spring_count());
+  if (!pedal_down && static_cast<double>(tissue_.dead_spring_count()) > config_.compact_dead_spring_fraction * springs) {
+    tissue_.compact_springs();
+    ++stats_.spring_compactions;
+  }
   return out;
 }
 

@@ -44,6 +44,10 @@ struct ResectionConfig {
   Vec3 channel_direction{0.0, 0.0, 1.0};
   /// Perforation sites kept (the count goes on past it).
   std::size_t max_perforation_sites = 64;
+  /// Once dead springs (no tetrahedron left around their edge) pass this fraction of all springs,
+  /// the first collision step with the pedal up compacts them away (MassSpringTissue::compact_springs):
+  /// resection then leaves the physics step no dearer than the tissue that remains.
+  double compact_dead_spring_fraction = 0.1;
 };
 
 /// Regions index arrays by their enum value (kCapsule = 1, kAdenoma = 2); slot 0 is unused.
@@ -64,6 +68,7 @@ struct ResectionStats {
   double loop_on_idle_s = 0.0;                 ///< time with the pedal down and nothing removed
   std::int64_t refined_tetrahedra = 0;         ///< tetrahedra split by refinement (1:8 and closures)
   std::int64_t refusals = 0;                   ///< edits refused for want of reserved capacity
+  std::int64_t spring_compactions = 0;         ///< dead springs dropped (with the pedal up)
 };
 
 /// What one collision step's cut did.

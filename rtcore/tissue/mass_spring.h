@@ -136,6 +136,14 @@ class MassSpringTissue {
   TopologyChange edit_tetrahedra(std::span<const std::uint32_t> removed, std::span<const Tetrahedron> added,
                                  std::span<const TissueRegion> added_regions);
   std::span<const std::uint32_t> added_slots() const { return added_slots_; }
+  /// Springs no live tetrahedron holds any more: they stay in place with k = c = 0 (forming no
+  /// force, but still costing the physics step their share of its passes) until compact_springs().
+  std::size_t dead_spring_count() const { return dead_springs_; }
+  /// Drops the dead springs from every per-spring array, keeping the others' order: a pass over
+  /// the springs (about a millisecond at 100,000), so the caller picks a moment nothing is cut. It
+  /// changes no force and no state (a dead spring adds exactly zero), and frees their room.
+  void compact_springs();
+  std::int64_t spring_compactions() const { return spring_compactions_; }
   /// Rest volume of live slot t (m^3).
   double rest_volume_m3(std::uint32_t t) const;
   /// Whether `node` is held by a capsule anchor spring (and still by a tetrahedron).
@@ -253,6 +261,8 @@ class MassSpringTissue {
   std::vector<std::uint64_t> spring_keys_;
   std::vector<std::uint32_t> spring_values_;
   std::size_t spring_capacity_ = 0;
+  std::size_t dead_springs_ = 0;  // springs with no live tetrahedron (volume share 0)
+  std::int64_t spring_compactions_ = 0;
   // Edit scratch, reserved at construction.
   std::vector<std::uint32_t> node_stamp_, spring_stamp_, touched_nodes_, touched_springs_, added_slots_;
   std::vector<std::uint32_t> slot_stamp_, changed_faces_;

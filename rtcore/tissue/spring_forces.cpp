@@ -85,6 +85,22 @@ void SpringForces::rebuild_incidence(std::size_t nodes) {
   for (std::size_t s = 0; s < count; ++s) in.second_springs[fill_[arrays_.j[s]]++] = static_cast<std::uint32_t>(s);
 }
 
+void SpringForces::keep(std::span<const std::uint32_t> kept, std::size_t node_count) {
+  // Forward, in place: position k is read from kept[k] >= k, never from a place already written.
+  auto compact = [&](auto& values) {
+    for (std::size_t k = 0; k < kept.size(); ++k) values[k] = values[kept[k]];
+    values.resize(kept.size());
+  };
+  compact(arrays_.i);
+  compact(arrays_.j);
+  compact(arrays_.rest_m);
+  compact(arrays_.k);
+  compact(arrays_.c);
+  compact(arrays_.f);
+  arrays_.compressed.resize(kept.size());
+  rebuild_incidence(node_count);
+}
+
 void SpringForces::add_nodes(std::size_t count) {
   // A new node holds no spring yet: empty ranges at the end.
   for (std::size_t k = 0; k < count; ++k) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "rtcore/geometry/vec3.h"
@@ -45,6 +46,9 @@ class SpringForces {
   /// Recounts the incidence over `node_count` nodes (counting sort, no allocation within the
   /// reserved room).
   void rebuild_incidence(std::size_t node_count);
+  /// Keeps only the springs listed in `kept` (ascending), in their order, and relists the incidence
+  /// over `node_count` nodes: spring s becomes the position of s in `kept`.
+  void keep(std::span<const std::uint32_t> kept, std::size_t node_count);
   /// Extends the incidence by `count` new nodes that hold no spring yet.
   void add_nodes(std::size_t count);
   /// Lists springs [first_new, spring_count()), appended since the incidence was last complete, in

@@ -400,6 +400,7 @@ TopologyChange MassSpringTissue::edit_tetrahedra(std::span<const std::uint32_t> 
       }
       insert_spring_key(ns.i, ns.j, s);
       touch_spring(s);
+      ++dead_springs_;  // until step 4 gives it its share
     }
     springs_.add_appended_to_incidence(first_new);
     change.springs_added = static_cast<std::int32_t>(new_springs_.size());
@@ -415,7 +416,13 @@ TopologyChange MassSpringTissue::edit_tetrahedra(std::span<const std::uint32_t> 
   for (std::uint32_t s : touched_springs_) {
     const bool was_live = network_.volume_share_m3[s] > 0.0;
     if (recompute_spring_share(s) == 0) network_.volume_share_m3[s] = 0.0;
-    if (was_live && !(network_.volume_share_m3[s] > 0.0)) ++change.springs_removed;
+    const bool live = network_.volume_share_m3[s] > 0.0;
+    if (was_live && !live) {
+      ++change.springs_removed;
+      ++dead_springs_;
+    } else if (!was_live && live) {
+      --dead_springs_;
+    }
     update_spring_material(s, modulus, viscosity);
   }
   for (std::uint32_t n : touched_nodes_) {
@@ -444,6 +451,43 @@ TopologyChange MassSpringTissue::edit_tetrahedra(std::span<const std::uint32_t> 
     surface_tree_edited_ = true;  // the search's refit judges its quality (refit_surface_tree)
   }
   return change;
+}
+
+void MassSpringTissue::compact_springs() {
+  std::vector<std::uint32_t>& kept = touched_springs_;  // scratch with room for every spring
+  kept.clear();
+  for (std::uint32_t s = 0; s < springs_.spring_count(); ++s) {
+    if (network_.volume_share_m3[s] > 0.0) kept.push_back(s);
+  }
+  if (kept.size() == springs_.spring_count()) return;
+  springs_.keep(kept, x_.size());
+  for (std::size_t k = 0; k < kept.size(); ++k) {
+    const std::uint32_t s = kept[k];
+    network_.spring_nodes[2 * k] = network_.spring_nodes[2 * s];
+    network_.spring_nodes[2 * k + 1] = network_.spring_nodes[2 * s + 1];
+    network_.rest_length_m[k] = network_.rest_length_m[s];
+    network_.volume_share_m3[k] = network_.volume_share_m3[s];
+    if (config_.integrator == TissueIntegrator::kImplicitEuler) {
+      spring_direction_[k] = spring_direction_[s];
+      spring_transverse_k_[k] = spring_transverse_k_[s];
+    }
+  }
+  network_.spring_nodes.resize(2 * kept.size());
+  network_.rest_length_m.resize(kept.size());
+  network_.volume_share_m3.resize(kept.size());
+  if (config_.integrator == TissueIntegrator::kImplicitEuler) {
+    spring_direction_.resize(kept.size());
+    spring_transverse_k_.resize(kept.size());
+  }
+  // The edge table maps to the new numbers; the spring stamps restart.
+  std::fill(spring_keys_.begin(), spring_keys_.end(), kEmptyKey);
+  for (std::size_t s = 0; s < kept.size(); ++s) {
+    insert_spring_key(network_.spring_nodes[2 * s], network_.spring_nodes[2 * s + 1], static_cast<std::uint32_t>(s));
+  }
+  std::fill(spring_stamp_.begin(), spring_stamp_.end(), 0u);
+  kept.clear();
+  dead_springs_ = 0;
+  ++spring_compactions_;
 }
 
 TriangleMesh MassSpringTissue::live_surface(bool rest_positions) const {

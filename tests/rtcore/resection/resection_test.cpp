@@ -195,12 +195,50 @@ TEST(Resection, TwoRunsWithCutsGiveTheSameHashAtEveryCollisionStep) {
   EXPECT_EQ(collision_hashes(config, p), first);
 }
 
+TEST(Resection, CompactingDeadSpringsChangesNoHashAndLeavesNoneDead) {
+  // A dead spring forms exactly zero force, so dropping them (with the pedal up) must leave every
+  // collision step's hash as it was without compaction, while the springs the physics step walks
+  // shrink to the live ones.
+  Procedure p = left_lobe_stroke(true, "1.0", true);
+  ProcedureKeyframe rest = p.keyframes.back();  // then a moment with the pedal up
+  rest.time_s += 0.5;
+  p.keyframes.push_back(rest);
+  auto run = [&](double fraction, std::int64_t* compactions, std::size_t* springs, std::size_t* dead) {
+    SimulationConfig config;
+    config.prostate_triangles = 1296;
+    config.resection.compact_dead_spring_fraction = fraction;
+    auto sim = Simulation::create(config);
+    EXPECT_TRUE(sim) << sim.error();
+    std::vector<std::uint64_t> hashes;
+    const double tick_s = config.tick_s();
+    const auto ticks = static_cast<std::uint64_t>(std::llround(p.duration_s() / tick_s));
+    for (std::uint64_t tick = 0; tick < ticks; ++tick) {
+      (*sim)->step(procedure_input(p, tick, tick_s), {});
+      if ((*sim)->is_collision_tick(tick)) hashes.push_back((*sim)->state_hash());
+    }
+    *compactions = (*sim)->resection().stats().spring_compactions;
+    *springs = (*sim)->tissue().network().spring_count();
+    *dead = (*sim)->tissue().dead_spring_count();
+    return hashes;
+  };
+  std::int64_t never_compactions = 0, always_compactions = 0;
+  std::size_t never_springs = 0, always_springs = 0, never_dead = 0, always_dead = 0;
+  const auto never = run(2.0, &never_compactions, &never_springs, &never_dead);
+  const auto always = run(0.0, &always_compactions, &always_springs, &always_dead);
+  EXPECT_EQ(never, always);
+  EXPECT_EQ(never_compactions, 0);
+  EXPECT_GT(always_compactions, 0);
+  EXPECT_GT(never_dead, 0u);
+  EXPECT_EQ(always_dead, 0u);
+  EXPECT_EQ(always_springs, never_springs - never_dead);
+}
+
 TEST(Resection, PhysicsTicksWhileCuttingAllocateNothingAndNoTickLocks) {
-  // The physics ticks between collision ticks allocate nothing; no tick takes a lock. The collision ticks' topology updates are counted and printed: a
-  // decayed sphere tree's rebuild allocates its build scratch, and a few updates still allocate a
-  // little (README "Resection", what is not done).
-  // The search runs inside the step (no collision thread), so an allocation, and a sphere-tree
-  // rebuild, land in the tick that caused them.
+  // The physics ticks between collision ticks allocate nothing; no tick takes a lock. The collision
+  // ticks' topology updates are counted and printed: a decayed sphere tree's rebuild allocates its
+  // build scratch, and a few updates still allocate a little (README "Resection", what is not
+  // done). The search runs inside the step (no collision thread), so an allocation, and a
+  // sphere-tree rebuild, land in the tick that caused them.
   SimulationConfig config;
   config.prostate_triangles = 1296;
   config.collision_thread = false;
