@@ -276,7 +276,7 @@ int Resection::refine_near(const SweptVolume& sweep) {
       if (sweep.within(centroid(t), sweep.radius() + 0.25 * longest)) marked_.push_back(t);
     }
     if (marked_.empty()) break;
-    const TetMeshView view{tissue_.rest_positions(), topo.tetrahedra(), topo.alive_flags(), topo.regions()};
+    const TetMeshView view{tissue_.rest_positions(), topo.tetrahedra(), topo.alive_flags(), topo.regions(), &topo};
     const RefinementEdit& edit = refiner_.plan(view, marked_);
     if (!tissue_.can_edit(edit.new_node_parents.size(), edit.added_tetrahedra.size(), edit.removed_tetrahedra.size())) {
       ++stats_.refusals;

@@ -43,8 +43,9 @@ constexpr std::size_t kQualityUpgradesPerMark = 4;
 const double kMaxClosureDihedralCos = std::cos(kMinClosureDihedralDeg * std::numbers::pi / 180.0);
 
 constexpr std::uint32_t kNoNode = 0xffffffffu;
-/// slot_state_ bits: red, waiting in to_judge_, listed in touched_.
-constexpr std::uint8_t kRed = 1, kQueued = 2, kTouched = 4;
+/// slot_state_ bits: red, waiting in to_judge_, listed in touched_, listed in candidates_ (while
+/// gathering from the topology).
+constexpr std::uint8_t kRed = 1, kQueued = 2, kTouched = 4, kListed = 8;
 /// slot_verdict_: the split-edge mask last judged (6 bits), whether it is known, and whether green.
 constexpr unsigned kVerdictMask = 0x3Fu, kVerdictKnown = 0x40u, kVerdictGreen = 0x80u;
 
@@ -242,9 +243,22 @@ void TetRefiner::gather_candidates(const TetMeshView& mesh) {
   // ascending (a counting sort).
   candidates_.clear();
   const std::uint8_t* covered = node_is_covered_.data();
-  for (std::uint32_t s = 0; s < mesh.tetrahedra.size(); ++s) {
-    const Tetrahedron& t = mesh.tetrahedra[s];
-    if ((covered[t[0]] | covered[t[1]] | covered[t[2]] | covered[t[3]]) && mesh.alive[s]) candidates_.push_back(s);
+  if (mesh.topology != nullptr) {
+    // The same list from the covered nodes' own lists: each slot once, then ascending.
+    for (std::uint32_t n : covered_nodes_) {
+      mesh.topology->for_each_tetrahedron_of(n, [&](std::uint32_t s) {
+        if (slot_state_[s] & kListed) return;
+        slot_state_[s] |= kListed;
+        candidates_.push_back(s);
+      });
+    }
+    for (std::uint32_t s : candidates_) slot_state_[s] &= static_cast<std::uint8_t>(~kListed);
+    std::sort(candidates_.begin(), candidates_.end());
+  } else {
+    for (std::uint32_t s = 0; s < mesh.tetrahedra.size(); ++s) {
+      const Tetrahedron& t = mesh.tetrahedra[s];
+      if ((covered[t[0]] | covered[t[1]] | covered[t[2]] | covered[t[3]]) && mesh.alive[s]) candidates_.push_back(s);
+    }
   }
   incidence_offsets_.assign(covered_nodes_.size() + 1, 0);
   for (std::uint32_t s : candidates_) {

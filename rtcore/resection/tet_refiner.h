@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "rtcore/tissue/tet_mesh.h"  // Tetrahedron, TissueRegion, Vec3
+#include "rtcore/tissue/tet_topology.h"
 
 namespace resecto {
 
@@ -19,6 +20,9 @@ struct TetMeshView {
   std::span<const Tetrahedron> tetrahedra;  ///< by slot; positively oriented at rest
   std::span<const std::uint8_t> alive;      ///< per slot: 1 live, 0 dead (ignored)
   std::span<const TissueRegion> regions;    ///< per slot
+  /// The live tetrahedra around each node, when the caller keeps them (the tissue does): the plan
+  /// then reads only the refined region's neighbourhood instead of passing over every slot.
+  const TetTopology* topology = nullptr;
 };
 
 /// A conforming refinement, as an edit the caller applies (the refiner changes nothing itself).
@@ -35,8 +39,9 @@ struct RefinementEdit {
   std::int32_t closure_tetrahedra = 0;            ///< split only to close the conforming mesh
 };
 
-/// Cost: one pass over the slots (two when the closure spreads beyond the marked slots' neighbours,
-/// and one more for each further ring), the rest proportional to the refined region. Per-node and
+/// Cost: proportional to the refined region when the view carries the topology; otherwise one pass
+/// over the slots (two when the closure spreads beyond the marked slots' neighbours, and one more
+/// for each further ring), the rest proportional to the refined region. Per-node and
 /// per-slot scratch is sized at construction (and grows if a mesh outgrows it); per-plan lists are
 /// sized for plans of about a thousand slots and grow once when a plan is larger, then stay: after
 /// the first plans, plan() allocates nothing. The returned edit lives until the next plan().

@@ -441,6 +441,32 @@ TEST(TetRefiner, DeterministicForShuffledAndDuplicatedMarks) {
   EXPECT_GT(first.closure_tetrahedra, 0);
 }
 
+TEST(TetRefiner, PlansFromTheTopologyEqualThePassOverSlots) {
+  // The tissue hands the refiner its node-to-tetrahedra lists; the plan must be the one the pass over
+  // every slot makes, byte for byte, with dead slots about and for clusters of any size.
+  PlainMesh m = from_tet_mesh(tissue_model(1296).mesh);
+  TetTopology topology(m.tets, m.regions, m.rest.size(), m.tets.size(), m.rest.size());
+  std::mt19937 rng(31);
+  for (int k = 0; k < 40; ++k) {
+    const auto t = std::uniform_int_distribution<std::uint32_t>(0, static_cast<std::uint32_t>(m.tets.size() - 1))(rng);
+    if (!m.alive[t]) continue;
+    m.alive[t] = 0;
+    topology.remove(t);
+  }
+  TetRefiner over_slots(m.rest.size(), m.tets.size()), from_topology(m.rest.size(), m.tets.size());
+  for (std::size_t count : {1u, 3u, 12u, 40u, 120u}) {
+    const std::vector<std::uint32_t> live = live_slots(m);
+    const Tetrahedron& centre = m.tets[live[std::uniform_int_distribution<std::size_t>(0, live.size() - 1)(rng)]];
+    const std::vector<std::uint32_t> marked =
+        slots_near(m, (m.rest[centre[0]] + m.rest[centre[1]] + m.rest[centre[2]] + m.rest[centre[3]]) * 0.25, count);
+    TetMeshView with_topology = m.view();
+    with_topology.topology = &topology;
+    const RefinementEdit expected = over_slots.plan(m.view(), marked);
+    expect_same_edit(expected, from_topology.plan(with_topology, marked));
+    EXPECT_GT(expected.red_tetrahedra, 0) << count;
+  }
+}
+
 TEST(TetRefiner, DeadSlotsAreIgnored) {
   PlainMesh m = tetgen_box();
   // Kill the half x > 12 mm: those slots are resected and never touched again.
