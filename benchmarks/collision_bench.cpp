@@ -498,21 +498,26 @@ int run_table(int repetitions, int only_size) {
 
 // ---- Google Benchmark cases (--gbench) ----------------------------------------------------------
 
-void BM_Query8640(benchmark::State& state) {
-  const ProstateModel gland = generate_prostate(8640);
+void query_case(benchmark::State& state, bool slabs) {
+  const ProstateModel gland = generate_prostate(static_cast<int>(state.range(0)));
   const TriangleMesh tool = combined_resectoscope_mesh(generate_resectoscope());
   SphereTree tissue_tree, tool_tree;
   tissue_tree.build(gland.surface);
   tool_tree.build(tool);
   const auto poses = benchmark_poses();
   Collider collider;
+  collider.set_slabs(slabs);
   std::size_t p = 0;
   for (auto _ : state) {
     collider.collide(tissue_tree, gland.surface, tool_tree, tool, poses[p++ % poses.size()]);
     benchmark::DoNotOptimize(collider.pairs().data());
   }
 }
-BENCHMARK(BM_Query8640);
+void BM_Query(benchmark::State& state) { query_case(state, true); }
+// The paper's test alone (spheres, no slabs): what the slabs save.
+void BM_QuerySpheresOnly(benchmark::State& state) { query_case(state, false); }
+BENCHMARK(BM_QuerySpheresOnly)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Query)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
 
 // The 60 Hz trajectory as a sequence (collide_sequence), frame after frame, looping.
 void BM_Sequence8640(benchmark::State& state) {
