@@ -98,9 +98,9 @@ void Collider::prepare(const SphereTree& tissue_tree, const SphereTree& tool_tre
   l2_stamp_.resize(tool_nodes, 0);
   l2_.resize(tool_nodes);
   const std::int32_t heights = tissue_tree.links()[tissue_tree.root()].height + tool_tree.links()[tool_tree.root()].height;
-  // Depth-first: at most one pending sibling per level, plus the two slots a node's children are
-  // written to before it is known which are kept.
-  stack_.resize(static_cast<std::size_t>(heights) + 4);
+  // Depth-first: at most three pending pairs per level (a step that opens both nodes pushes four),
+  // plus the slots a step's pairs are written to before it is known which are kept.
+  stack_.resize(3 * static_cast<std::size_t>(heights) + 8);
 }
 
 bool Collider::first_test_of(std::uint32_t tissue_triangle, std::uint32_t tool_triangle) {
@@ -352,6 +352,26 @@ void Collider::descend(NodePair start) {
       visit_leaves(pair);
       if constexpr (kRecord) record(pair, -1.0);  // leaves that may meet are walked again every call
       continue;
+    }
+    if constexpr (!kRecord) {
+      if (!leaf1 && !leaf2 && s1.radius < 4.0 * s2.radius && s2.radius < 4.0 * s1.radius) {
+        // Both internal and of a size (within 4x): both opened at once, their four pairs tested in
+        // one step. More tests than opening the larger and then the other (the middle level's
+        // pruning is lost), but half the steps, and a step's branches, not its tests, are what the
+        // descent pays for (measured: 14-18% faster at 8640 and 138240; within 2x or always, alike).
+        tests += 4;
+        const std::int32_t a[2] = {links1.left, links1.right};
+        const std::int32_t b[2] = {links2.left, links2.right};
+        for (int i = 0; i < 2; ++i) {
+          for (int j = 0; j < 2; ++j) {
+            const NodePair child{a[i], b[j]};
+            stack[top] = child;
+            top += bounds_meet(child.tissue, child.tool,
+                               length_squared(tissue_spheres[child.tissue].center - tool_spheres[child.tool].center));
+          }
+        }
+        continue;
+      }
     }
     tests += 2;
     // Steps 11-17: open the non-leaf sphere, or the larger when neither is a leaf.
