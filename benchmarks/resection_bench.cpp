@@ -43,7 +43,7 @@ std::unique_ptr<Simulation> simulation(int triangles) {
 void BM_TopologyUpdateWhileCutting(benchmark::State& state) {
   const int triangles = static_cast<int>(state.range(0));
   const Procedure procedure = *parse_procedure(kStrokes, "strokes");
-  double median = 0.0, p99 = 0.0, per_tet = 0.0, removed = 0.0, refined = 0.0, steps = 0.0;
+  double median = 0.0, p99 = 0.0, per_tet = 0.0, removed = 0.0, refined = 0.0, steps = 0.0, list_builds = 0.0;
   for (auto _ : state) {
     state.PauseTiming();
     auto sim = simulation(triangles);
@@ -68,6 +68,7 @@ void BM_TopologyUpdateWhileCutting(benchmark::State& state) {
       refined_tets += cut.refined_tetrahedra;
       ++cut_steps;
     }
+    list_builds = static_cast<double>(sim->resection().candidate_list_builds());
     const StageStatistics topology = profiler.statistics(Stage::kTopology);
     total_us = profiler.total_us(Stage::kTopology);
     median = topology.median_us;
@@ -83,6 +84,7 @@ void BM_TopologyUpdateWhileCutting(benchmark::State& state) {
   state.counters["removed_tets"] = removed;
   state.counters["refined_tets"] = refined;
   state.counters["cutting_steps"] = steps;
+  state.counters["candidate_list_builds"] = list_builds;
 }
 BENCHMARK(BM_TopologyUpdateWhileCutting)->Arg(8640)->Arg(34560)->Iterations(1)->Unit(benchmark::kMillisecond);
 

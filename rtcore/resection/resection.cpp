@@ -98,6 +98,9 @@ Resection::Resection(MassSpringTissue& tissue, const ResectionConfig& config)
   frontier_.reserve(slots);
 
   candidates_.reserve(slots);
+  near_.reserve(2 * slots);
+  near_positions_.reserve(nodes);
+  moved_nodes_.reserve(kMaxMovedNodes + 1);
   marked_.reserve(slots);
   removing_.reserve(slots);
   queue_.reserve(slots);
@@ -157,6 +160,7 @@ ResectionStep Resection::step(const SweptVolume* sweep, bool pedal_down, bool di
   if (!pedal_down) in_stroke_ = false;
   if (pedal_down && !in_stroke_) {
     in_stroke_ = true;
+    near_valid_ = false;  // the candidate list starts afresh with each stroke
     stroke_cut_ = stroke_perforated_ = stroke_distal_ = false;
   }
   if (sweep != nullptr) {
@@ -221,28 +225,69 @@ ResectionStep Resection::step(const SweptVolume* sweep, bool pedal_down, bool di
 }
 
 void Resection::gather_candidates(const SweptVolume& sweep) {
-  // Every live tetrahedron whose centroid may be within a quarter of its longest edge of the path
-  // (refine_near marks within that, and the cut needs the centroid inside). A centroid lies within
-  // 3/4 of the tetrahedron's longest current edge of each of its nodes, so the nodes to start from
-  // are those within kNodeReach times their reach (the longest rest edge around them) of the path:
-  // exact while no edge is stretched past 1.5 times its rest length, far beyond what the penalty
-  // contact lets the tissue do. Only those nodes' stars are read, so the cost follows the loop's
-  // neighbourhood, not the gland's size.
-  constexpr double kNodeReach = 0.25 + 0.75 * 1.5;
+  // Candidates: every live slot whose centroid is within a quarter of its longest edge of the path
+  // (refine_near marks within that, and the cut needs the centroid inside), found on the skin list.
+  // A slot off the list had its centroid further than the skin beyond that reach of the list's
+  // path; the path has since moved at most `wire` and the radius grown by `grown`, so it can be a
+  // candidate now only if its centroid moved more than what is left, which needs one of its nodes
+  // to have: those nodes' stars are read directly.
+  std::span<const Vec3> x = tissue_.positions();
+  const double wire = near_valid_ ? sweep.sample_displacement(near_sweep_) : 0.0;
+  const double left = config_.candidate_skin_m - wire - std::max(0.0, sweep.radius() - near_sweep_.radius());
+  moved_nodes_.clear();
+  bool valid = near_valid_ && left > 0.0 && near_.size() < near_.capacity() / 2;
+  if (valid) {
+    const double left2 = left * left;
+    for (std::uint32_t n = 0; n < near_positions_.size() && valid; ++n) {
+      if (length_squared(x[n] - near_positions_[n]) <= left2) continue;
+      moved_nodes_.push_back(n);
+      valid = moved_nodes_.size() <= kMaxMovedNodes;
+    }
+  }
+  if (!valid) {
+    moved_nodes_.clear();
+    near_.clear();
+    search_near(sweep, config_.candidate_skin_m, near_);
+    near_sweep_ = sweep;
+    near_positions_.assign(x.begin(), x.end());
+    near_valid_ = true;
+    ++near_builds_;
+  }
   candidates_.clear();
   const std::uint32_t stamp = next_stamp();
   const TetTopology& topo = tissue_.topology();
-  std::span<const Vec3> x = tissue_.positions();
   const double radius = sweep.radius();
+  auto consider = [&](std::uint32_t t) {
+    if (slot_stamp_[t] == stamp) return;
+    slot_stamp_[t] = stamp;
+    if (sweep.may_be_within(centroid(t), radius + 0.25 * slot_longest_[t])) candidates_.push_back(t);
+  };
+  for (std::uint32_t t : near_) {
+    if (topo.alive(t)) consider(t);
+  }
+  for (std::uint32_t n : moved_nodes_) topo.for_each_tetrahedron_of(n, consider);
+  std::sort(candidates_.begin(), candidates_.end());
+}
+
+void Resection::search_near(const SweptVolume& sweep, double extra, std::vector<std::uint32_t>& out) {
+  // A centroid lies within 3/4 of the tetrahedron's longest current edge of each of its nodes, so the
+  // nodes to start from are those within kNodeReach times their reach (the longest rest edge around
+  // them) of the path: exact while no edge is stretched past 1.5 times its rest length, far beyond
+  // what the penalty contact lets the tissue do. Only those nodes' stars are read, so the cost
+  // follows the loop's neighbourhood, not the gland's size.
+  constexpr double kNodeReach = 0.25 + 0.75 * 1.5;
+  const std::uint32_t stamp = next_stamp();
+  const TetTopology& topo = tissue_.topology();
+  std::span<const Vec3> x = tissue_.positions();
+  const double radius = sweep.radius() + extra;
   for (std::uint32_t n = 0; n < x.size(); ++n) {
     if (!sweep.may_be_within(x[n], radius + kNodeReach * node_reach_[n])) continue;
     topo.for_each_tetrahedron_of(n, [&](std::uint32_t t) {
       if (slot_stamp_[t] == stamp) return;
       slot_stamp_[t] = stamp;
-      if (sweep.may_be_within(centroid(t), radius + 0.25 * slot_longest_[t])) candidates_.push_back(t);
+      if (sweep.may_be_within(centroid(t), radius + 0.25 * slot_longest_[t])) out.push_back(t);
     });
   }
-  std::sort(candidates_.begin(), candidates_.end());
 }
 
 void Resection::note_refinement(std::span<const std::uint32_t> added_slots) {
@@ -304,6 +349,7 @@ int Resection::refine_near(const SweptVolume& sweep) {
     }
     refined += edit.red_tetrahedra + edit.closure_tetrahedra;
     note_refinement(tissue_.added_slots());
+    for (std::uint32_t t : tissue_.added_slots()) near_.push_back(t);  // the children replace their parents
     for (std::size_t k = 0; k < tissue_.added_slots().size(); ++k) {
       const std::uint32_t t = tissue_.added_slots()[k];
       slot_level_[t] = static_cast<std::uint8_t>(child_info_[k] & 0x7f);

@@ -48,6 +48,9 @@ struct ResectionConfig {
   /// the first collision step with the pedal up compacts them away (MassSpringTissue::compact_springs):
   /// resection then leaves the physics step no dearer than the tissue that remains.
   double compact_dead_spring_fraction = 0.1;
+  /// The candidate search's skin (Resection's skin list): larger keeps the list valid for more
+  /// steps but makes it longer; 0 searches afresh every step (the same candidates, slower).
+  double candidate_skin_m = 0.002;
 };
 
 /// Regions index arrays by their enum value (kCapsule = 1, kAdenoma = 2); slot 0 is unused.
@@ -92,6 +95,8 @@ class Resection {
   ResectionStep step(const SweptVolume* sweep, bool pedal_down, bool distal, double period_s);
 
   const ResectionStats& stats() const { return stats_; }
+  /// How many times the candidate search's skin list was built (each a search over the nodes).
+  std::int64_t candidate_list_builds() const { return near_builds_; }
   const ResectionConfig& config() const { return config_; }
   /// Rest volume of the live tetrahedra by region, summed afresh (for checks, O(tetrahedra)).
   RegionVolumes remaining_m3() const;
@@ -100,6 +105,9 @@ class Resection {
 
  private:
   void gather_candidates(const SweptVolume& sweep);
+  /// The node-by-node search: every live slot whose centroid may be within `reach` more than the
+  /// candidates' own reach of the path, into `out` (unsorted).
+  void search_near(const SweptVolume& sweep, double extra, std::vector<std::uint32_t>& out);
   int refine_near(const SweptVolume& sweep);
   /// Removes `slots` through the tissue, accounting them; `chip` adds them to the chips' volume.
   void remove(std::vector<std::uint32_t>& slots, bool chip, ResectionStep& out);
@@ -125,6 +133,18 @@ class Resection {
   std::vector<std::uint8_t> outer_node_;  // per node (capacity)
   // The candidate search's margins, kept for live slots and nodes as edits go: each slot's longest
   // rest edge, and each node's longest rest edge over the slots around it.
+  // The candidate search keeps a skin list (as molecular dynamics keeps Verlet lists): the slots
+  // whose centroid was within the skin (ResectionConfig::candidate_skin_m) more than the candidates' reach of the path when it was built.
+  // While the wire's samples have moved less than the skin since, a step reads the list, plus the
+  // stars of the nodes that moved further than what the skin has left (a flap of cut tissue); when
+  // the wire has used up the skin, too many nodes moved, or a stroke starts, it is built afresh.
+  static constexpr std::size_t kMaxMovedNodes = 512;
+  std::vector<std::uint32_t> near_;  // slots (unsorted; may hold dead or reused ones: filtered)
+  SweptVolume near_sweep_;           // the path it was built for
+  std::vector<Vec3> near_positions_;  // the nodes' positions then (nodes made since hold only listed slots)
+  std::vector<std::uint32_t> moved_nodes_;
+  bool near_valid_ = false;
+  std::int64_t near_builds_ = 0;
   std::vector<double> slot_longest_;  // per slot (capacity)
   std::vector<double> node_reach_;    // per node (capacity)
   // The chip search's guide: each node's rest path length along edges to the nearest anchored node

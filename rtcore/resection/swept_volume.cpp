@@ -13,12 +13,25 @@ namespace resecto {
 SweptVolume::SweptVolume(std::size_t max_points) {
   quads_.reserve(max_points);
   groups_.reserve(max_points / kGroupSize + 1);
+  from_.reserve(max_points);
+  to_.reserve(max_points);
+}
+
+double SweptVolume::sample_displacement(const SweptVolume& other) const {
+  if (from_.size() != other.from_.size()) return std::numeric_limits<double>::infinity();
+  double largest2 = 0.0;
+  for (std::size_t i = 0; i < from_.size(); ++i) {
+    largest2 = std::max({largest2, length_squared(from_[i] - other.from_[i]), length_squared(to_[i] - other.to_[i])});
+  }
+  return std::sqrt(largest2);
 }
 
 void SweptVolume::set(std::span<const Vec3> from, std::span<const Vec3> to, double radius_m) {
   quads_.clear();
   radius_m_ = radius_m;
-  const std::size_t count = std::min(from.size(), to.size());
+  const std::size_t count = std::min({from.size(), to.size(), from_.capacity()});
+  from_.assign(from.begin(), from.begin() + static_cast<std::ptrdiff_t>(count));
+  to_.assign(to.begin(), to.begin() + static_cast<std::ptrdiff_t>(count));
   bounds_.min = Vec3(std::numeric_limits<double>::infinity());
   bounds_.max = Vec3(-std::numeric_limits<double>::infinity());
   for (std::size_t i = 0; i < count; ++i) {

@@ -36,6 +36,10 @@ class SweptVolume {
   /// Exact volume of a straight stroke: a segment of length `span_m` moving `travel_m` across
   /// itself, inflated by r (a box with half-cylinders and a quarter-sphere rim): the oracle's value.
   static double straight_stroke_volume(double span_m, double travel_m, double radius_m);
+  /// How far the wire's samples (at both steps) moved from `other`'s: every point of this path lies
+  /// within this distance of `other`'s path (the same point of the same ribbon). Infinite when the
+  /// two have different sample counts.
+  double sample_displacement(const SweptVolume& other) const;
 
  private:
   struct Quad {
@@ -52,6 +56,7 @@ class SweptVolume {
   static constexpr std::size_t kGroupSize = 4;
   std::vector<Quad> quads_;
   std::vector<Group> groups_;
+  std::vector<Vec3> from_, to_;  // the samples, as set()
   double radius_m_ = 0.0;
   Aabb bounds_;
 };

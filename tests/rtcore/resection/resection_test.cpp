@@ -195,6 +195,19 @@ TEST(Resection, TwoRunsWithCutsGiveTheSameHashAtEveryCollisionStep) {
   EXPECT_EQ(collision_hashes(config, p), first);
 }
 
+TEST(Resection, SkinListFindsWhatAFreshSearchEveryStepFinds) {
+  // The candidate search's skin list must be exact: with it and with a search over the nodes at
+  // every step (skin 0), the same cuts, so the same hash at every collision step.
+  SimulationConfig config;
+  config.prostate_triangles = 1296;
+  Procedure p = left_lobe_stroke(true, "1.0", true);
+  const auto with_list = collision_hashes(config, p);
+  config.resection.candidate_skin_m = 0.0;
+  EXPECT_EQ(collision_hashes(config, p), with_list);
+  config.resection.candidate_skin_m = 0.006;  // a wide skin: long lists, few builds
+  EXPECT_EQ(collision_hashes(config, p), with_list);
+}
+
 TEST(Resection, CompactingDeadSpringsChangesNoHashAndLeavesNoneDead) {
   // A dead spring forms exactly zero force, so dropping them (with the pedal up) must leave every
   // collision step's hash as it was without compaction, while the springs the physics step walks
