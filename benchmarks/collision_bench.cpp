@@ -7,6 +7,7 @@
 #include <fcl/fcl.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -68,29 +69,17 @@ double median(std::vector<double> values) {
 // A pose with the sheath along the channel, its tip at depth z, pushed sideways toward angle theta
 // by `offset` and tilted a little: the sheath (8.67 mm) is wider than the lobes leave the lumen, so
 // it lies against the wall along its length and the loop presses into it.
-RigidTransform pressing_pose(double z_m, double theta, double offset_m, double tilt_rad, double roll_rad) {
-  const double ct = std::cos(tilt_rad), st = std::sin(tilt_rad);
-  const double cr = std::cos(roll_rad), sr = std::sin(roll_rad);
+RigidPose pressing_pose(double z_m, double theta, double offset_m, double tilt_rad, double roll_rad) {
   // R = R_tilt(about the axis perpendicular to the push) * R_roll(about z).
   const Vec3 axis{-std::sin(theta), std::cos(theta), 0.0};
-  double tilt[3][3];
-  const double k[3] = {axis.x, axis.y, axis.z};
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      const double cross_term = (i == j) ? 0.0 : ((i + 1) % 3 == j ? -k[3 - i - j] : k[3 - i - j]);
-      tilt[i][j] = (i == j ? ct : 0.0) + (1.0 - ct) * k[i] * k[j] + st * cross_term;
-    }
-  }
-  const double roll[3][3] = {{cr, -sr, 0}, {sr, cr, 0}, {0, 0, 1}};
-  RigidTransform pose;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) pose.rotation[i][j] = tilt[i][0] * roll[0][j] + tilt[i][1] * roll[1][j] + tilt[i][2] * roll[2][j];
+  RigidPose pose;
+  pose.rotation = axis_angle_rotation(axis, tilt_rad) * rotation_about_z(roll_rad);
   pose.translation = Vec3{offset_m * std::cos(theta), offset_m * std::sin(theta), z_m};
   return pose;
 }
 
-std::vector<RigidTransform> benchmark_poses() {
-  std::vector<RigidTransform> poses;
+std::vector<RigidPose> benchmark_poses() {
+  std::vector<RigidPose> poses;
   std::mt19937_64 rng(2006);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (int i = 0; i < 24; ++i) {
@@ -105,8 +94,8 @@ std::vector<RigidTransform> benchmark_poses() {
 // along it while swinging between sides, and the loop swept through the lobe by rolling the tool.
 // Consecutive frames move the tool's points 0.2-0.4 mm (its far end included): what
 // Collider::collide_sequence() reuses.
-std::vector<RigidTransform> trajectory_poses() {
-  std::vector<RigidTransform> poses;
+std::vector<RigidPose> trajectory_poses() {
+  std::vector<RigidPose> poses;
   constexpr int kFrames = 120;
   for (int f = 0; f < kFrames; ++f) {
     const double t = f / 60.0;
@@ -117,17 +106,16 @@ std::vector<RigidTransform> trajectory_poses() {
 }
 
 // Writes poses in the `resecto collide` format, in millimetres (the unit `resecto mesh` writes).
-void write_poses(const std::string& path, const std::vector<RigidTransform>& poses) {
+void write_poses(const std::string& path, const std::vector<RigidPose>& poses) {
   std::FILE* out = std::fopen(path.c_str(), "w");
   if (!out) {
     std::fprintf(stderr, "%s: cannot write\n", path.c_str());
     std::exit(1);
   }
-  for (const RigidTransform& p : poses) {
-    for (int i = 0; i < 3; ++i) {
-      std::fprintf(out, "%.17g %.17g %.17g %.17g%s", p.rotation[i][0], p.rotation[i][1], p.rotation[i][2],
-                   1000.0 * p.translation[i], i == 2 ? "\n" : " ");
-    }
+  for (const RigidPose& p : poses) {
+    std::array<double, 12> m = to_row_major_3x4(p);
+    for (int i = 0; i < 3; ++i) m[static_cast<std::size_t>(4 * i + 3)] *= 1000.0;
+    for (std::size_t e = 0; e < 12; ++e) std::fprintf(out, "%.17g%s", m[e], e == 11 ? "\n" : " ");
   }
   std::fclose(out);
 }
@@ -147,18 +135,18 @@ std::shared_ptr<fcl::BVHModel<BV>> fcl_model(const TriangleMesh& mesh) {
   return model;
 }
 
-fcl::Transform3d fcl_pose(const RigidTransform& pose) {
+fcl::Transform3d fcl_pose(const RigidPose& pose) {
   fcl::Transform3d tf = fcl::Transform3d::Identity();
   fcl::Matrix3d r;
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) r(i, j) = pose.rotation[i][j];
+    for (int j = 0; j < 3; ++j) r(i, j) = pose.rotation[j][i];  // glm is column-major
   tf.linear() = r;
   tf.translation() = fcl::Vector3d(pose.translation.x, pose.translation.y, pose.translation.z);
   return tf;
 }
 
 template <class BV>
-std::vector<TrianglePair> fcl_pairs(const fcl::CollisionObjectd& tissue, fcl::CollisionObjectd& tool, const RigidTransform& pose,
+std::vector<TrianglePair> fcl_pairs(const fcl::CollisionObjectd& tissue, fcl::CollisionObjectd& tool, const RigidPose& pose,
                                     double* time_us) {
   tool.setTransform(fcl_pose(pose));
   tool.computeAABB();
@@ -212,7 +200,7 @@ struct Row {
 };
 
 Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, const SphereTree& tool_tree,
-            const std::vector<RigidTransform>& poses, int repetitions, bool with_brute) {
+            const std::vector<RigidPose>& poses, int repetitions, bool with_brute) {
   Row row;
   row.paper_hz = paper_hz;
   ProstateModel gland = generate_prostate(target_triangles);
@@ -313,7 +301,7 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
     fcl::CollisionObjectd fcl_deformed(fcl_refitted);
     fcl::CollisionObjectd fcl_tool_obj(fcl_model<fcl::OBBRSSd>(tool));
     row.deformed_checked = true;
-    for (const RigidTransform& pose : poses) {
+    for (const RigidPose& pose : poses) {
       collider.collide(tissue_tree, tissue, tool_tree, tool, pose);
       const auto expected = collide_brute_force(tissue, tool, pose);
       row.deformed_pairs += expected.size();
@@ -364,7 +352,7 @@ struct SequenceRow {
 };
 
 SequenceRow measure_sequence(int target_triangles, const TriangleMesh& tool, const SphereTree& tool_tree,
-                             const std::vector<RigidTransform>& frames, int repetitions) {
+                             const std::vector<RigidPose>& frames, int repetitions) {
   SequenceRow row;
   ProstateModel gland = generate_prostate(target_triangles);
   const TriangleMesh& tissue = gland.surface;

@@ -44,10 +44,10 @@ TriangleMesh read_mesh_or_fail(const std::string& path) {
   return std::move(mesh).value();
 }
 
-std::vector<RigidTransform> read_poses_or_fail(const std::string& path) {
+std::vector<RigidPose> read_poses_or_fail(const std::string& path) {
   Result<std::string> text = read_text_file(path, " the poses file");
   if (!text) fail(text.error());
-  Result<std::vector<RigidTransform>> poses = parse_poses(*text, path);
+  Result<std::vector<RigidPose>> poses = parse_poses(*text, path);
   if (!poses) fail(poses.error());
   return std::move(poses).value();
 }
@@ -62,7 +62,7 @@ void run_collide(const CollideOptions& options) {
   using Clock = std::chrono::steady_clock;
   const TriangleMesh tissue = read_mesh_or_fail(options.tissue);
   const TriangleMesh tool = read_mesh_or_fail(options.tool);
-  const std::vector<RigidTransform> poses = read_poses_or_fail(options.poses);
+  const std::vector<RigidPose> poses = read_poses_or_fail(options.poses);
 
   const auto build_start = Clock::now();
   SphereTree tissue_tree;
@@ -77,7 +77,7 @@ void run_collide(const CollideOptions& options) {
   std::vector<double> times_us;
   times_us.reserve(poses.size() * static_cast<std::size_t>(options.repeat));
   std::size_t most_pairs = 1 << 16;
-  const auto query = [&](const RigidTransform& pose) {
+  const auto query = [&](const RigidPose& pose) {
     return options.sequence ? collider.collide_sequence(tissue_tree, tissue, tool_tree, tool, pose)
                             : collider.collide(tissue_tree, tissue, tool_tree, tool, pose);
   };

@@ -13,15 +13,6 @@
 namespace resecto {
 namespace {
 
-RigidTransform to_transform(const RigidPose& pose) {
-  RigidTransform t;
-  // glm matrices are column-major: rotation[c][r] is row r, column c.
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) t.rotation[r][c] = pose.rotation[c][r];
-  t.translation = pose.translation;
-  return t;
-}
-
 /// Where the tool waits before the device has reported: far outside the body, touching nothing.
 RigidPose withdrawn_pose() {
   RigidPose pose;
@@ -87,7 +78,7 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
   sim->wire_to_.assign(sim->wire_loop_.size(), Vec3(0.0));
   sim->sweep_ = SweptVolume(sim->wire_loop_.size());
   sim->input_filter_ = JointFilter(config.input_filter);
-  const RigidTransform away = to_transform(withdrawn_pose());
+  const RigidPose away = withdrawn_pose();
   sim->tissue_->tool().reset_pose(sim->sheath_part_, away);
   sim->tissue_->tool().reset_pose(sim->loop_part_, away);
   sim->placed_.poses = {withdrawn_pose(), withdrawn_pose()};
@@ -113,8 +104,8 @@ void Simulation::place_tool(const TickInput& input) {
     placed_joints_ = input_filter_.filter(input.joints, config_.tick_s());
     placed_ = {resecto::tool_poses(placed_joints_, config_.gimbal), true};
   }
-  tissue_->tool().set_pose(sheath_part_, to_transform(placed_.poses.sheath));
-  tissue_->tool().set_pose(loop_part_, to_transform(placed_.poses.loop));
+  tissue_->tool().set_pose(sheath_part_, placed_.poses.sheath);
+  tissue_->tool().set_pose(loop_part_, placed_.poses.loop);
   // The energised loop cuts rather than pushes: while it cuts it takes no part in contact.
   cut_pedal_ = input.tool_present && input.cut;
   tissue_->tool().set_enabled(loop_part_, !loop_cutting());
@@ -211,8 +202,8 @@ void Simulation::advance_collision_pipeline(std::uint64_t tick, FrameProfiler* p
     ahead.insertion_m = now.insertion_m + lead * (now.insertion_m - before.insertion_m);
     ahead.loop_travel_m = now.loop_travel_m + lead * (now.loop_travel_m - before.loop_travel_m);
     searching_.poses = resecto::tool_poses(ahead, config_.gimbal);
-    tissue_->tool().set_query_pose(sheath_part_, to_transform(searching_.poses.sheath));
-    tissue_->tool().set_query_pose(loop_part_, to_transform(searching_.poses.loop));
+    tissue_->tool().set_query_pose(sheath_part_, searching_.poses.sheath);
+    tissue_->tool().set_query_pose(loop_part_, searching_.poses.loop);
   }
   last_search_joints_ = placed_joints_;
   last_search_present_ = placed_.present;

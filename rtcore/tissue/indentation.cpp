@@ -22,14 +22,14 @@ Result<ProstateTissueModel> build_prostate_tissue_model(ProstateModel anatomy, T
   return model;
 }
 
-RigidTransform indentation_loop_pose(const ProstateModel& anatomy, const TriangleMesh& loop, double depth_m) {
-  RigidTransform pose;
+RigidPose indentation_loop_pose(const ProstateModel& anatomy, const TriangleMesh& loop, double depth_m) {
+  RigidPose pose;
   // Roll +90 degrees about the sheath axis: the wire's -y side turns to +x, the left lobe.
-  pose.rotation[0][0] = 0.0, pose.rotation[0][1] = -1.0;
-  pose.rotation[1][0] = 1.0, pose.rotation[1][1] = 0.0;
+  pose.rotation[0] = Vec3(0.0, 1.0, 0.0);  // columns: x -> +y, y -> -x
+  pose.rotation[1] = Vec3(-1.0, 0.0, 0.0);
   Vec3 outermost(-1e300, 0.0, 0.0);
   for (const Vec3& p : loop.positions) {
-    const Vec3 rolled = transform_point(pose, p);
+    const Vec3 rolled = pose.apply_point(p);
     if (rolled.x > outermost.x) outermost = rolled;
   }
   Vec3 crest(0.0);

@@ -26,7 +26,7 @@ Result<ProstateTissueModel> build_prostate_tissue_model(ProstateModel anatomy, T
 
 /// Pose of the loop (in the tool frame of generate_resectoscope) rolled so its wire hangs toward +x,
 /// its outermost point touching the left lateral lobe's crest, moved `depth_m` further along +x.
-RigidTransform indentation_loop_pose(const ProstateModel& anatomy, const TriangleMesh& loop, double depth_m);
+RigidPose indentation_loop_pose(const ProstateModel& anatomy, const TriangleMesh& loop, double depth_m);
 
 /// The protocol and the solver set-up.
 struct IndentationOptions {
