@@ -22,6 +22,7 @@
 #include "rtcore/anatomy/prostate.h"
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/collision/collide.h"
+#include "rtcore/scenes/collision_poses.h"
 
 namespace {
 
@@ -64,45 +65,6 @@ double elapsed_us(double start_us) { return Clock::now() - start_us; }
 double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   return values[values.size() / 2];
-}
-
-// A pose with the sheath along the channel, its tip at depth z, pushed sideways toward angle theta
-// by `offset` and tilted a little: the sheath (8.67 mm) is wider than the lobes leave the lumen, so
-// it lies against the wall along its length and the loop presses into it.
-RigidPose pressing_pose(double z_m, double theta, double offset_m, double tilt_rad, double roll_rad) {
-  // R = R_tilt(about the axis perpendicular to the push) * R_roll(about z).
-  const Vec3 axis{-std::sin(theta), std::cos(theta), 0.0};
-  RigidPose pose;
-  pose.rotation = axis_angle_rotation(axis, tilt_rad) * rotation_about_z(roll_rad);
-  pose.translation = Vec3{offset_m * std::cos(theta), offset_m * std::sin(theta), z_m};
-  return pose;
-}
-
-std::vector<RigidPose> benchmark_poses() {
-  std::vector<RigidPose> poses;
-  std::mt19937_64 rng(2006);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  for (int i = 0; i < 24; ++i) {
-    const double z = 0.012 + 0.028 * i / 23.0;
-    poses.push_back(pressing_pose(z, 2.0 * M_PI * unit(rng), 0.0005 + 0.0015 * unit(rng), 0.03 * (unit(rng) - 0.5),
-                                  -M_PI / 2 + 0.6 * (unit(rng) - 0.5)));
-  }
-  return poses;
-}
-
-// A 60 Hz trajectory of 2 s: the sheath pressed 0.8-1.6 mm into the channel wall, advancing 10 mm/s
-// along it while swinging between sides, and the loop swept through the lobe by rolling the tool.
-// Consecutive frames move the tool's points 0.2-0.4 mm (its far end included): what
-// Collider::collide_sequence() reuses.
-std::vector<RigidPose> trajectory_poses() {
-  std::vector<RigidPose> poses;
-  constexpr int kFrames = 120;
-  for (int f = 0; f < kFrames; ++f) {
-    const double t = f / 60.0;
-    poses.push_back(pressing_pose(0.015 + 0.010 * t, 0.6 + 0.25 * std::sin(1.5 * t), 0.0012 + 0.0004 * std::sin(2.0 * t),
-                                  0.01 * std::sin(t), -M_PI / 2 + 0.5 * std::sin(3.0 * t)));
-  }
-  return poses;
 }
 
 // Writes poses in the `resecto collide` format, in millimetres (the unit `resecto mesh` writes).
@@ -412,7 +374,7 @@ SequenceRow measure_sequence(int target_triangles, const TriangleMesh& tool, con
 
 int run_sequence_table(int repetitions, int only_size) {
   const BenchTool tool = make_bench_tool();
-  const auto frames = trajectory_poses();
+  const auto frames = pressing_trajectory();
   std::printf("\n60 Hz trajectory: %zu consecutive frames (sheath along the wall, loop through the lobe), %d runs of the "
               "whole trajectory, medians and means over every frame of every run (the first frame of a run starts afresh)\n",
               frames.size(), repetitions);
@@ -447,7 +409,7 @@ int run_table(int repetitions, int only_size) {
   const BenchTool bench_tool = make_bench_tool();
   const TriangleMesh& tool = bench_tool.mesh;
   const SphereTree& tool_tree = bench_tool.tree;
-  const auto poses = benchmark_poses();
+  const auto poses = pressing_poses();
   std::printf("collision benchmark: resectoscope %zu triangles (%d leaf spheres), %zu poses pressing into the wall, "
               "median of %d repetitions of every pose\n",
               tool.triangle_count(), tool_tree.leaf_count(), poses.size(), repetitions);
@@ -492,7 +454,7 @@ void BM_Query8640(benchmark::State& state) {
   SphereTree tissue_tree, tool_tree;
   tissue_tree.build(gland.surface);
   tool_tree.build(tool);
-  const auto poses = benchmark_poses();
+  const auto poses = pressing_poses();
   Collider collider;
   std::size_t p = 0;
   for (auto _ : state) {
@@ -508,7 +470,7 @@ void BM_Sequence8640(benchmark::State& state) {
   const BenchTool tool = make_bench_tool();
   SphereTree tissue_tree;
   tissue_tree.build(gland.surface);
-  const auto frames = trajectory_poses();
+  const auto frames = pressing_trajectory();
   Collider collider;
   std::size_t f = 0;
   for (auto _ : state) {
@@ -571,8 +533,8 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--write-poses") == 0 && i + 1 < argc) {
       // The bench's poses for `resecto collide`: PREFIX-independent.txt and PREFIX-trajectory.txt (mm).
       const std::string prefix = argv[++i];
-      write_poses(prefix + "-independent.txt", benchmark_poses());
-      write_poses(prefix + "-trajectory.txt", trajectory_poses());
+      write_poses(prefix + "-independent.txt", pressing_poses());
+      write_poses(prefix + "-trajectory.txt", pressing_trajectory());
       return 0;
     }
   }

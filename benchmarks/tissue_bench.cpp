@@ -10,7 +10,7 @@
 #include <memory>
 
 #include "rtcore/anatomy/resectoscope.h"
-#include "rtcore/tissue/indentation.h"
+#include "rtcore/scenes/indentation.h"
 
 namespace resecto {
 namespace {

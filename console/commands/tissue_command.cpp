@@ -13,7 +13,7 @@
 #include "console/commands/parameter_options.h"
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/base/units.h"
-#include "rtcore/tissue/indentation.h"
+#include "rtcore/scenes/indentation.h"
 
 namespace resecto::cli {
 namespace {

@@ -7,8 +7,8 @@
 #include <cmath>
 
 #include "rtcore/base/units.h"
+#include "rtcore/scenes/prostate_tissue.h"
 #include "rtcore/tissue/state_hash.h"
-#include "rtcore/tissue/tetrahedralize.h"
 
 namespace resecto {
 namespace {
@@ -53,11 +53,7 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
   std::unique_ptr<Simulation> sim(new Simulation());
   sim->config_ = config;
   sim->prostate_ = generate_prostate(config.prostate_triangles);
-  TetrahedralizeOptions tet;
-  tet.capsule_thickness_m = sim->prostate_.shape.capsule_thickness_m;
-  tet.channel_axis = {{0.0, 0.0, 0.0}, {0.0, 0.0, sim->prostate_.shape.length_m}};
-  tet.max_volume_m3 = config.max_tet_volume_m3;
-  Result<TetMesh> tetra = tetrahedralize(sim->prostate_.surface, tet);
+  Result<TetMesh> tetra = tetrahedralize_prostate(sim->prostate_, config.max_tet_volume_m3);
   if (!tetra) return Error{"building the tissue model: " + tetra.error()};
   sim->tetrahedra_ = tetra->tetrahedron_count();
   sim->tissue_ = std::make_unique<MassSpringTissue>(*tetra, config.parameters, config.tissue);

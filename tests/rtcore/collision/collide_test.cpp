@@ -13,7 +13,6 @@
 namespace resecto {
 namespace {
 
-using testing::random_channel_pose;
 
 std::vector<TrianglePair> pairs_of(const Collider& collider) {
   return {collider.pairs().begin(), collider.pairs().end()};

@@ -1,26 +1,11 @@
 // The indentation protocol. Wall-clock timing happens here, around the core's steps, never inside.
-#include "rtcore/tissue/indentation.h"
+#include "rtcore/scenes/indentation.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
-#include "rtcore/tissue/tetrahedralize.h"
-
 namespace resecto {
-
-Result<ProstateTissueModel> build_prostate_tissue_model(ProstateModel anatomy, TriangleMesh loop) {
-  ProstateTissueModel model;
-  model.anatomy = std::move(anatomy);
-  model.loop = std::move(loop);
-  TetrahedralizeOptions options;
-  options.capsule_thickness_m = model.anatomy.shape.capsule_thickness_m;
-  options.channel_axis = {{0.0, 0.0, 0.0}, {0.0, 0.0, model.anatomy.shape.length_m}};
-  Result<TetMesh> mesh = tetrahedralize(model.anatomy.surface, options);
-  if (!mesh) return Error{"prostate of " + std::to_string(model.anatomy.surface.triangle_count()) + " triangles: " + mesh.error()};
-  model.mesh = std::move(*mesh);
-  return model;
-}
 
 RigidPose indentation_loop_pose(const ProstateModel& anatomy, const TriangleMesh& loop, double depth_m) {
   RigidPose pose;
