@@ -21,6 +21,7 @@
 
 #include "rtcore/anatomy/prostate.h"
 #include "rtcore/anatomy/resectoscope.h"
+#include "rtcore/base/quantile.h"
 #include "rtcore/collision/collide.h"
 #include "rtcore/scenes/collision_poses.h"
 
@@ -61,11 +62,6 @@ BenchTool make_bench_tool() {
 }
 
 double elapsed_us(double start_us) { return Clock::now() - start_us; }
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
 
 // Writes poses in the `resecto collide` format, in millimetres (the unit `resecto mesh` writes).
 void write_poses(const std::string& path, const std::vector<RigidPose>& poses) {
@@ -191,7 +187,7 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
       }
     }
   }
-  row.ours_us = median(ours);
+  row.ours_us = quantile(ours, 0.5);
   row.sphere_tests = sphere_tests / static_cast<double>(poses.size());
   row.triangle_tests = triangle_tests / static_cast<double>(poses.size());
   row.leaf_pairs = leaf_pairs / static_cast<double>(poses.size());
@@ -218,7 +214,7 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
       }
     }
   }
-  row.fcl_us = median(fcl_times);
+  row.fcl_us = quantile(fcl_times, 0.5);
 
   if (with_brute) {
     std::vector<double> brute;
@@ -228,7 +224,7 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
       brute.push_back(elapsed_us(start));
       if (found != ours_found[p]) ++row.brute_mismatch;
     }
-    row.brute_us = median(brute);
+    row.brute_us = quantile(brute, 0.5);
   }
 
   // Refit after a full-surface deformation: ours vs FCL's bottom-up AABB refit.
@@ -248,8 +244,8 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
     fcl_aabb->endUpdateModel(true, true);
     fcl_refit.push_back(elapsed_us(start));
   }
-  row.refit_us = median(refit);
-  row.fcl_refit_us = median(fcl_refit);
+  row.refit_us = quantile(refit, 0.5);
+  row.fcl_refit_us = quantile(fcl_refit, 0.5);
   // After the refit, still exact: the deformed surface against the poses, vs brute force.
   // The same poses through FCL's OBBRSS tree built on the rest surface and refitted bottom-up to
   // the deformed one (its update path), against brute force on the deformed surface.
@@ -296,8 +292,8 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
     tissue_tree.insert_triangle(tissue, t);
     inserts.push_back(elapsed_us(start));
   }
-  row.remove_us = median(removes);
-  row.insert_us = median(inserts);
+  row.remove_us = quantile(removes, 0.5);
+  row.insert_us = quantile(inserts, 0.5);
   return row;
 }
 
@@ -362,10 +358,10 @@ SequenceRow measure_sequence(int target_triangles, const TriangleMesh& tool, con
     for (double x : v) sum += x;
     return sum / static_cast<double>(v.size());
   };
-  row.fresh_us = median(fresh_times);
-  row.sequence_us = median(sequence_times);
+  row.fresh_us = quantile(fresh_times, 0.5);
+  row.sequence_us = quantile(sequence_times, 0.5);
   row.sequence_mean_us = mean(sequence_times);
-  row.fcl_us = median(fcl_times);
+  row.fcl_us = quantile(fcl_times, 0.5);
   row.fcl_mean_us = mean(fcl_times);
   row.kept /= static_cast<double>(frames.size());
   row.renewed /= static_cast<double>(frames.size());

@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "rtcore/anatomy/resectoscope.h"
+#include "rtcore/base/quantile.h"
 #include "rtcore/scenes/indentation.h"
 
 namespace resecto {

@@ -16,14 +16,13 @@
 #include "console/commands/command_registry.h"
 #include "console/commands/pose_file.h"
 #include "rtcore/base/atomic_file.h"
+#include "rtcore/base/quantile.h"
 #include "rtcore/base/text_file.h"
 #include "rtcore/collision/collide.h"
 #include "rtcore/mesh/mesh_io.h"
 
 namespace resecto::cli {
 namespace {
-
-[[noreturn]] void fail(const std::string& message) { throw std::runtime_error(message); }
 
 struct CollideOptions {
   std::string tissue;
@@ -50,12 +49,6 @@ std::vector<RigidPose> read_poses_or_fail(const std::string& path) {
   Result<std::vector<RigidPose>> poses = parse_poses(*text, path);
   if (!poses) fail(poses.error());
   return std::move(poses).value();
-}
-
-// Nearest-rank percentile of sorted values.
-double percentile(const std::vector<double>& sorted, double fraction) {
-  const auto rank = static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(sorted.size())));
-  return sorted[std::clamp<std::size_t>(rank, 1, sorted.size()) - 1];
 }
 
 void run_collide(const CollideOptions& options) {
@@ -107,8 +100,8 @@ void run_collide(const CollideOptions& options) {
   }
 
   std::sort(times_us.begin(), times_us.end());
-  const double median = percentile(times_us, 0.5);
-  const double p95 = percentile(times_us, 0.95);
+  const double median = sorted_quantile(times_us, 0.5);
+  const double p95 = sorted_quantile(times_us, 0.95);
   if (options.json) {
     nlohmann::json report = {
         {"tissue_triangles", tissue.triangle_count()},

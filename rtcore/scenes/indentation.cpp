@@ -25,13 +25,6 @@ RigidPose indentation_loop_pose(const ProstateModel& anatomy, const TriangleMesh
   return pose;
 }
 
-double quantile(std::vector<double> samples, double q) {
-  if (samples.empty()) return 0.0;
-  std::sort(samples.begin(), samples.end());
-  const auto rank = static_cast<std::size_t>(std::ceil(q * static_cast<double>(samples.size())));
-  return samples[std::min(samples.size() - 1, rank > 0 ? rank - 1 : 0)];
-}
-
 IndentationResult run_indentation(const ProstateTissueModel& model, const IndentationOptions& options) {
   using Clock = std::chrono::steady_clock;
   MassSpringTissue tissue(model.mesh, options.parameters, options.config);

@@ -58,7 +58,4 @@ struct IndentationResult {
 /// Runs the protocol on a fresh tissue built from `model`.
 IndentationResult run_indentation(const ProstateTissueModel& model, const IndentationOptions& options);
 
-/// The q-quantile (0..1) of samples, by nearest rank; 0 when empty.
-double quantile(std::vector<double> samples, double q);
-
 }  // namespace resecto
