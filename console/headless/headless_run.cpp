@@ -22,7 +22,7 @@
 #include "rtcore/core/fixed_step_scheduler.h"
 #include "rtcore/core/thread_priority.h"
 #include "rtcore/mesh/mesh_io.h"
-#include "rtcore/tissue/state_hash.h"
+#include "rtcore/base/state_hash.h"
 
 namespace resecto {
 namespace {

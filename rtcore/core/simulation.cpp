@@ -4,14 +4,30 @@
 #include "rtcore/core/simulation.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "rtcore/base/units.h"
 #include "rtcore/scenes/prostate_tissue.h"
-#include "rtcore/tissue/state_hash.h"
+#include "rtcore/base/state_hash.h"
 
 namespace resecto {
 namespace {
+
+/// The sheath's and the loop's poses as the state hash reads them, member by member: each pose's
+/// rotation column by column, then its translation. Written out so the hash never depends on how
+/// RigidPose is laid out in memory (it is the order that layout had, so the hash did not change).
+std::array<double, 24> pose_words(const ToolPoses& poses) {
+  std::array<double, 24> words{};
+  std::size_t w = 0;
+  for (const RigidPose* pose : {&poses.sheath, &poses.loop}) {
+    for (int c = 0; c < 3; ++c) {
+      for (int r = 0; r < 3; ++r) words[w++] = pose->rotation[c][r];
+    }
+    for (int r = 0; r < 3; ++r) words[w++] = pose->translation[r];
+  }
+  return words;
+}
 
 /// Where the tool waits before the device has reported: far outside the body, touching nothing.
 RigidPose withdrawn_pose() {
@@ -153,7 +169,8 @@ void Simulation::step(const TickInput& input, std::span<const ParameterCommand> 
       const std::uint64_t tissue_hash = tissue_->state_hash();
       hasher.add(std::span<const std::uint64_t>(&tissue_hash, 1));
       hasher.add(std::span<const std::uint64_t>(&tick, 1));
-      hasher.add(std::span<const RigidPose>(&placed_.poses.sheath, 2));
+      const std::array<double, 24> poses = pose_words(placed_.poses);
+      hasher.add(std::span<const double>(poses));
       state_hash_ = hasher.value();
     }
   }
