@@ -199,7 +199,7 @@ TEST(Resection, PhysicsTicksWhileCuttingAllocateNothingAndNoTickLocks) {
   // The physics ticks between collision ticks (with the search running on its thread) allocate
   // nothing; no tick takes a lock. The collision ticks' topology updates are counted and printed: a
   // decayed sphere tree's rebuild allocates its build scratch, and a few updates still allocate a
-  // little (README "Resection", what is not done).
+  // little (docs/commands.md "Resection", what is not done).
   auto sim = small_simulation();
   const Procedure p = left_lobe_stroke(true, "1.0", true);
   const double tick_s = sim->config().tick_s();
