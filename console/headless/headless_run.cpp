@@ -76,7 +76,7 @@ ordered_json metrics_json(const ProcedureMetrics& m) {
           {"mean_contact_force_n", m.mean_contact_force_n},
           {"max_tissue_displacement_mm", m.max_tissue_displacement_mm},
           {"max_insertion_mm", m.max_insertion_mm},
-          {"distal_margin_mm", m.distal_margin_mm > 1e8 ? ordered_json(nullptr) : ordered_json(m.distal_margin_mm)},
+          {"distal_margin_mm", m.distal_margin_mm ? ordered_json(*m.distal_margin_mm) : ordered_json(nullptr)},
           {"verumontanum_violations", m.verumontanum_violations},
           {"non_finite_steps", m.non_finite_steps},
           {"contact_overflows", m.contact_overflows},

@@ -95,7 +95,6 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
   sim->tissue_->tool().reset_pose(sim->loop_part_, away);
   sim->placed_.poses = {withdrawn_pose(), withdrawn_pose()};
   sim->searching_ = sim->published_ = sim->placed_;
-  sim->metrics_.distal_margin_mm = 1e9;
   sim->state_hash_ = sim->tissue_->state_hash();
   if (config.collision_thread) {
     Simulation* raw = sim.get();
@@ -268,7 +267,8 @@ void Simulation::update_metrics(const TickInput& input, bool collision_tick) {
   metrics_.max_tissue_displacement_mm = std::max(metrics_.max_tissue_displacement_mm, units::m_to_mm(tissue_->max_displacement_m()));
   if (cutting) {
     const double margin_m = placed_.poses.loop.apply_point(loop_front_tool_).z - verumontanum_z_m_;
-    metrics_.distal_margin_mm = std::min(metrics_.distal_margin_mm, units::m_to_mm(margin_m));
+    const double margin_mm = units::m_to_mm(margin_m);
+    metrics_.distal_margin_mm = std::min(metrics_.distal_margin_mm.value_or(margin_mm), margin_mm);
     if (margin_m < 0.0) ++metrics_.verumontanum_violations;
   }
   const ResectionStats& cut = resection_->stats();
