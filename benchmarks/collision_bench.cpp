@@ -7,6 +7,7 @@
 #include <fcl/fcl.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -20,7 +21,9 @@
 
 #include "rtcore/anatomy/prostate.h"
 #include "rtcore/anatomy/resectoscope.h"
+#include "rtcore/base/quantile.h"
 #include "rtcore/collision/collide.h"
+#include "rtcore/scenes/collision_poses.h"
 
 namespace {
 
@@ -60,74 +63,17 @@ BenchTool make_bench_tool() {
 
 double elapsed_us(double start_us) { return Clock::now() - start_us; }
 
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
-
-// A pose with the sheath along the channel, its tip at depth z, pushed sideways toward angle theta
-// by `offset` and tilted a little: the sheath (8.67 mm) is wider than the lobes leave the lumen, so
-// it lies against the wall along its length and the loop presses into it.
-RigidTransform pressing_pose(double z_m, double theta, double offset_m, double tilt_rad, double roll_rad) {
-  const double ct = std::cos(tilt_rad), st = std::sin(tilt_rad);
-  const double cr = std::cos(roll_rad), sr = std::sin(roll_rad);
-  // R = R_tilt(about the axis perpendicular to the push) * R_roll(about z).
-  const Vec3 axis{-std::sin(theta), std::cos(theta), 0.0};
-  double tilt[3][3];
-  const double k[3] = {axis.x, axis.y, axis.z};
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      const double cross_term = (i == j) ? 0.0 : ((i + 1) % 3 == j ? -k[3 - i - j] : k[3 - i - j]);
-      tilt[i][j] = (i == j ? ct : 0.0) + (1.0 - ct) * k[i] * k[j] + st * cross_term;
-    }
-  }
-  const double roll[3][3] = {{cr, -sr, 0}, {sr, cr, 0}, {0, 0, 1}};
-  RigidTransform pose;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) pose.rotation[i][j] = tilt[i][0] * roll[0][j] + tilt[i][1] * roll[1][j] + tilt[i][2] * roll[2][j];
-  pose.translation = Vec3{offset_m * std::cos(theta), offset_m * std::sin(theta), z_m};
-  return pose;
-}
-
-std::vector<RigidTransform> benchmark_poses() {
-  std::vector<RigidTransform> poses;
-  std::mt19937_64 rng(2006);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  for (int i = 0; i < 24; ++i) {
-    const double z = 0.012 + 0.028 * i / 23.0;
-    poses.push_back(pressing_pose(z, 2.0 * M_PI * unit(rng), 0.0005 + 0.0015 * unit(rng), 0.03 * (unit(rng) - 0.5),
-                                  -M_PI / 2 + 0.6 * (unit(rng) - 0.5)));
-  }
-  return poses;
-}
-
-// A 60 Hz trajectory of 2 s: the sheath pressed 0.8-1.6 mm into the channel wall, advancing 10 mm/s
-// along it while swinging between sides, and the loop swept through the lobe by rolling the tool.
-// Consecutive frames move the tool's points 0.2-0.4 mm (its far end included): what
-// Collider::collide_sequence() reuses.
-std::vector<RigidTransform> trajectory_poses() {
-  std::vector<RigidTransform> poses;
-  constexpr int kFrames = 120;
-  for (int f = 0; f < kFrames; ++f) {
-    const double t = f / 60.0;
-    poses.push_back(pressing_pose(0.015 + 0.010 * t, 0.6 + 0.25 * std::sin(1.5 * t), 0.0012 + 0.0004 * std::sin(2.0 * t),
-                                  0.01 * std::sin(t), -M_PI / 2 + 0.5 * std::sin(3.0 * t)));
-  }
-  return poses;
-}
-
 // Writes poses in the `resecto collide` format, in millimetres (the unit `resecto mesh` writes).
-void write_poses(const std::string& path, const std::vector<RigidTransform>& poses) {
+void write_poses(const std::string& path, const std::vector<RigidPose>& poses) {
   std::FILE* out = std::fopen(path.c_str(), "w");
   if (!out) {
     std::fprintf(stderr, "%s: cannot write\n", path.c_str());
     std::exit(1);
   }
-  for (const RigidTransform& p : poses) {
-    for (int i = 0; i < 3; ++i) {
-      std::fprintf(out, "%.17g %.17g %.17g %.17g%s", p.rotation[i][0], p.rotation[i][1], p.rotation[i][2],
-                   1000.0 * p.translation[i], i == 2 ? "\n" : " ");
-    }
+  for (const RigidPose& p : poses) {
+    std::array<double, 12> m = to_row_major_3x4(p);
+    for (int i = 0; i < 3; ++i) m[static_cast<std::size_t>(4 * i + 3)] *= 1000.0;
+    for (std::size_t e = 0; e < 12; ++e) std::fprintf(out, "%.17g%s", m[e], e == 11 ? "\n" : " ");
   }
   std::fclose(out);
 }
@@ -147,18 +93,18 @@ std::shared_ptr<fcl::BVHModel<BV>> fcl_model(const TriangleMesh& mesh) {
   return model;
 }
 
-fcl::Transform3d fcl_pose(const RigidTransform& pose) {
+fcl::Transform3d fcl_pose(const RigidPose& pose) {
   fcl::Transform3d tf = fcl::Transform3d::Identity();
   fcl::Matrix3d r;
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) r(i, j) = pose.rotation[i][j];
+    for (int j = 0; j < 3; ++j) r(i, j) = pose.rotation[j][i];  // glm is column-major
   tf.linear() = r;
   tf.translation() = fcl::Vector3d(pose.translation.x, pose.translation.y, pose.translation.z);
   return tf;
 }
 
 template <class BV>
-std::vector<TrianglePair> fcl_pairs(const fcl::CollisionObjectd& tissue, fcl::CollisionObjectd& tool, const RigidTransform& pose,
+std::vector<TrianglePair> fcl_pairs(const fcl::CollisionObjectd& tissue, fcl::CollisionObjectd& tool, const RigidPose& pose,
                                     double* time_us) {
   tool.setTransform(fcl_pose(pose));
   tool.computeAABB();
@@ -212,7 +158,7 @@ struct Row {
 };
 
 Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, const SphereTree& tool_tree,
-            const std::vector<RigidTransform>& poses, int repetitions, bool with_brute) {
+            const std::vector<RigidPose>& poses, int repetitions, bool with_brute) {
   Row row;
   row.paper_hz = paper_hz;
   ProstateModel gland = generate_prostate(target_triangles);
@@ -253,8 +199,8 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
       row.fcl_extra += diff.size();
     }
   }
-  row.ours_us = median(ours);
-  row.fcl_us = median(fcl_times);
+  row.ours_us = quantile(ours, 0.5);
+  row.fcl_us = quantile(fcl_times, 0.5);
   row.sphere_tests = sphere_tests / static_cast<double>(poses.size());
   row.triangle_tests = triangle_tests / static_cast<double>(poses.size());
   row.leaf_pairs = leaf_pairs / static_cast<double>(poses.size());
@@ -269,7 +215,7 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
       brute.push_back(elapsed_us(start));
       if (found != ours_found[p]) ++row.brute_mismatch;
     }
-    row.brute_us = median(brute);
+    row.brute_us = quantile(brute, 0.5);
   }
 
   // Refit after a full-surface deformation: ours vs FCL's bottom-up AABB refit.
@@ -289,8 +235,8 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
     fcl_aabb->endUpdateModel(true, true);
     fcl_refit.push_back(elapsed_us(start));
   }
-  row.refit_us = median(refit);
-  row.fcl_refit_us = median(fcl_refit);
+  row.refit_us = quantile(refit, 0.5);
+  row.fcl_refit_us = quantile(fcl_refit, 0.5);
   // After the refit, still exact: the deformed surface against the poses, vs brute force.
   // The same poses through FCL's OBBRSS tree built on the rest surface and refitted bottom-up to
   // the deformed one (its update path), against brute force on the deformed surface.
@@ -304,7 +250,7 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
     fcl::CollisionObjectd fcl_deformed(fcl_refitted);
     fcl::CollisionObjectd fcl_tool_obj(fcl_model<fcl::OBBRSSd>(tool));
     row.deformed_checked = true;
-    for (const RigidTransform& pose : poses) {
+    for (const RigidPose& pose : poses) {
       collider.collide(tissue_tree, tissue, tool_tree, tool, pose);
       const auto expected = collide_brute_force(tissue, tool, pose);
       row.deformed_pairs += expected.size();
@@ -337,8 +283,8 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
     tissue_tree.insert_triangle(tissue, t);
     inserts.push_back(elapsed_us(start));
   }
-  row.remove_us = median(removes);
-  row.insert_us = median(inserts);
+  row.remove_us = quantile(removes, 0.5);
+  row.insert_us = quantile(inserts, 0.5);
   return row;
 }
 
@@ -355,7 +301,7 @@ struct SequenceRow {
 };
 
 SequenceRow measure_sequence(int target_triangles, const TriangleMesh& tool, const SphereTree& tool_tree,
-                             const std::vector<RigidTransform>& frames, int repetitions) {
+                             const std::vector<RigidPose>& frames, int repetitions) {
   SequenceRow row;
   ProstateModel gland = generate_prostate(target_triangles);
   const TriangleMesh& tissue = gland.surface;
@@ -403,10 +349,10 @@ SequenceRow measure_sequence(int target_triangles, const TriangleMesh& tool, con
     for (double x : v) sum += x;
     return sum / static_cast<double>(v.size());
   };
-  row.fresh_us = median(fresh_times);
-  row.sequence_us = median(sequence_times);
+  row.fresh_us = quantile(fresh_times, 0.5);
+  row.sequence_us = quantile(sequence_times, 0.5);
   row.sequence_mean_us = mean(sequence_times);
-  row.fcl_us = median(fcl_times);
+  row.fcl_us = quantile(fcl_times, 0.5);
   row.fcl_mean_us = mean(fcl_times);
   row.kept /= static_cast<double>(frames.size());
   row.renewed /= static_cast<double>(frames.size());
@@ -415,7 +361,7 @@ SequenceRow measure_sequence(int target_triangles, const TriangleMesh& tool, con
 
 int run_sequence_table(int repetitions, int only_size) {
   const BenchTool tool = make_bench_tool();
-  const auto frames = trajectory_poses();
+  const auto frames = pressing_trajectory();
   std::printf("\n60 Hz trajectory: %zu consecutive frames (sheath along the wall, loop through the lobe), %d runs of the "
               "whole trajectory, medians and means over every frame of every run (the first frame of a run starts afresh)\n",
               frames.size(), repetitions);
@@ -450,7 +396,7 @@ int run_table(int repetitions, int only_size) {
   const BenchTool bench_tool = make_bench_tool();
   const TriangleMesh& tool = bench_tool.mesh;
   const SphereTree& tool_tree = bench_tool.tree;
-  const auto poses = benchmark_poses();
+  const auto poses = pressing_poses();
   std::printf("collision benchmark: resectoscope %zu triangles (%d leaf spheres), %zu poses pressing into the wall, "
               "median of %d repetitions of every pose\n",
               tool.triangle_count(), tool_tree.leaf_count(), poses.size(), repetitions);
@@ -495,7 +441,7 @@ void query_case(benchmark::State& state, bool slabs) {
   SphereTree tissue_tree, tool_tree;
   tissue_tree.build(gland.surface);
   tool_tree.build(tool);
-  const auto poses = benchmark_poses();
+  const auto poses = pressing_poses();
   Collider collider;
   collider.set_slabs(slabs);
   std::size_t p = 0;
@@ -516,7 +462,7 @@ void BM_Sequence8640(benchmark::State& state) {
   const BenchTool tool = make_bench_tool();
   SphereTree tissue_tree;
   tissue_tree.build(gland.surface);
-  const auto frames = trajectory_poses();
+  const auto frames = pressing_trajectory();
   Collider collider;
   std::size_t f = 0;
   for (auto _ : state) {
@@ -579,8 +525,8 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--write-poses") == 0 && i + 1 < argc) {
       // The bench's poses for `resecto collide`: PREFIX-independent.txt and PREFIX-trajectory.txt (mm).
       const std::string prefix = argv[++i];
-      write_poses(prefix + "-independent.txt", benchmark_poses());
-      write_poses(prefix + "-trajectory.txt", trajectory_poses());
+      write_poses(prefix + "-independent.txt", pressing_poses());
+      write_poses(prefix + "-trajectory.txt", pressing_trajectory());
       return 0;
     }
   }

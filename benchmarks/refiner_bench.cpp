@@ -13,7 +13,7 @@
 
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/resection/tet_refiner.h"
-#include "rtcore/tissue/indentation.h"
+#include "rtcore/scenes/prostate_tissue.h"
 
 namespace resecto {
 namespace {

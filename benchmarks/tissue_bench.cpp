@@ -10,7 +10,8 @@
 #include <memory>
 
 #include "rtcore/anatomy/resectoscope.h"
-#include "rtcore/tissue/indentation.h"
+#include "rtcore/base/quantile.h"
+#include "rtcore/scenes/indentation.h"
 
 namespace resecto {
 namespace {

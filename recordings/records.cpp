@@ -1,7 +1,11 @@
 // Packing of tick, step, command and keyframe payloads (layouts in recordings/README.md).
 #include "recordings/records.h"
 
+#include <cmath>
 #include <cstring>
+#include <limits>
+#include <optional>
+#include <type_traits>
 #include <string>
 
 #include <zlib.h>
@@ -83,12 +87,45 @@ void put_pose(std::uint64_t* out, const RigidPose& pose) {
 }
 
 RigidPose get_pose(const std::uint64_t* in) {
-  RigidPose pose;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) pose.rotation[c][r] = double_of(in[r * 4 + c]);
-    pose.translation[r] = double_of(in[r * 4 + 3]);
-  }
-  return pose;
+  std::array<double, 12> m{};
+  for (std::size_t i = 0; i < 12; ++i) m[i] = double_of(in[i]);
+  return from_row_major_3x4(m);
+}
+
+// The distal margin's word when there is none yet (no cut). Files written before it became an
+// optional hold 1e9 there, which reads back as none too.
+constexpr double kNoMarginWord = std::numeric_limits<double>::quiet_NaN();
+constexpr double kOldNoMarginWord = 1e9;
+
+void put_metrics(std::uint64_t* out, const ProcedureMetrics& metrics) {
+  std::size_t w = 0;
+  for_each_metric(metrics, [&](const auto& field) {
+    using Field = std::decay_t<decltype(field)>;
+    if constexpr (std::is_same_v<Field, std::uint64_t>) {
+      out[w++] = field;
+    } else if constexpr (std::is_same_v<Field, double>) {
+      out[w++] = bits_of(field);
+    } else {
+      out[w++] = bits_of(field.value_or(kNoMarginWord));
+    }
+  });
+}
+
+ProcedureMetrics get_metrics(const std::uint64_t* in) {
+  ProcedureMetrics metrics;
+  std::size_t w = 0;
+  for_each_metric(metrics, [&](auto& field) {
+    using Field = std::decay_t<decltype(field)>;
+    if constexpr (std::is_same_v<Field, std::uint64_t>) {
+      field = in[w++];
+    } else if constexpr (std::is_same_v<Field, double>) {
+      field = double_of(in[w++]);
+    } else {
+      const double value = double_of(in[w++]);
+      field = std::isnan(value) || value >= kOldNoMarginWord ? std::nullopt : std::optional<double>(value);
+    }
+  });
+  return metrics;
 }
 
 }  // namespace
@@ -137,7 +174,7 @@ void encode_step_block(std::span<const StepRecord> steps, std::vector<std::uint8
     row[1] = steps[i].state_hash;
     put_pose(row + 2, steps[i].tool.sheath);
     put_pose(row + 2 + kPoseWords, steps[i].tool.loop);
-    std::memcpy(row + 2 + 2 * kPoseWords, &steps[i].metrics, sizeof(ProcedureMetrics));
+    put_metrics(row + 2 + 2 * kPoseWords, steps[i].metrics);
   }
   put_columns(w, words, static_cast<std::uint32_t>(steps.size()), kStepColumns);
 }
@@ -154,7 +191,7 @@ Result<std::vector<StepRecord>> decode_step_block(std::span<const std::uint8_t> 
     steps[i].state_hash = row[1];
     steps[i].tool.sheath = get_pose(row + 2);
     steps[i].tool.loop = get_pose(row + 2 + kPoseWords);
-    std::memcpy(static_cast<void*>(&steps[i].metrics), row + 2 + 2 * kPoseWords, sizeof(ProcedureMetrics));
+    steps[i].metrics = get_metrics(row + 2 + 2 * kPoseWords);
   }
   return steps;
 }

@@ -29,9 +29,9 @@ struct StepRecord {
   ProcedureMetrics metrics;
 };
 
-/// ProcedureMetrics is recorded as its 8-byte fields in declaration order (names in the README).
-static_assert(std::is_trivially_copyable_v<ProcedureMetrics> && sizeof(ProcedureMetrics) % 8 == 0);
-inline constexpr std::uint32_t kMetricWords = sizeof(ProcedureMetrics) / 8;
+/// ProcedureMetrics is recorded as one word per field in declaration order (for_each_metric; names in
+/// recordings/README.md).
+inline constexpr std::uint32_t kMetricWords = static_cast<std::uint32_t>(metric_field_count());
 
 /// Payload of a kTicks chunk: consecutive ticks (`ticks[i].tick == ticks[0].tick + i`).
 void encode_tick_block(std::span<const TickRecord> ticks, std::vector<std::uint8_t>& payload);

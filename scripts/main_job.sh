@@ -29,7 +29,7 @@ echo
   --trace "$out/realtime-trace.json"
 echo
 # The machine's own floor for that schedule: the same scheduler and priority with ticks that compute
-# nothing. Misses it shows too are the machine's (README, "Running the simulator").
+# nothing. Misses it shows too are the machine's (docs/commands.md, "Running the simulator"; benchmarks/results/README.md).
 floor="$(dirname "$bin")/../benchmarks/deadline_floor_bench"
 if [ -x "$floor" ]; then
   echo "the machine's own floor (the same schedule, each tick only 300 us of busy waiting):"

@@ -16,14 +16,13 @@
 #include "console/commands/command_registry.h"
 #include "console/commands/pose_file.h"
 #include "rtcore/base/atomic_file.h"
+#include "rtcore/base/quantile.h"
 #include "rtcore/base/text_file.h"
 #include "rtcore/collision/collide.h"
 #include "rtcore/mesh/mesh_io.h"
 
 namespace resecto::cli {
 namespace {
-
-[[noreturn]] void fail(const std::string& message) { throw std::runtime_error(message); }
 
 struct CollideOptions {
   std::string tissue;
@@ -44,25 +43,19 @@ TriangleMesh read_mesh_or_fail(const std::string& path) {
   return std::move(mesh).value();
 }
 
-std::vector<RigidTransform> read_poses_or_fail(const std::string& path) {
+std::vector<RigidPose> read_poses_or_fail(const std::string& path) {
   Result<std::string> text = read_text_file(path, " the poses file");
   if (!text) fail(text.error());
-  Result<std::vector<RigidTransform>> poses = parse_poses(*text, path);
+  Result<std::vector<RigidPose>> poses = parse_poses(*text, path);
   if (!poses) fail(poses.error());
   return std::move(poses).value();
-}
-
-// Nearest-rank percentile of sorted values.
-double percentile(const std::vector<double>& sorted, double fraction) {
-  const auto rank = static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(sorted.size())));
-  return sorted[std::clamp<std::size_t>(rank, 1, sorted.size()) - 1];
 }
 
 void run_collide(const CollideOptions& options) {
   using Clock = std::chrono::steady_clock;
   const TriangleMesh tissue = read_mesh_or_fail(options.tissue);
   const TriangleMesh tool = read_mesh_or_fail(options.tool);
-  const std::vector<RigidTransform> poses = read_poses_or_fail(options.poses);
+  const std::vector<RigidPose> poses = read_poses_or_fail(options.poses);
 
   const auto build_start = Clock::now();
   SphereTree tissue_tree;
@@ -77,7 +70,7 @@ void run_collide(const CollideOptions& options) {
   std::vector<double> times_us;
   times_us.reserve(poses.size() * static_cast<std::size_t>(options.repeat));
   std::size_t most_pairs = 1 << 16;
-  const auto query = [&](const RigidTransform& pose) {
+  const auto query = [&](const RigidPose& pose) {
     return options.sequence ? collider.collide_sequence(tissue_tree, tissue, tool_tree, tool, pose)
                             : collider.collide(tissue_tree, tissue, tool_tree, tool, pose);
   };
@@ -107,8 +100,8 @@ void run_collide(const CollideOptions& options) {
   }
 
   std::sort(times_us.begin(), times_us.end());
-  const double median = percentile(times_us, 0.5);
-  const double p95 = percentile(times_us, 0.95);
+  const double median = sorted_quantile(times_us, 0.5);
+  const double p95 = sorted_quantile(times_us, 0.95);
   if (options.json) {
     nlohmann::json report = {
         {"tissue_triangles", tissue.triangle_count()},

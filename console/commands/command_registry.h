@@ -2,6 +2,7 @@
 // static RegisterCommand, and main() adds them all, in name order so --help reads the same each time.
 #pragma once
 
+#include <stdexcept>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -18,6 +19,9 @@ struct RegisterCommand {
 /// The subcommand `name` of `app`, created on first use: families that share a prefix (`device list`,
 /// `device calibrate`) live in different files and meet here.
 CLI::App& subcommand_family(CLI::App& app, const std::string& name, const std::string& description);
+
+/// Ends the running subcommand: main() prints `resecto: <message>` on standard error and exits 1.
+[[noreturn]] inline void fail(const std::string& message) { throw std::runtime_error(message); }
 
 /// Adds every registered family to `app`, ordered by name.
 void register_all_commands(CLI::App& app);

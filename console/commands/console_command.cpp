@@ -32,7 +32,7 @@ void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_r
   cmd.add_option("--preset", o.preset, "Tissue parameter preset (JSON) to start from");
   cmd.add_option("--replay", o.replay, "Open this recording in the replay panel and show it in the views");
   if (!shared_with_run) cmd.add_option("--record", o.record, "Record the session from its first tick to this file (replayable and verifiable)");
-  cmd.add_option("--actions", o.actions, "Scripted UI actions, one 'frame N VERB ...' per line (README, \"Operator console\")");
+  cmd.add_option("--actions", o.actions, "Scripted UI actions, one 'frame N VERB ...' per line (docs/commands.md, \"Operator console\")");
   CLI::Option* frames = cmd.add_option("--frames", o.frames, "Quit after this many frames")->check(CLI::Range(1, 100000000));
   cmd.add_option("--screenshot", o.screenshot, "Write a PNG of the whole window after the last of --frames")->needs(frames);
   cmd.add_flag("--lockstep", o.lockstep,

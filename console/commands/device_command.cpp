@@ -33,7 +33,6 @@ namespace {
 
 constexpr const char* kFamilyDescription = "Device tools: list, monitor and calibrate the LP3500 resectoscope interface";
 
-[[noreturn]] void fail(const std::string& message) { throw std::runtime_error(message); }
 
 std::string hex4(unsigned value) {
   char text[8];

@@ -39,7 +39,6 @@ void print_surface_report(const SurfaceReport& r) {
               units::m_to_mm(r.max_edge_m), r.min_angle_deg);
 }
 
-[[noreturn]] void fail(const std::string& message) { throw std::runtime_error(message); }
 
 SurfaceReport validated(const TriangleMesh& mesh, const std::string& what) {
   Result<SurfaceReport> report = validate_closed_surface(mesh);

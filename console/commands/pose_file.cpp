@@ -1,16 +1,20 @@
 // Pose lines for `resecto collide`, checked at the edge: finite, rigid, within reach.
 #include "console/commands/pose_file.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
+
+#include <glm/matrix.hpp>
 
 #include "rtcore/base/checked_number.h"
 
 namespace resecto::cli {
 
-Result<std::vector<RigidTransform>> parse_poses(const std::string& text, const std::string& source) {
-  std::vector<RigidTransform> poses;
+Result<std::vector<RigidPose>> parse_poses(const std::string& text, const std::string& source) {
+  std::vector<RigidPose> poses;
   std::istringstream in(text);
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {
@@ -34,24 +38,17 @@ Result<std::vector<RigidTransform>> parse_poses(const std::string& text, const s
     if (count != 12) {
       return Error{where + "expected 12 numbers (r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz), found " + std::to_string(count)};
     }
-    RigidTransform pose;
+    std::array<double, 12> row_major{};
+    std::copy(values, values + 12, row_major.begin());
+    const RigidPose pose = from_row_major_3x4(row_major);
     for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) pose.rotation[i][j] = values[4 * i + j];
-      pose.translation[i] = values[4 * i + 3];
       if (!in_closed_range(pose.translation[i], -kMaxPoseTranslation, kMaxPoseTranslation)) {
         return Error{where + "translation " + exact_number(pose.translation[i]) + " is outside [" + exact_number(-kMaxPoseTranslation) +
                      ", " + exact_number(kMaxPoseTranslation) + "]"};
       }
     }
-    const auto& r = pose.rotation;
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) {
-        const double rtr = r[0][i] * r[0][j] + r[1][i] * r[1][j] + r[2][i] * r[2][j];
-        if (!(std::abs(rtr - (i == j ? 1.0 : 0.0)) <= 1e-4)) return Error{where + "the 3x3 rotation is not orthonormal"};
-      }
-    }
-    const double det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
-                       r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+    if (!(orthonormality_error(pose.rotation) <= 1e-4)) return Error{where + "the 3x3 rotation is not orthonormal"};
+    const double det = glm::determinant(pose.rotation);
     if (!(det > 0.0)) return Error{where + "the 3x3 rotation is a reflection (determinant " + exact_number(det) + "), not a rotation"};
     poses.push_back(pose);
   }

@@ -14,6 +14,6 @@ inline constexpr double kMaxPoseTranslation = 1e6;
 
 /// Parses pose text: blank lines and '#' comments skipped; every rotation orthonormal to 1e-4 with
 /// determinant +1 (a mirror is not a rigid motion); errors name file:line.
-Result<std::vector<RigidTransform>> parse_poses(const std::string& text, const std::string& source);
+Result<std::vector<RigidPose>> parse_poses(const std::string& text, const std::string& source);
 
 }  // namespace resecto::cli

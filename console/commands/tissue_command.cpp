@@ -12,8 +12,9 @@
 #include "console/commands/command_registry.h"
 #include "console/commands/parameter_options.h"
 #include "rtcore/anatomy/resectoscope.h"
+#include "rtcore/base/quantile.h"
 #include "rtcore/base/units.h"
-#include "rtcore/tissue/indentation.h"
+#include "rtcore/scenes/indentation.h"
 
 namespace resecto::cli {
 namespace {

@@ -1,6 +1,6 @@
 // The console's scripted input (`resecto console --actions FILE`): timed UI actions a person could do,
 // played into the same paths the widgets use, so tests and tutorials drive the real window. One action
-// per line, `frame N VERB ...`; `#` starts a comment. The README's "Operator console" section lists
+// per line, `frame N VERB ...`; `#` starts a comment. docs/commands.md's "Operator console" section lists
 // every verb.
 #pragma once
 

@@ -185,10 +185,10 @@ void draw_metrics_panel(ConsoleController& console) {
   row("cut pedal", "%.2f s (%.2f s in contact)", m.cut_pedal_time_s, m.cut_in_contact_time_s);
   row("tissue moved", "up to %.2f mm", m.max_tissue_displacement_mm);
   row("deepest insertion", "%.1f mm", m.max_insertion_mm);
-  if (m.distal_margin_mm > 1e8) {
+  if (!m.distal_margin_mm) {
     row("verumontanum margin", "no cut yet");
   } else {
-    row("verumontanum margin", "%.1f mm (%" PRIu64 " violations)", m.distal_margin_mm, m.verumontanum_violations);
+    row("verumontanum margin", "%.1f mm (%" PRIu64 " violations)", *m.distal_margin_mm, m.verumontanum_violations);
   }
   resection_rows(m);
   row("faults", "%" PRIu64 " non-finite, %" PRIu64 " contact overflows", m.non_finite_steps, m.contact_overflows);

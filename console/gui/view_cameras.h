@@ -6,7 +6,7 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
-#include "rtcore/kinematics/rigid_pose.h"
+#include "rtcore/geometry/rigid_pose.h"
 
 namespace resecto::gui {
 

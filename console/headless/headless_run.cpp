@@ -22,7 +22,7 @@
 #include "rtcore/core/fixed_step_scheduler.h"
 #include "rtcore/core/thread_priority.h"
 #include "rtcore/mesh/mesh_io.h"
-#include "rtcore/tissue/state_hash.h"
+#include "rtcore/base/state_hash.h"
 
 namespace resecto {
 namespace {
@@ -76,7 +76,7 @@ ordered_json metrics_json(const ProcedureMetrics& m) {
           {"mean_contact_force_n", m.mean_contact_force_n},
           {"max_tissue_displacement_mm", m.max_tissue_displacement_mm},
           {"max_insertion_mm", m.max_insertion_mm},
-          {"distal_margin_mm", m.distal_margin_mm > 1e8 ? ordered_json(nullptr) : ordered_json(m.distal_margin_mm)},
+          {"distal_margin_mm", m.distal_margin_mm ? ordered_json(*m.distal_margin_mm) : ordered_json(nullptr)},
           {"verumontanum_violations", m.verumontanum_violations},
           {"non_finite_steps", m.non_finite_steps},
           {"contact_overflows", m.contact_overflows},

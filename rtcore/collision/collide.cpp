@@ -14,13 +14,13 @@ double max_abs(const Vec3& v) { return std::max({std::abs(v.x), std::abs(v.y), s
 
 // An upper bound on how much the pose's matrix can lengthen a vector: sqrt of the infinity norm of
 // R^T R bounds its spectral norm; exactly 1 (up to rounding) for a rotation.
-double stretch_bound(const RigidTransform& pose) {
+double stretch_bound(const RigidPose& pose) {
   const auto& r = pose.rotation;
   double worst_row = 0.0;
   for (int i = 0; i < 3; ++i) {
     double row = 0.0;
     for (int j = 0; j < 3; ++j) {
-      row += std::abs(r[0][i] * r[0][j] + r[1][i] * r[1][j] + r[2][i] * r[2][j]);
+      row += std::abs(r[i][0] * r[j][0] + r[i][1] * r[j][1] + r[i][2] * r[j][2]);
     }
     worst_row = std::max(worst_row, row);
   }
@@ -193,7 +193,7 @@ double Collider::gap(std::int32_t tissue_node, std::int32_t tool_node) const {
 // ---- The descent --------------------------------------------------------------------------------
 
 bool Collider::begin_query(const SphereTree& tissue_tree, const SphereTree& tool_tree, const TriangleMesh& tool,
-                           const RigidTransform& tool_pose) {
+                           const RigidPose& tool_pose) {
   pair_count_ = 0;
   l1_count_ = 0;
   l2_count_ = 0;
@@ -215,9 +215,9 @@ bool Collider::begin_query(const SphereTree& tissue_tree, const SphereTree& tool
   // Place the tool once: its tree and mesh are small next to the work of the descent.
   const std::vector<Sphere>& tool_rest = tool_tree.spheres();
   for (std::size_t n = 0; n < tool_rest.size(); ++n) {
-    tool_spheres_[n] = {transform_point(pose_, tool_rest[n].center), tool_rest[n].radius * radius_scale_};
+    tool_spheres_[n] = {pose_.apply_point(tool_rest[n].center), tool_rest[n].radius * radius_scale_};
   }
-  for (std::size_t v = 0; v < tool_vertices_.size(); ++v) tool_vertices_[v] = transform_point(pose_, tool.positions[v]);
+  for (std::size_t v = 0; v < tool_vertices_.size(); ++v) tool_vertices_[v] = pose_.apply_point(tool.positions[v]);
   for (std::size_t u = 0; u < tool_boxes_.size(); ++u) {
     const Triangle& t = tool.triangles[u];
     const Vec3& a = tool_vertices_[t[0]];
@@ -238,7 +238,7 @@ bool Collider::begin_query(const SphereTree& tissue_tree, const SphereTree& tool
   double defect = 0.0;
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
-      const double rtr = r[0][i] * r[0][j] + r[1][i] * r[1][j] + r[2][i] * r[2][j];
+      const double rtr = r[i][0] * r[j][0] + r[i][1] * r[j][1] + r[i][2] * r[j][2];
       defect = std::max(defect, std::abs(rtr - (i == j ? 1.0 : 0.0)));
     }
   }
@@ -248,8 +248,7 @@ bool Collider::begin_query(const SphereTree& tissue_tree, const SphereTree& tool
     const std::vector<Slab>& rest_slabs = tool_tree.slabs();
     for (std::size_t n = 0; n < rest_slabs.size(); ++n) {
       const Vec3& m = rest_slabs[n].normal;
-      const Vec3 normal{r[0][0] * m.x + r[0][1] * m.y + r[0][2] * m.z, r[1][0] * m.x + r[1][1] * m.y + r[1][2] * m.z,
-                        r[2][0] * m.x + r[2][1] * m.y + r[2][2] * m.z};
+      const Vec3 normal = tool_pose.apply_vector(m);
       const double offset = dot(normal, tool_pose.translation);
       tool_slabs_[n] = {normal, rest_slabs[n].lo + offset, rest_slabs[n].hi + offset};
     }
@@ -421,7 +420,7 @@ void Collider::finish_query() {
 }
 
 bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
-                       const TriangleMesh& tool, const RigidTransform& tool_pose) {
+                       const TriangleMesh& tool, const RigidPose& tool_pose) {
   if (!begin_query(tissue_tree, tool_tree, tool, tool_pose)) return true;
   tissue_mesh_ = &tissue;
   descend<false>({tissue_tree.root(), tool_tree.root()});
@@ -436,7 +435,7 @@ void Collider::reserve_front(std::int32_t max_front) {
 }
 
 bool Collider::collide_sequence(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
-                                const TriangleMesh& tool, const RigidTransform& tool_pose, double tissue_travel_m) {
+                                const TriangleMesh& tool, const RigidPose& tool_pose, double tissue_travel_m) {
   if (!begin_query(tissue_tree, tool_tree, tool, tool_pose)) {
     front_valid_ = false;
     return true;
@@ -512,9 +511,9 @@ bool Collider::collide_sequence(const SphereTree& tissue_tree, const TriangleMes
 }
 
 std::vector<TrianglePair> collide_brute_force(const TriangleMesh& tissue, const TriangleMesh& tool,
-                                              const RigidTransform& tool_pose) {
+                                              const RigidPose& tool_pose) {
   std::vector<Vec3> world(tool.vertex_count());
-  for (std::size_t v = 0; v < world.size(); ++v) world[v] = transform_point(tool_pose, tool.positions[v]);
+  for (std::size_t v = 0; v < world.size(); ++v) world[v] = tool_pose.apply_point(tool.positions[v]);
   const auto box_of = [](const Vec3& a, const Vec3& b, const Vec3& c) {
     return Aabb{glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
   };

@@ -8,22 +8,9 @@
 #include <vector>
 
 #include "rtcore/collision/sphere_tree.h"
+#include "rtcore/geometry/rigid_pose.h"
 
 namespace resecto {
-
-/// A rigid placement of the tool: world = rotation * tool + translation (rotation row-major).
-struct RigidTransform {
-  double rotation[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-  Vec3 translation{0.0};
-};
-
-/// The one way a tool point reaches the world: every caller (query, brute force) rounds alike.
-inline Vec3 transform_point(const RigidTransform& pose, const Vec3& p) {
-  const auto& r = pose.rotation;
-  return {r[0][0] * p.x + r[0][1] * p.y + r[0][2] * p.z + pose.translation.x,
-          r[1][0] * p.x + r[1][1] * p.y + r[1][2] * p.z + pose.translation.y,
-          r[2][0] * p.x + r[2][1] * p.y + r[2][2] * p.z + pose.translation.z};
-}
 
 /// An intersecting pair: a tissue triangle and a tool triangle (indices into their meshes).
 struct TrianglePair {
@@ -59,7 +46,7 @@ class Collider {
   /// `tool_pose` (the tool tree is in tool coordinates; its spheres move with the pose, never
   /// refitted). Pairs come out sorted by (tissue, tool), each once. False on overflow.
   bool collide(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
-               const TriangleMesh& tool, const RigidTransform& tool_pose);
+               const TriangleMesh& tool, const RigidPose& tool_pose);
 
   /// The same pairs as collide() for consecutive poses of one tool against one tissue tree, reusing
   /// the previous call's work (temporal coherence). Every node pair where the last descent stopped
@@ -71,7 +58,7 @@ class Collider {
   /// either tree's structure changed or the cached pairs grew past twice a fresh descent's. The
   /// leaf lists are those of the walked pairs (a subset of collide()'s); the pairs are the same.
   bool collide_sequence(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
-                        const TriangleMesh& tool, const RigidTransform& tool_pose, double tissue_travel_m = 0.0);
+                        const TriangleMesh& tool, const RigidPose& tool_pose, double tissue_travel_m = 0.0);
   /// Forgets the cached front: the next collide_sequence() descends from the roots.
   void reset_sequence() { front_valid_ = false; }
   /// Room for this many cached node pairs (a sequence that needs more starts afresh each call).
@@ -100,7 +87,7 @@ class Collider {
   void prepare(const SphereTree& tissue_tree, const SphereTree& tool_tree, const TriangleMesh& tool);
   /// Resets the per-query state and places the tool; false when either tree is empty.
   bool begin_query(const SphereTree& tissue_tree, const SphereTree& tool_tree, const TriangleMesh& tool,
-                   const RigidTransform& tool_pose);
+                   const RigidPose& tool_pose);
   /// The bounds test of one node pair: > 0 is a lower bound on the distance between their
   /// triangles (separated), <= 0 means they may meet.
   double gap(std::int32_t tissue_node, std::int32_t tool_node) const;
@@ -116,7 +103,7 @@ class Collider {
   void test_triangles(const TriangleMesh& tissue, std::uint32_t a, std::uint32_t b, bool may_repeat);
   void next_stamp();
 
-  RigidTransform pose_;
+  RigidPose pose_;
   // The trees and meshes of the running query.
   const SphereTree* tissue_tree_ = nullptr;
   const SphereTree* tool_tree_ = nullptr;
@@ -183,6 +170,6 @@ class Collider {
 /// Every intersecting pair by testing every tissue triangle against every tool triangle (with a
 /// box-overlap prefilter, exact on the coordinates), sorted: the oracle and the benchmark baseline.
 std::vector<TrianglePair> collide_brute_force(const TriangleMesh& tissue, const TriangleMesh& tool,
-                                              const RigidTransform& tool_pose);
+                                              const RigidPose& tool_pose);
 
 }  // namespace resecto

@@ -4,22 +4,29 @@
 #include "rtcore/core/simulation.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "rtcore/base/units.h"
-#include "rtcore/tissue/state_hash.h"
-#include "rtcore/tissue/tetrahedralize.h"
+#include "rtcore/scenes/prostate_tissue.h"
+#include "rtcore/base/state_hash.h"
 
 namespace resecto {
 namespace {
 
-RigidTransform to_transform(const RigidPose& pose) {
-  RigidTransform t;
-  // glm matrices are column-major: rotation[c][r] is row r, column c.
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) t.rotation[r][c] = pose.rotation[c][r];
-  t.translation = pose.translation;
-  return t;
+/// The sheath's and the loop's poses as the state hash reads them, member by member: each pose's
+/// rotation column by column, then its translation. Written out so the hash never depends on how
+/// RigidPose is laid out in memory (it is the order that layout had, so the hash did not change).
+std::array<double, 24> pose_words(const ToolPoses& poses) {
+  std::array<double, 24> words{};
+  std::size_t w = 0;
+  for (const RigidPose* pose : {&poses.sheath, &poses.loop}) {
+    for (int c = 0; c < 3; ++c) {
+      for (int r = 0; r < 3; ++r) words[w++] = pose->rotation[c][r];
+    }
+    for (int r = 0; r < 3; ++r) words[w++] = pose->translation[r];
+  }
+  return words;
 }
 
 /// Where the tool waits before the device has reported: far outside the body, touching nothing.
@@ -62,11 +69,7 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
   std::unique_ptr<Simulation> sim(new Simulation());
   sim->config_ = config;
   sim->prostate_ = generate_prostate(config.prostate_triangles);
-  TetrahedralizeOptions tet;
-  tet.capsule_thickness_m = sim->prostate_.shape.capsule_thickness_m;
-  tet.channel_axis = {{0.0, 0.0, 0.0}, {0.0, 0.0, sim->prostate_.shape.length_m}};
-  tet.max_volume_m3 = config.max_tet_volume_m3;
-  Result<TetMesh> tetra = tetrahedralize(sim->prostate_.surface, tet);
+  Result<TetMesh> tetra = tetrahedralize_prostate(sim->prostate_, config.max_tet_volume_m3);
   if (!tetra) return Error{"building the tissue model: " + tetra.error()};
   sim->tetrahedra_ = tetra->tetrahedron_count();
   sim->tissue_ = std::make_unique<MassSpringTissue>(*tetra, config.parameters, config.tissue);
@@ -87,12 +90,11 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
   sim->wire_to_.assign(sim->wire_loop_.size(), Vec3(0.0));
   sim->sweep_ = SweptVolume(sim->wire_loop_.size());
   sim->input_filter_ = JointFilter(config.input_filter);
-  const RigidTransform away = to_transform(withdrawn_pose());
+  const RigidPose away = withdrawn_pose();
   sim->tissue_->tool().reset_pose(sim->sheath_part_, away);
   sim->tissue_->tool().reset_pose(sim->loop_part_, away);
   sim->placed_.poses = {withdrawn_pose(), withdrawn_pose()};
   sim->searching_ = sim->published_ = sim->placed_;
-  sim->metrics_.distal_margin_mm = 1e9;
   sim->state_hash_ = sim->tissue_->state_hash();
   if (config.collision_thread) {
     Simulation* raw = sim.get();
@@ -113,8 +115,8 @@ void Simulation::place_tool(const TickInput& input) {
     placed_joints_ = input_filter_.filter(input.joints, config_.tick_s());
     placed_ = {resecto::tool_poses(placed_joints_, config_.gimbal), true};
   }
-  tissue_->tool().set_pose(sheath_part_, to_transform(placed_.poses.sheath));
-  tissue_->tool().set_pose(loop_part_, to_transform(placed_.poses.loop));
+  tissue_->tool().set_pose(sheath_part_, placed_.poses.sheath);
+  tissue_->tool().set_pose(loop_part_, placed_.poses.loop);
   // The energised loop cuts rather than pushes: while it cuts it takes no part in contact.
   cut_pedal_ = input.tool_present && input.cut;
   tissue_->tool().set_enabled(loop_part_, !loop_cutting());
@@ -166,7 +168,8 @@ void Simulation::step(const TickInput& input, std::span<const ParameterCommand> 
       const std::uint64_t tissue_hash = tissue_->state_hash();
       hasher.add(std::span<const std::uint64_t>(&tissue_hash, 1));
       hasher.add(std::span<const std::uint64_t>(&tick, 1));
-      hasher.add(std::span<const RigidPose>(&placed_.poses.sheath, 2));
+      const std::array<double, 24> poses = pose_words(placed_.poses);
+      hasher.add(std::span<const double>(poses));
       state_hash_ = hasher.value();
     }
   }
@@ -211,8 +214,8 @@ void Simulation::advance_collision_pipeline(std::uint64_t tick, FrameProfiler* p
     ahead.insertion_m = now.insertion_m + lead * (now.insertion_m - before.insertion_m);
     ahead.loop_travel_m = now.loop_travel_m + lead * (now.loop_travel_m - before.loop_travel_m);
     searching_.poses = resecto::tool_poses(ahead, config_.gimbal);
-    tissue_->tool().set_query_pose(sheath_part_, to_transform(searching_.poses.sheath));
-    tissue_->tool().set_query_pose(loop_part_, to_transform(searching_.poses.loop));
+    tissue_->tool().set_query_pose(sheath_part_, searching_.poses.sheath);
+    tissue_->tool().set_query_pose(loop_part_, searching_.poses.loop);
   }
   last_search_joints_ = placed_joints_;
   last_search_present_ = placed_.present;
@@ -264,7 +267,8 @@ void Simulation::update_metrics(const TickInput& input, bool collision_tick) {
   metrics_.max_tissue_displacement_mm = std::max(metrics_.max_tissue_displacement_mm, units::m_to_mm(tissue_->max_displacement_m()));
   if (cutting) {
     const double margin_m = placed_.poses.loop.apply_point(loop_front_tool_).z - verumontanum_z_m_;
-    metrics_.distal_margin_mm = std::min(metrics_.distal_margin_mm, units::m_to_mm(margin_m));
+    const double margin_mm = units::m_to_mm(margin_m);
+    metrics_.distal_margin_mm = std::min(metrics_.distal_margin_mm.value_or(margin_mm), margin_mm);
     if (margin_m < 0.0) ++metrics_.verumontanum_violations;
   }
   const ResectionStats& cut = resection_->stats();

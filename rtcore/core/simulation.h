@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -59,7 +60,8 @@ struct ProcedureMetrics {
   double mean_contact_force_n = 0.0;       ///< over the ticks in contact
   double max_tissue_displacement_mm = 0.0;
   double max_insertion_mm = 0.0;           ///< deepest the sheath tip went past the pivot
-  double distal_margin_mm = 0.0;           ///< least loop-to-verumontanum distance (along z) while cutting; + is proximal (safe)
+  /// Least loop-to-verumontanum distance (along z) while cutting; + is proximal (safe). None until the pedal cuts.
+  std::optional<double> distal_margin_mm;
   std::uint64_t verumontanum_violations = 0;  ///< collision steps cutting distal to the verumontanum
   std::uint64_t non_finite_steps = 0;
   std::uint64_t contact_overflows = 0;
@@ -84,6 +86,50 @@ struct ProcedureMetrics {
   std::uint64_t refined_tetrahedra = 0;
   std::uint64_t topology_refusals = 0;          ///< edits refused for want of reserved capacity
 };
+
+/// Calls `visit(field)` on every field of `m` in declaration order (the order recordings store them,
+/// one 8-byte word each): a double, a std::uint64_t or the one std::optional<double>.
+template <class Metrics, class Visit>
+constexpr void for_each_metric(Metrics& m, Visit&& visit) {
+  visit(m.contact_time_s);
+  visit(m.cut_pedal_time_s);
+  visit(m.cut_in_contact_time_s);
+  visit(m.peak_reaction_force_n);
+  visit(m.mean_contact_force_n);
+  visit(m.max_tissue_displacement_mm);
+  visit(m.max_insertion_mm);
+  visit(m.distal_margin_mm);
+  visit(m.verumontanum_violations);
+  visit(m.non_finite_steps);
+  visit(m.contact_overflows);
+  visit(m.contact_margin_exceeded_ticks);
+  visit(m.max_tool_travel_since_search_mm);
+  visit(m.initial_tissue_g);
+  visit(m.remaining_tissue_g);
+  visit(m.resected_adenoma_g);
+  visit(m.resected_capsule_g);
+  visit(m.resected_total_g);
+  visit(m.remaining_adenoma_fraction);
+  visit(m.chips);
+  visit(m.chips_g);
+  visit(m.cuts);
+  visit(m.perforations);
+  visit(m.sphincter_zone_violations);
+  visit(m.sphincter_zone_cut_s);
+  visit(m.loop_on_idle_s);
+  visit(m.refined_tetrahedra);
+  visit(m.topology_refusals);
+}
+/// How many fields for_each_metric visits.
+constexpr std::size_t metric_field_count() {
+  ProcedureMetrics m;
+  std::size_t n = 0;
+  for_each_metric(m, [&n](auto&) { ++n; });
+  return n;
+}
+// A field added to ProcedureMetrics but not to for_each_metric fails here.
+static_assert(sizeof(ProcedureMetrics) == 8 * (metric_field_count() - 1) + sizeof(std::optional<double>),
+              "for_each_metric must visit every field of ProcedureMetrics");
 
 /// What the core publishes for the console and recorder (taken at collision steps).
 struct SimulationSnapshot {

@@ -10,7 +10,7 @@
 // channel axis (world z), and insertions of 150..194 mm carry the tip from the apex to the bladder neck.
 #pragma once
 
-#include "rtcore/kinematics/rigid_pose.h"
+#include "rtcore/geometry/rigid_pose.h"
 #include "rtcore/geometry/vec3.h"
 
 namespace resecto {

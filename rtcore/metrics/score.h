@@ -4,7 +4,7 @@
 // (ProcedureMetrics: grams by region, cuts, perforations, sphincter zone, loop on idle, force) are
 // read as they are; this module adds what is measured across steps: the tool tip's path and speed,
 // the rates per minute and per cut, the lobe order, time series for plots and a resection heat map.
-// Each metric's unit and literature source are in the README ("Scoring and debrief").
+// Each metric's unit and literature source are in docs/commands.md ("Scoring and debrief").
 #pragma once
 
 #include <array>

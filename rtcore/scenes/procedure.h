@@ -1,6 +1,6 @@
 // Procedures: scripted motions of the resectoscope (time-stamped 5-DOF and pedal keyframes, linearly
 // interpolated) that drive the emulator in headless runs, tests and benchmarks. Built-ins `demo` and `turp`;
-// users write their own in the text format documented in the README.
+// users write their own in the text format documented in docs/commands.md.
 #pragma once
 
 #include <filesystem>

@@ -8,7 +8,7 @@
 #include <limits>
 
 #include "rtcore/tissue/node_order.h"
-#include "rtcore/tissue/state_hash.h"
+#include "rtcore/base/state_hash.h"
 
 namespace resecto {
 namespace {

@@ -17,7 +17,7 @@
 
 namespace resecto {
 
-/// How a physics step advances the nodes (README: the measured comparison behind the default).
+/// How a physics step advances the nodes (benchmarks/results/README.md: the measured comparison behind the default).
 enum class TissueIntegrator : std::uint8_t {
   /// Symplectic Euler whose per-node mass is raised by a Gershgorin bound of the step's stiffness
   /// and damping (D = m + h^2 R_K / 2 + h R_C): stable for every stiffness, one force pass a step,

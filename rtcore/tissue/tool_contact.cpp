@@ -13,20 +13,6 @@
 namespace resecto {
 namespace {
 
-Vec3 rotate(const RigidTransform& pose, const Vec3& p) {
-  const auto& r = pose.rotation;
-  return {r[0][0] * p.x + r[0][1] * p.y + r[0][2] * p.z, r[1][0] * p.x + r[1][1] * p.y + r[1][2] * p.z,
-          r[2][0] * p.x + r[2][1] * p.y + r[2][2] * p.z};
-}
-
-/// World point into the tool frame (the pose's rotation is orthonormal).
-Vec3 to_tool_frame(const RigidTransform& pose, const Vec3& world) {
-  const auto& r = pose.rotation;
-  const Vec3 d = world - pose.translation;
-  return {r[0][0] * d.x + r[1][0] * d.y + r[2][0] * d.z, r[0][1] * d.x + r[1][1] * d.y + r[2][1] * d.z,
-          r[0][2] * d.x + r[1][2] * d.y + r[2][2] * d.z};
-}
-
 /// Barycentric weights of q, a point of triangle (a, b, c); equal thirds for a degenerate triangle.
 Vec3 barycentric(const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 v0 = b - a, v1 = c - a, v2 = q - a;
@@ -185,13 +171,13 @@ int ToolContacts::add_part(const TriangleMesh& mesh) {
   return static_cast<int>(parts_.size()) - 1;
 }
 
-void ToolContacts::set_pose(int part, const RigidTransform& pose) {
+void ToolContacts::set_pose(int part, const RigidPose& pose) {
   Part& p = parts_[static_cast<std::size_t>(part)];
   p.previous_pose = p.pose;
   p.pose = pose;
 }
 
-void ToolContacts::reset_pose(int part, const RigidTransform& pose) {
+void ToolContacts::reset_pose(int part, const RigidPose& pose) {
   Part& p = parts_[static_cast<std::size_t>(part)];
   p.previous_pose = pose;
   p.pose = pose;
@@ -300,7 +286,7 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
   for (std::size_t pi = 0; pi < parts_.size(); vertex_offset += static_cast<std::uint32_t>(parts_[pi].mesh.vertex_count()), ++pi) {
     Part& part = parts_[pi];
     if (!part.query_enabled) continue;
-    const RigidTransform& pose = part.query_pose;
+    const RigidPose& pose = part.query_pose;
     if (!part.collider.collide(tissue_tree, surface, part.tree, part.inflated, pose)) out.stats.overflowed = true;
     out.stats.tissue_leaves += static_cast<std::int32_t>(part.collider.tissue_leaves().size());
     out.stats.tool_leaves += static_cast<std::int32_t>(part.collider.tool_leaves().size());
@@ -317,7 +303,7 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
           continue;
         }
         const auto first = static_cast<std::uint32_t>(out.pair_count);
-        const Vec3 p = to_tool_frame(pose, surface.positions[n]);
+        const Vec3 p = pose.inverse_apply_point(surface.positions[n]);
         gather_triangles(part.tree, p, search_radius, triangle_stamp_);
         keep_within_margin(first, p, part.mesh.positions, part.mesh.triangles);
         const auto count = static_cast<std::uint32_t>(out.pair_count - first);
@@ -340,7 +326,7 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
           continue;
         }
         const auto first = static_cast<std::uint32_t>(out.pair_count);
-        const Vec3 w = transform_point(pose, part.mesh.positions[v]);
+        const Vec3 w = pose.apply_point(part.mesh.positions[v]);
         gather_triangles(tissue_tree, w, search_radius, tissue_triangle_stamp_);
         keep_within_margin(first, w, surface.positions, surface.triangles);
         const auto count = static_cast<std::uint32_t>(out.pair_count - first);
@@ -370,7 +356,7 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
   for (std::size_t i = 0; i < node_count_; ++i) {
     const PointCandidates& pc = node_candidates_[i];
     const Part& part = parts_[pc.part];
-    const Vec3 p = to_tool_frame(part.pose, x[pc.point]);
+    const Vec3 p = part.pose.inverse_apply_point(x[pc.point]);
     Clearance& clearance = node_clearance_[i];
     if (clearance_skipping_ && clearance.holds(p, 0.0)) {
       ++skipped;
@@ -385,9 +371,9 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
     // Capped at the margin: a deeper "penetration" is a crushed or inverted face, not a contact to
     // push ever harder on (that feedback is what blew up the stiffest corner of the sweep).
     const double depth = std::min(-best.side, margin_m_);
-    const Vec3 out = rotate(part.pose, part.face_normals[best.triangle]);
-    const Vec3 surface_world = transform_point(part.pose, best.point);
-    const Vec3 surface_velocity = (surface_world - transform_point(part.previous_pose, best.point)) * inverse_h;
+    const Vec3 out = part.pose.apply_vector(part.face_normals[best.triangle]);
+    const Vec3 surface_world = part.pose.apply_point(best.point);
+    const Vec3 surface_velocity = (surface_world - part.previous_pose.apply_point(best.point)) * inverse_h;
     const double separating_speed = glm::dot(v[pc.point] - surface_velocity, out);
     const double magnitude = std::max(0.0, k * depth - c * separating_speed);
     const Vec3 f = magnitude * out;
@@ -401,7 +387,7 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
   for (std::size_t i = 0; i < vertex_count_; ++i) {
     const PointCandidates& pc = vertex_candidates_[i];
     const Part& part = parts_[pc.part];
-    const Vec3 w = transform_point(part.pose, part.mesh.positions[pc.point]);
+    const Vec3 w = part.pose.apply_point(part.mesh.positions[pc.point]);
     Clearance& clearance = vertex_clearance_[i];
     if (clearance_skipping_ && clearance.holds(w, tissue_travel_m)) {
       ++skipped;
@@ -417,7 +403,7 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
     const Vec3 in = -n2 / glm::length(n2);
     const Vec3 weights = barycentric(best.point, x[t[0]], x[t[1]], x[t[2]]);
     const Vec3 tissue_velocity = weights[0] * v[t[0]] + weights[1] * v[t[1]] + weights[2] * v[t[2]];
-    const Vec3 tool_velocity = (w - transform_point(part.previous_pose, part.mesh.positions[pc.point])) * inverse_h;
+    const Vec3 tool_velocity = (w - part.previous_pose.apply_point(part.mesh.positions[pc.point])) * inverse_h;
     const double approach_speed = glm::dot(tool_velocity - tissue_velocity, in);
     const double magnitude = std::max(0.0, k * depth + c * approach_speed);
     const Vec3 f = magnitude * in;

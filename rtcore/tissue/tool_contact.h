@@ -64,12 +64,12 @@ class ToolContacts {
   int add_part(const TriangleMesh& mesh_in_tool_frame);
   int part_count() const { return static_cast<int>(parts_.size()); }
   /// Sets where a part is for the coming physics step; the previous pose gives the tool's velocity.
-  void set_pose(int part, const RigidTransform& pose);
+  void set_pose(int part, const RigidPose& pose);
   /// Places a part without motion (both poses), e.g. at start.
-  void reset_pose(int part, const RigidTransform& pose);
+  void reset_pose(int part, const RigidPose& pose);
   /// Takes a part out of (or back into) contact, e.g. the loop when it is not modelled.
   void set_enabled(int part, bool enabled) { parts_[static_cast<std::size_t>(part)].enabled = enabled; }
-  const RigidTransform& pose(int part) const { return parts_[static_cast<std::size_t>(part)].pose; }
+  const RigidPose& pose(int part) const { return parts_[static_cast<std::size_t>(part)].pose; }
   /// How far outside the tool a point may be and still become a candidate.
   double margin_m() const { return margin_m_; }
 
@@ -81,7 +81,7 @@ class ToolContacts {
   void latch_query_poses(double tissue_travel_m);
   /// Replaces a part's latched pose with where the search should look for it instead (e.g. where the
   /// part is expected to be while the candidates are in use). Same rules as latch_query_poses().
-  void set_query_pose(int part, const RigidTransform& pose) { parts_[static_cast<std::size_t>(part)].query_pose = pose; }
+  void set_query_pose(int part, const RigidPose& pose) { parts_[static_cast<std::size_t>(part)].query_pose = pose; }
   /// Queries each part's tree (at its latched pose) against the tissue surface tree, already refitted
   /// to `surface`'s positions, into a back buffer. Touches nothing add_forces() or set_pose() use, so
   /// it may run concurrently with them; never with latch_query_poses() or publish_candidates().
@@ -126,9 +126,9 @@ class ToolContacts {
     std::vector<Sphere> triangle_spheres;  // per face, tool frame: prunes the closest-point tests
     SphereTree tree;            // over `inflated`, so the query's contact is the margin's
     Collider collider;
-    RigidTransform pose, previous_pose;
+    RigidPose pose, previous_pose;
     bool enabled = true;
-    RigidTransform query_pose;  // latched for the search (the search's thread reads only these)
+    RigidPose query_pose;  // latched for the search (the search's thread reads only these)
     bool query_enabled = true;
   };
   /// A point with its candidate triangles: entries [first, first + count) of pair_triangles_.

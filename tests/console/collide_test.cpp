@@ -2,6 +2,8 @@
 // against brute force on the same files), and one-line errors naming the poses line or the face.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -67,11 +69,9 @@ TEST(CollideCommand, PairsCsvEqualsBruteForceOnTheSameFiles) {
   expected << "pose,tissue_face,tool_face\n";
   std::size_t total = 0;
   for (int p = 0; p < 4; ++p) {
-    RigidTransform pose;
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) pose.rotation[i][j] = rotations[p][4 * i + j];
-      pose.translation[i] = rotations[p][4 * i + 3];
-    }
+    std::array<double, 12> row_major{};
+    std::copy(rotations[p], rotations[p] + 12, row_major.begin());
+    const RigidPose pose = from_row_major_3x4(row_major);
     for (const TrianglePair& pair : collide_brute_force(*tissue, *tool, pose)) {
       expected << p << ',' << pair.tissue << ',' << pair.tool << '\n';
       ++total;
@@ -96,21 +96,18 @@ TEST(CollideCommand, PairsCsvEqualsBruteForceOnTheSameFiles) {
 TEST(CollideCommand, SequenceGivesThePairsOfIndependentQueries) {
   Files f = make_files("collide_sequence");
   f.poses = f.dir / "frames.txt";
-  std::vector<RigidTransform> frames;
+  std::vector<RigidPose> frames;
   {
     std::ofstream out(f.poses);
     out.precision(17);
     for (int k = 0; k < 40; ++k) {
       const double a = 0.01 * k;
-      RigidTransform pose;
-      pose.rotation[0][0] = std::cos(a), pose.rotation[0][1] = -std::sin(a);
-      pose.rotation[1][0] = std::sin(a), pose.rotation[1][1] = std::cos(a);
+      RigidPose pose;
+      pose.rotation = rotation_about_z(a);
       pose.translation = Vec3{1.6, 0.3, 15.0 + 0.2 * k};
       frames.push_back(pose);
-      for (int i = 0; i < 3; ++i) {
-        out << pose.rotation[i][0] << ' ' << pose.rotation[i][1] << ' ' << pose.rotation[i][2] << ' ' << pose.translation[i]
-            << (i == 2 ? '\n' : ' ');
-      }
+      const std::array<double, 12> row_major = to_row_major_3x4(pose);
+      for (std::size_t e = 0; e < 12; ++e) out << row_major[e] << (e == 11 ? '\n' : ' ');
     }
   }
   const auto independent = f.dir / "independent.csv";

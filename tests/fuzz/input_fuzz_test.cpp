@@ -138,9 +138,9 @@ TEST(Fuzz, StlReader) { fuzz_mesh("stl", MeshFormat::stl, 4); }
 TEST(Fuzz, Poses) {
   campaign("poses", {"1 0 0 0  0 1 0 0  0 0 1 0\n# comment\n\n0 -1 0 5, 1 0 0 -2.5, 0 0 1 100\n", "1 0 0 1e5 0 1 0 0 0 0 1 0\r\n"}, 5,
            [](const std::string& input) {
-             Result<std::vector<RigidTransform>> poses = cli::parse_poses(input, "fuzz.poses");
+             Result<std::vector<RigidPose>> poses = cli::parse_poses(input, "fuzz.poses");
              if (!poses) return expect_one_line_error(poses.error(), "fuzz.poses", input);
-             for (const RigidTransform& pose : *poses) {
+             for (const RigidPose& pose : *poses) {
                for (int i = 0; i < 3; ++i) ASSERT_LE(std::abs(pose.translation[i]), cli::kMaxPoseTranslation);
              }
            });

@@ -7,7 +7,7 @@
 #include <map>
 
 #include "rtcore/anatomy/resectoscope.h"
-#include "rtcore/tissue/indentation.h"
+#include "rtcore/scenes/prostate_tissue.h"
 
 namespace resecto {
 

@@ -13,19 +13,8 @@
 namespace resecto {
 namespace {
 
-using testing::tilted_pose;
 
 std::vector<TrianglePair> pairs_of(const Collider& collider) { return {collider.pairs().begin(), collider.pairs().end()}; }
-
-// Frame f of a sweep: the tip advancing along the channel 0.2 mm a frame, off-axis toward a
-// slowly turning side (pressed into the wall), rolling and tilting a little.
-RigidTransform sweep_pose(int f, double phase) {
-  const double t = f / 60.0;
-  const double angle = phase + 0.8 * std::sin(1.3 * t);
-  const double offset = 0.0022 + 0.0008 * std::sin(2.1 * t + phase);
-  const Vec3 tip{offset * std::cos(angle), offset * std::sin(angle), 0.010 + 0.012 * t};
-  return tilted_pose(0.03 * std::sin(0.7 * t + phase), 0.03 * std::cos(0.9 * t), phase + 0.6 * std::sin(2.5 * t), tip);
-}
 
 struct Scene {
   ProstateModel prostate;
@@ -45,7 +34,7 @@ TEST(CollideSequence, EveryFrameEqualsAFreshQueryAndBruteForce) {
   for (int run = 0; run < 3; ++run) {
     sequence.reset_sequence();
     for (int f = 0; f < 90; ++f) {
-      const RigidTransform pose = sweep_pose(f, 1.7 * run);
+      const RigidPose pose = channel_sweep_pose(f, 1.7 * run);
       ASSERT_TRUE(fresh.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
       ASSERT_TRUE(sequence.collide_sequence(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
       const auto expected = collide_brute_force(scene.prostate.surface, scene.tool, pose);
@@ -65,7 +54,7 @@ TEST(CollideSequence, JumpsAndStandstillsStayExact) {
   Collider sequence;
   std::mt19937_64 rng(3);
   for (int i = 0; i < 60; ++i) {
-    const RigidTransform pose = (i % 3 == 2) ? testing::random_channel_pose(rng) : sweep_pose(i, 0.4);
+    const RigidPose pose = (i % 3 == 2) ? random_channel_pose(rng) : channel_sweep_pose(i, 0.4);
     for (int repeat = 0; repeat < 2; ++repeat) {
       ASSERT_TRUE(sequence.collide_sequence(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
       ASSERT_EQ(pairs_of(sequence), collide_brute_force(scene.prostate.surface, scene.tool, pose)) << "step " << i;
@@ -112,7 +101,7 @@ TEST(CollideSequence, FollowsDeformationAndCutting) {
         removed.push_back(t);
       }
     }
-    const RigidTransform pose = sweep_pose(f, 2.5);
+    const RigidPose pose = channel_sweep_pose(f, 2.5);
     ASSERT_TRUE(sequence.collide_sequence(scene.tissue_tree, surface, scene.tool_tree, scene.tool, pose, travel));
     auto expected = collide_brute_force(surface, scene.tool, pose);
     std::erase_if(expected, [&](const TrianglePair& p) {
@@ -131,7 +120,7 @@ TEST(CollideSequence, SlabsChangeTheWorkNotThePairs) {
   std::mt19937_64 rng(8);
   std::int64_t with_tests = 0, without_tests = 0;
   for (int i = 0; i < 200; ++i) {
-    const RigidTransform pose = testing::random_channel_pose(rng);
+    const RigidPose pose = random_channel_pose(rng);
     ASSERT_TRUE(with.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
     ASSERT_TRUE(without.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
     ASSERT_EQ(pairs_of(with), pairs_of(without)) << "pose " << i;
@@ -174,7 +163,7 @@ TEST(CollideSequence, TreesWithoutSlabsUseTheSpheres) {
       surface.positions[v] = p + 0.0004 * std::sin(0.2 * f) * Vec3(std::sin(150 * p.z), std::cos(120 * p.x), 0.0);
     }
     tissue_tree.refit(surface);
-    const RigidTransform pose = sweep_pose(f, 0.9);
+    const RigidPose pose = channel_sweep_pose(f, 0.9);
     const auto expected = collide_brute_force(surface, tool, pose);
     ASSERT_TRUE(fresh.collide(tissue_tree, surface, tool_tree, tool, pose));
     ASSERT_TRUE(sequence.collide_sequence(tissue_tree, surface, tool_tree, tool, pose, 0.0004 * f));

@@ -13,7 +13,6 @@
 namespace resecto {
 namespace {
 
-using testing::random_channel_pose;
 
 std::vector<TrianglePair> pairs_of(const Collider& collider) {
   return {collider.pairs().begin(), collider.pairs().end()};
@@ -61,7 +60,7 @@ void expect_brute_force_over_poses(const ProstateScene& scene, std::uint64_t see
   Collider collider;
   std::mt19937_64 rng(seed);
   for (int i = 0; i < poses; ++i) {
-    const RigidTransform pose = random_channel_pose(rng);
+    const RigidPose pose = random_channel_pose(rng);
     ASSERT_TRUE(collider.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
     ASSERT_EQ(pairs_of(collider), collide_brute_force(scene.prostate.surface, scene.tool, pose)) << "pose " << i;
     if (i % list_every == 0) expect_leaf_lists(collider, scene.tissue_tree, scene.tool_tree);
@@ -76,7 +75,7 @@ TEST(Collide, EqualsBruteForceOnTheGlandOverThousandsOfPoses) {
   int poses_with_pairs = 0;
   const int poses = 2000;
   for (int i = 0; i < poses; ++i) {
-    const RigidTransform pose = random_channel_pose(rng);
+    const RigidPose pose = random_channel_pose(rng);
     ASSERT_TRUE(collider.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
     const auto expected = collide_brute_force(scene.prostate.surface, scene.tool, pose);
     ASSERT_EQ(pairs_of(collider), expected) << "pose " << i;
@@ -97,7 +96,7 @@ TEST(Collide, LeafListsAloneAreTheSameListsWithoutTheTriangleTests) {
   lists_only.set_pairs_wanted(false);
   std::mt19937_64 rng(11);
   for (int i = 0; i < 300; ++i) {
-    const RigidTransform pose = random_channel_pose(rng);
+    const RigidPose pose = random_channel_pose(rng);
     ASSERT_TRUE(with_pairs.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
     ASSERT_TRUE(lists_only.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
     const auto l1 = with_pairs.tissue_leaves(), l2 = with_pairs.tool_leaves();
@@ -154,11 +153,12 @@ TEST(Collide, EqualsBruteForceOnTouchingAndCoplanarSoups) {
     SphereTree tool_tree;
     tissue_tree.build(tissue);
     tool_tree.build(tool);
-    RigidTransform pose;
+    RigidPose pose;
     const int quarter = trial % 4;  // rotation by quarter * 90 degrees about z: exact entries
     const double c = quarter == 0 ? 1 : quarter == 2 ? -1 : 0;
     const double s = quarter == 1 ? 1 : quarter == 3 ? -1 : 0;
-    pose.rotation[0][0] = c, pose.rotation[0][1] = -s, pose.rotation[1][0] = s, pose.rotation[1][1] = c;
+    pose.rotation[0] = Vec3(c, s, 0.0);  // columns
+    pose.rotation[1] = Vec3(-s, c, 0.0);
     pose.translation = Vec3(grid(rng) - 3, grid(rng) - 3, trial % 3 == 0 ? 0 : grid(rng) - 3);
     ASSERT_TRUE(collider.collide(tissue_tree, tissue, tool_tree, tool, pose));
     const auto expected = collide_brute_force(tissue, tool, pose);
@@ -187,7 +187,7 @@ TEST(Collide, EqualsBruteForceAfterDeformationAndRefit) {
     scene.tissue_tree.refit(surface);
     testing::expect_tree_invariants(scene.tissue_tree);
     for (int i = 0; i < 40; ++i) {
-      const RigidTransform pose = random_channel_pose(rng);
+      const RigidPose pose = random_channel_pose(rng);
       ASSERT_TRUE(collider.collide(scene.tissue_tree, surface, scene.tool_tree, scene.tool, pose));
       ASSERT_EQ(pairs_of(collider), collide_brute_force(surface, scene.tool, pose)) << "step " << step << " pose " << i;
     }
@@ -199,7 +199,7 @@ TEST(Collide, OverflowIsReportedNotAllocated) {
   Collider collider;
   collider.reserve(2, 8);
   std::mt19937_64 rng(9);
-  RigidTransform pose;
+  RigidPose pose;
   std::vector<TrianglePair> expected;
   while (expected.size() < 10) {
     pose = random_channel_pose(rng);

@@ -1,47 +1,18 @@
-// Shared scenes of the collision tests: the procedural gland and tool, poses of the tool inside the
-// urethral channel, and the tree invariants every test checks.
+// Checks every collision test makes on its trees: the tree invariants and the slabs' cover (the
+// scenes and the tool's poses are rtcore/scenes/collision_poses.h, shared with the benchmark).
 #pragma once
 
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <random>
 #include <vector>
 
 #include "rtcore/anatomy/prostate.h"
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/collision/collide.h"
+#include "rtcore/scenes/collision_poses.h"
 
 namespace resecto::testing {
-
-/// A pose that turns the tool's +z by small tilts about x and y, then places its tip at `tip`.
-inline RigidTransform tilted_pose(double tilt_x_rad, double tilt_y_rad, double roll_rad, const Vec3& tip) {
-  const double cx = std::cos(tilt_x_rad), sx = std::sin(tilt_x_rad);
-  const double cy = std::cos(tilt_y_rad), sy = std::sin(tilt_y_rad);
-  const double cz = std::cos(roll_rad), sz = std::sin(roll_rad);
-  // R = Ry * Rx * Rz, row-major.
-  const double rz[3][3] = {{cz, -sz, 0}, {sz, cz, 0}, {0, 0, 1}};
-  const double rx[3][3] = {{1, 0, 0}, {0, cx, -sx}, {0, sx, cx}};
-  const double ry[3][3] = {{cy, 0, sy}, {0, 1, 0}, {-sy, 0, cy}};
-  double rxz[3][3];
-  RigidTransform pose;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) rxz[i][j] = rx[i][0] * rz[0][j] + rx[i][1] * rz[1][j] + rx[i][2] * rz[2][j];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) pose.rotation[i][j] = ry[i][0] * rxz[0][j] + ry[i][1] * rxz[1][j] + ry[i][2] * rxz[2][j];
-  pose.translation = tip;
-  return pose;
-}
-
-/// A random pose of the resectoscope in the channel of a gland of the default shape (metres): the
-/// tip somewhere along the channel, off-axis by up to 3 mm, tilted up to 8 degrees, any roll.
-inline RigidTransform random_channel_pose(std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  const double angle = 2.0 * M_PI * unit(rng);
-  const double offset = 0.003 * unit(rng);
-  const Vec3 tip{offset * std::cos(angle), offset * std::sin(angle), 0.005 + 0.040 * unit(rng)};
-  return tilted_pose(0.14 * (unit(rng) - 0.5), 0.14 * (unit(rng) - 0.5), 2.0 * M_PI * unit(rng), tip);
-}
 
 /// Checks the structure of a tree: parent and child links agree, heights are right, every node's
 /// sphere covers every leaf sphere below it, every live node is reachable and every other slot free.

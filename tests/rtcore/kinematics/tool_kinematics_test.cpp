@@ -130,14 +130,5 @@ TEST(ToolKinematics, TipFollowsTheChannelAxisOverTheInsertionRange) {
   }
 }
 
-TEST(ToolKinematics, RowMajorExportMatchesThePosesFileLayout) {
-  RigidPose pose;
-  pose.rotation = axis_angle_rotation(Vec3(0, 0, 1), kPi / 2);  // x -> y
-  pose.translation = Vec3(1, 2, 3);
-  const auto m = to_row_major_3x4(pose);
-  const double expected[12] = {0, -1, 0, 1, 1, 0, 0, 2, 0, 0, 1, 3};
-  for (int i = 0; i < 12; ++i) EXPECT_NEAR(m[static_cast<std::size_t>(i)], expected[i], kTolerance) << i;
-}
-
 }  // namespace
 }  // namespace resecto

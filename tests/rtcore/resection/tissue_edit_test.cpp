@@ -127,9 +127,8 @@ TEST(TissueEdits, CollisionPairsAfterCutsEqualBruteForce) {
   int poses_with_pairs = 0;
   for (int k = 0; k < 24; ++k) {
     // The loop swept along the cut, where new faces are.
-    RigidTransform pose;
-    const double rotation[3][3] = {{0.0, -1.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 0.0, 1.0}};  // the loop hangs toward +x
-    std::copy(&rotation[0][0], &rotation[0][0] + 9, &pose.rotation[0][0]);
+    RigidPose pose;
+    pose.rotation = glm::dmat3(Vec3(0.0, 1.0, 0.0), Vec3(-1.0, 0.0, 0.0), Vec3(0.0, 0.0, 1.0));  // the loop hangs toward +x
     pose.translation = Vec3(0.0005 * (k % 4), 0.0, 0.010 + 0.001 * k);
     ASSERT_TRUE(collider.collide(tissue.surface_tree(), tissue.surface(), tool_tree, tool.loop, pose));
     std::vector<TrianglePair> expected;

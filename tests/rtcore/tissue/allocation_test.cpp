@@ -7,7 +7,7 @@
 #include <new>
 
 #include "rtcore/anatomy/resectoscope.h"
-#include "rtcore/tissue/indentation.h"
+#include "rtcore/scenes/indentation.h"
 
 namespace {
 std::atomic<bool> g_counting{false};

@@ -7,7 +7,7 @@
 
 #include "rtcore/base/units.h"
 #include "rtcore/anatomy/resectoscope.h"
-#include "rtcore/tissue/indentation.h"
+#include "rtcore/scenes/indentation.h"
 #include "tests/support/tissue_models.h"
 
 namespace resecto {

@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "rtcore/anatomy/resectoscope.h"
-#include "rtcore/tissue/indentation.h"
+#include "rtcore/scenes/indentation.h"
 #include "rtcore/tissue/node_order.h"
 #include "tests/support/tissue_models.h"
 

@@ -10,7 +10,7 @@
 #include <random>
 
 #include "rtcore/anatomy/resectoscope.h"
-#include "rtcore/tissue/indentation.h"
+#include "rtcore/scenes/prostate_tissue.h"
 #include "rtcore/tissue/spring_forces.h"
 #include "tests/support/tissue_models.h"
 

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "rtcore/anatomy/resectoscope.h"
-#include "rtcore/tissue/indentation.h"
+#include "rtcore/scenes/indentation.h"
 #include "tests/support/tissue_models.h"
 
 namespace resecto {

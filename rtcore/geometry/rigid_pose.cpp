@@ -1,5 +1,5 @@
-// Rigid pose composition and conversions for the device kinematics.
-#include "rtcore/kinematics/rigid_pose.h"
+// Rigid pose composition, rotations and conversions to and from row-major text.
+#include "rtcore/geometry/rigid_pose.h"
 
 #include <algorithm>
 #include <cmath>
@@ -35,6 +35,21 @@ glm::dmat3 axis_angle_rotation(const Vec3& unit_axis, double angle_rad) {
   return m;
 }
 
+glm::dmat3 rotation_about_x(double angle_rad) {
+  const double c = std::cos(angle_rad), s = std::sin(angle_rad);
+  return glm::dmat3(Vec3(1, 0, 0), Vec3(0, c, s), Vec3(0, -s, c));  // columns
+}
+
+glm::dmat3 rotation_about_y(double angle_rad) {
+  const double c = std::cos(angle_rad), s = std::sin(angle_rad);
+  return glm::dmat3(Vec3(c, 0, -s), Vec3(0, 1, 0), Vec3(s, 0, c));
+}
+
+glm::dmat3 rotation_about_z(double angle_rad) {
+  const double c = std::cos(angle_rad), s = std::sin(angle_rad);
+  return glm::dmat3(Vec3(c, s, 0), Vec3(-s, c, 0), Vec3(0, 0, 1));
+}
+
 std::array<double, 12> to_row_major_3x4(const RigidPose& pose) {
   std::array<double, 12> out{};
   for (int row = 0; row < 3; ++row) {
@@ -42,6 +57,15 @@ std::array<double, 12> to_row_major_3x4(const RigidPose& pose) {
     out[static_cast<std::size_t>(row * 4 + 3)] = pose.translation[row];
   }
   return out;
+}
+
+RigidPose from_row_major_3x4(const std::array<double, 12>& m) {
+  RigidPose pose;
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col) pose.rotation[col][row] = m[static_cast<std::size_t>(row * 4 + col)];
+    pose.translation[row] = m[static_cast<std::size_t>(row * 4 + 3)];
+  }
+  return pose;
 }
 
 double orthonormality_error(const glm::dmat3& rotation) {

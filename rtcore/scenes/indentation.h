@@ -8,25 +8,15 @@
 #include <vector>
 
 #include "rtcore/anatomy/prostate.h"
-#include "rtcore/base/result.h"
-#include "rtcore/collision/collide.h"
+#include "rtcore/geometry/rigid_pose.h"
+#include "rtcore/scenes/prostate_tissue.h"
 #include "rtcore/tissue/mass_spring.h"
 
 namespace resecto {
 
-/// The gland as a tetrahedral model, labelled, ready for MassSpringTissue, with the loop that indents it.
-struct ProstateTissueModel {
-  ProstateModel anatomy;
-  TetMesh mesh;
-  TriangleMesh loop;  ///< the resectoscope's loop in the tool frame
-};
-/// Tetrahedralizes `anatomy` (from generate_prostate) with its channel axis and capsule shell. The
-/// callers generate the models, so this library needs no link to the anatomy library.
-Result<ProstateTissueModel> build_prostate_tissue_model(ProstateModel anatomy, TriangleMesh loop);
-
 /// Pose of the loop (in the tool frame of generate_resectoscope) rolled so its wire hangs toward +x,
 /// its outermost point touching the left lateral lobe's crest, moved `depth_m` further along +x.
-RigidTransform indentation_loop_pose(const ProstateModel& anatomy, const TriangleMesh& loop, double depth_m);
+RigidPose indentation_loop_pose(const ProstateModel& anatomy, const TriangleMesh& loop, double depth_m);
 
 /// The protocol and the solver set-up.
 struct IndentationOptions {
@@ -67,8 +57,5 @@ struct IndentationResult {
 
 /// Runs the protocol on a fresh tissue built from `model`.
 IndentationResult run_indentation(const ProstateTissueModel& model, const IndentationOptions& options);
-
-/// The q-quantile (0..1) of samples, by nearest rank; 0 when empty.
-double quantile(std::vector<double> samples, double q);
 
 }  // namespace resecto

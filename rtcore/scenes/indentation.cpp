@@ -1,35 +1,20 @@
 // The indentation protocol. Wall-clock timing happens here, around the core's steps, never inside.
-#include "rtcore/tissue/indentation.h"
+#include "rtcore/scenes/indentation.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
-#include "rtcore/tissue/tetrahedralize.h"
-
 namespace resecto {
 
-Result<ProstateTissueModel> build_prostate_tissue_model(ProstateModel anatomy, TriangleMesh loop) {
-  ProstateTissueModel model;
-  model.anatomy = std::move(anatomy);
-  model.loop = std::move(loop);
-  TetrahedralizeOptions options;
-  options.capsule_thickness_m = model.anatomy.shape.capsule_thickness_m;
-  options.channel_axis = {{0.0, 0.0, 0.0}, {0.0, 0.0, model.anatomy.shape.length_m}};
-  Result<TetMesh> mesh = tetrahedralize(model.anatomy.surface, options);
-  if (!mesh) return Error{"prostate of " + std::to_string(model.anatomy.surface.triangle_count()) + " triangles: " + mesh.error()};
-  model.mesh = std::move(*mesh);
-  return model;
-}
-
-RigidTransform indentation_loop_pose(const ProstateModel& anatomy, const TriangleMesh& loop, double depth_m) {
-  RigidTransform pose;
+RigidPose indentation_loop_pose(const ProstateModel& anatomy, const TriangleMesh& loop, double depth_m) {
+  RigidPose pose;
   // Roll +90 degrees about the sheath axis: the wire's -y side turns to +x, the left lobe.
-  pose.rotation[0][0] = 0.0, pose.rotation[0][1] = -1.0;
-  pose.rotation[1][0] = 1.0, pose.rotation[1][1] = 0.0;
+  pose.rotation[0] = Vec3(0.0, 1.0, 0.0);  // columns: x -> +y, y -> -x
+  pose.rotation[1] = Vec3(-1.0, 0.0, 0.0);
   Vec3 outermost(-1e300, 0.0, 0.0);
   for (const Vec3& p : loop.positions) {
-    const Vec3 rolled = transform_point(pose, p);
+    const Vec3 rolled = pose.apply_point(p);
     if (rolled.x > outermost.x) outermost = rolled;
   }
   Vec3 crest(0.0);
@@ -38,13 +23,6 @@ RigidTransform indentation_loop_pose(const ProstateModel& anatomy, const Triangl
   }
   pose.translation = {crest.x - outermost.x + depth_m, 0.0, crest.z - outermost.z};
   return pose;
-}
-
-double quantile(std::vector<double> samples, double q) {
-  if (samples.empty()) return 0.0;
-  std::sort(samples.begin(), samples.end());
-  const auto rank = static_cast<std::size_t>(std::ceil(q * static_cast<double>(samples.size())));
-  return samples[std::min(samples.size() - 1, rank > 0 ? rank - 1 : 0)];
 }
 
 IndentationResult run_indentation(const ProstateTissueModel& model, const IndentationOptions& options) {

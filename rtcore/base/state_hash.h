@@ -1,5 +1,7 @@
 // StateHasher: the 64-bit state hash the core records at every collision step (DESIGN.md "Data
-// flow"), FNV-1a over 64-bit words of raw bytes in index order, so equal states hash equal.
+// flow"), FNV-1a over 64-bit words of raw bytes in index order, so equal states hash equal. In base
+// because the tissue hashes its own state with it and the core hashes the tissue's hash, the tick
+// and the tool's poses (simulation.cpp).
 #pragma once
 
 #include <cstdint>

@@ -1,6 +1,6 @@
 // Word-wise FNV-1a: the tail shorter than a word is zero-padded, and the length is mixed in last so
 // spans that differ only in trailing zero bytes still differ.
-#include "rtcore/tissue/state_hash.h"
+#include "rtcore/base/state_hash.h"
 
 namespace resecto {
 

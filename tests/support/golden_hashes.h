@@ -1,0 +1,34 @@
+// Golden state hashes: the core's state after fixed scenarios, committed so that any change to the
+// numerics shows as one (Box2D's test_determinism.c does the same). Checked by
+// tests/console/golden_hash_test.cpp through `resecto run --headless` (batch: the emulated device in
+// lockstep, so the run is the same on every machine).
+//
+// When the test fails:
+// - If your change was NOT meant to change the numerics (a refactor, a rename, a speed-up that should
+//   give the same bits), it has a bug. To find the first collision step that moved: record the
+//   scenario with the build before the change (`resecto run --headless <arguments> --record A.rsr`)
+//   and replay it with the build after (`resecto replay A.rsr --verify`).
+// - If it was meant to (a new solver term, a changed default, a new order of summation), update the
+//   values below from the command in each row's comment, and say in the commit message that the
+//   golden hashes moved and why. Keep the scenarios as they are; add one rather than change one.
+#pragma once
+
+#include <cstdint>
+
+namespace resecto::testing {
+
+struct GoldenRun {
+  const char* arguments;     ///< after `resecto run --headless`
+  const char* state_hash;    ///< the report's final `state_hash`
+  const char* hash_chain;    ///< the report's `hash_chain` over every collision step
+  std::uint64_t cuts;        ///< the report's `metrics.cuts`: shows the scenario still cuts
+};
+
+inline constexpr GoldenRun kGoldenRuns[] = {
+    // resecto run --headless --procedure demo --seconds 2 --triangles 1296 --json
+    {"--procedure demo --seconds 2 --triangles 1296", "2bd3bcf94111ab8a", "1911fb088f1590cf", 0},
+    // resecto run --headless --procedure turp --seconds 4 --triangles 1296 --json (two strokes cut)
+    {"--procedure turp --seconds 4 --triangles 1296", "d316c15ed369808e", "66949aed1337e35f", 2},
+};
+
+}  // namespace resecto::testing
