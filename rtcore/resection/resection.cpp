@@ -121,10 +121,15 @@ Resection::Resection(MassSpringTissue& tissue, const ResectionConfig& config)
   stats_.perforation_sites.reserve(config_.max_perforation_sites);
 }
 
+void Resection::restart_stamps() {
+  std::fill(slot_stamp_.begin(), slot_stamp_.end(), 0u);
+  std::fill(node_stamp_.begin(), node_stamp_.end(), 0u);
+  stamp_ = 0;
+}
+
 std::uint32_t Resection::next_stamp() {
   if (++stamp_ == 0) {
-    std::fill(slot_stamp_.begin(), slot_stamp_.end(), 0u);
-    std::fill(node_stamp_.begin(), node_stamp_.end(), 0u);
+    restart_stamps();
     stamp_ = 1;
   }
   return stamp_;
@@ -525,11 +530,7 @@ bool Resection::remove_chips(ResectionStep& out) {
   const TetTopology& topo = tissue_.topology();
   bool any = false;
   sort_unique(seeds_);
-  if (stamp_ > 0xF0000000u) {  // each walk takes a stamp; keep this pass's stamps ordered
-    std::fill(slot_stamp_.begin(), slot_stamp_.end(), 0u);
-    std::fill(node_stamp_.begin(), node_stamp_.end(), 0u);
-    stamp_ = 0;
-  }
+  if (stamp_ > 0xF0000000u) restart_stamps();  // each walk takes a stamp; keep this pass's stamps ordered
   const std::uint32_t pass = stamp_ + 1;  // stamps of this pass's walks are >= pass
   next_nodes_.clear();  // the seeds, copied: remove() appends to seeds_
   for (std::uint32_t s : seeds_) next_nodes_.push_back(s);

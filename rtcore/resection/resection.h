@@ -125,6 +125,8 @@ class Resection {
   /// (which includes every node of the slots it removed: children keep their parents' corners).
   void note_refinement(std::span<const std::uint32_t> added_slots);
   std::uint32_t next_stamp();
+  /// Zeroes every slot and node stamp (none is current any more).
+  void restart_stamps();
 
   MassSpringTissue& tissue_;
   ResectionConfig config_;

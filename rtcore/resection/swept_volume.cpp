@@ -73,12 +73,7 @@ double SweptVolume::path_distance(const Vec3& p) const {
 }
 
 bool SweptVolume::within(const Vec3& p, double reach) const {
-  // The box holds the path grown by the radius; grown further by what reach exceeds it.
-  const double grow = std::max(0.0, reach - radius_m_);
-  if (p.x < bounds_.min.x - grow || p.y < bounds_.min.y - grow || p.z < bounds_.min.z - grow || p.x > bounds_.max.x + grow ||
-      p.y > bounds_.max.y + grow || p.z > bounds_.max.z + grow) {
-    return false;
-  }
+  if (!in_grown_bounds(p, reach)) return false;
   const double reach2 = reach * reach;
   for (const Group& g : groups_) {
     const double group_bound = g.reach + reach;
@@ -95,12 +90,15 @@ bool SweptVolume::within(const Vec3& p, double reach) const {
   return false;
 }
 
-bool SweptVolume::may_be_within(const Vec3& p, double reach) const {
+bool SweptVolume::in_grown_bounds(const Vec3& p, double reach) const {
+  // The box holds the path grown by the radius; grown further by what reach exceeds it.
   const double grow = std::max(0.0, reach - radius_m_);
-  if (p.x < bounds_.min.x - grow || p.y < bounds_.min.y - grow || p.z < bounds_.min.z - grow || p.x > bounds_.max.x + grow ||
-      p.y > bounds_.max.y + grow || p.z > bounds_.max.z + grow) {
-    return false;
-  }
+  return p.x >= bounds_.min.x - grow && p.y >= bounds_.min.y - grow && p.z >= bounds_.min.z - grow && p.x <= bounds_.max.x + grow &&
+         p.y <= bounds_.max.y + grow && p.z <= bounds_.max.z + grow;
+}
+
+bool SweptVolume::may_be_within(const Vec3& p, double reach) const {
+  if (!in_grown_bounds(p, reach)) return false;
   for (const Group& g : groups_) {
     const double group_bound = g.reach + reach;
     if (length_squared(p - g.centre) > group_bound * group_bound) continue;

@@ -47,6 +47,8 @@ class SweptVolume {
     Vec3 centre;
     double reach;  // every point of the quad is within this of centre
   };
+  /// Whether p is inside the volume's box grown by what `reach` exceeds the radius.
+  bool in_grown_bounds(const Vec3& p, double reach) const;
   /// Consecutive quads in fours under one bounding sphere, so a far point costs a few tests.
   struct Group {
     Vec3 centre;

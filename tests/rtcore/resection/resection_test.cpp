@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <random>
 
 #include "rtcore/mesh/mesh_validation.h"
@@ -170,7 +171,9 @@ TEST(Resection, CuttingDistalToTheVerumontanumIsASphincterZoneViolation) {
   EXPECT_GT(m.sphincter_zone_cut_s, 0.0);
 }
 
-std::vector<std::uint64_t> collision_hashes(const SimulationConfig& config, const Procedure& procedure) {
+/// The state hash at every collision step of `procedure`; `after` then sees the simulation.
+std::vector<std::uint64_t> collision_hashes(const SimulationConfig& config, const Procedure& procedure,
+                                            const std::function<void(const Simulation&)>& after = {}) {
   auto sim = Simulation::create(config);
   EXPECT_TRUE(sim);
   std::vector<std::uint64_t> hashes;
@@ -181,6 +184,7 @@ std::vector<std::uint64_t> collision_hashes(const SimulationConfig& config, cons
     if ((*sim)->is_collision_tick(tick)) hashes.push_back((*sim)->state_hash());
   }
   EXPECT_GT((*sim)->resection().stats().removed_tetrahedra, 0);
+  if (after) after(**sim);
   return hashes;
 }
 
@@ -220,19 +224,11 @@ TEST(Resection, CompactingDeadSpringsChangesNoHashAndLeavesNoneDead) {
     SimulationConfig config;
     config.prostate_triangles = 1296;
     config.resection.compact_dead_spring_fraction = fraction;
-    auto sim = Simulation::create(config);
-    EXPECT_TRUE(sim) << sim.error();
-    std::vector<std::uint64_t> hashes;
-    const double tick_s = config.tick_s();
-    const auto ticks = static_cast<std::uint64_t>(std::llround(p.duration_s() / tick_s));
-    for (std::uint64_t tick = 0; tick < ticks; ++tick) {
-      (*sim)->step(procedure_input(p, tick, tick_s), {});
-      if ((*sim)->is_collision_tick(tick)) hashes.push_back((*sim)->state_hash());
-    }
-    *compactions = (*sim)->resection().stats().spring_compactions;
-    *springs = (*sim)->tissue().network().spring_count();
-    *dead = (*sim)->tissue().dead_spring_count();
-    return hashes;
+    return collision_hashes(config, p, [&](const Simulation& sim) {
+      *compactions = sim.resection().stats().spring_compactions;
+      *springs = sim.tissue().network().spring_count();
+      *dead = sim.tissue().dead_spring_count();
+    });
   };
   std::int64_t never_compactions = 0, always_compactions = 0;
   std::size_t never_springs = 0, always_springs = 0, never_dead = 0, always_dead = 0;
