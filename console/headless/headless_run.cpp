@@ -212,6 +212,9 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   core_priority.reset();
   consumer.stop();
   if (live) live->link().stop();
+  // The last collision step's job may still be cutting the other copy: take it in before reading the
+  // tissue, the metrics and the score.
+  sim.settle();
 
   result.ticks = sim.tick();
   result.final_hash = sim.state_hash();
@@ -236,7 +239,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
                 {"tetrahedra", sim.tetrahedron_count()},
                 {"nodes", sim.tissue().node_count()}};
   ordered_json stages = ordered_json::object();
-  for (Stage stage : {Stage::kInput, Stage::kKinematics, Stage::kCollisionWait, Stage::kTopology, Stage::kPhysics, Stage::kRefit, Stage::kQuery,
+  for (Stage stage : {Stage::kInput, Stage::kKinematics, Stage::kCollisionWait, Stage::kAdopt, Stage::kTopology, Stage::kPhysics, Stage::kRefit, Stage::kQuery,
                       Stage::kResponse, Stage::kPublish, Stage::kTick}) {
     stages[stage_name(stage)] = stage_json(profiler.statistics(stage));
   }

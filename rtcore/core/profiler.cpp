@@ -14,7 +14,7 @@ namespace resecto {
 namespace {
 
 /// The stages the collision thread runs get their own track in the trace.
-bool runs_on_collision_thread(Stage stage) { return stage == Stage::kRefit || stage == Stage::kQuery; }
+bool runs_on_collision_thread(Stage stage) { return stage == Stage::kTopology || stage == Stage::kRefit || stage == Stage::kQuery; }
 
 }  // namespace
 
@@ -23,6 +23,7 @@ const char* stage_name(Stage stage) {
     case Stage::kInput: return "input";
     case Stage::kKinematics: return "kinematics";
     case Stage::kCollisionWait: return "collision_wait";
+    case Stage::kAdopt: return "adopt";
     case Stage::kTopology: return "topology";
     case Stage::kPhysics: return "physics";
     case Stage::kRefit: return "refit";
@@ -68,7 +69,7 @@ Status FrameProfiler::write_chrome_trace(const std::filesystem::path& path) cons
   out << "{\"displayTimeUnit\":\"ms\",\"traceEvents\":[\n";
   out << R"({"name":"process_name","ph":"M","pid":1,"tid":1,"args":{"name":"resecto core"}},)" << "\n";
   out << R"json({"name":"thread_name","ph":"M","pid":1,"tid":1,"args":{"name":"core (fixed step)"}},)json" << "\n";
-  out << R"json({"name":"thread_name","ph":"M","pid":1,"tid":2,"args":{"name":"collision (refit + query)"}})json";
+  out << R"json({"name":"thread_name","ph":"M","pid":1,"tid":2,"args":{"name":"collision (topology + refit + query)"}})json";
   char line[256];
   // Oldest first: the order the stages ran in.
   for (std::uint64_t i = first; i < trace_written_; ++i) {

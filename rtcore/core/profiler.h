@@ -14,11 +14,12 @@
 namespace resecto {
 
 /// The stages of a core tick, in execution order.
-/// kRefit and kQuery run on the collision thread, alongside the ticks after their own; kCollisionWait
-/// is the core's wait for them at the next collision tick; kTopology is resection's edit of the
-/// tissue at a collision tick, between that wait and the next search.
-enum class Stage : std::uint8_t { kInput, kKinematics, kCollisionWait, kTopology, kPhysics, kRefit, kQuery, kResponse, kPublish, kTick };
-inline constexpr int kStageCount = 10;
+/// kTopology (resection's edit of the tissue's second copy), kRefit and kQuery run on the collision
+/// thread, alongside the ticks after their own; kCollisionWait is the core's wait for them at the next
+/// collision tick, and kAdopt the core's share of an edit: the edited copy taking over the front's
+/// motion (Simulation).
+enum class Stage : std::uint8_t { kInput, kKinematics, kCollisionWait, kAdopt, kTopology, kPhysics, kRefit, kQuery, kResponse, kPublish, kTick };
+inline constexpr int kStageCount = 11;
 
 /// Lower-case name used in reports and traces ("physics").
 const char* stage_name(Stage stage);

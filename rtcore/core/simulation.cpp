@@ -72,11 +72,16 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
   Result<TetMesh> tetra = tetrahedralize_prostate(sim->prostate_, config.max_tet_volume_m3);
   if (!tetra) return Error{"building the tissue model: " + tetra.error()};
   sim->tetrahedra_ = tetra->tetrahedron_count();
-  sim->tissue_ = std::make_unique<MassSpringTissue>(*tetra, config.parameters, config.tissue);
-
+  // Two copies built alike (each with its own reserved room), so either can be the front.
   const ResectoscopeModel tool = generate_resectoscope();
-  sim->sheath_part_ = sim->tissue_->tool().add_part(tool.sheath);
-  sim->loop_part_ = sim->tissue_->tool().add_part(tool.loop);
+  for (std::unique_ptr<MassSpringTissue>& copy : sim->copies_) {
+    copy = std::make_unique<MassSpringTissue>(*tetra, config.parameters, config.tissue);
+    sim->sheath_part_ = copy->tool().add_part(tool.sheath);
+    sim->loop_part_ = copy->tool().add_part(tool.loop);
+  }
+  sim->tissue_ = sim->copies_[0].get();
+  sim->lag_log_.reserve(1024, sim->tissue_->node_capacity() / 8, sim->tissue_->topology().tetrahedron_capacity() / 8);
+  sim->resection_stats_.perforation_sites.reserve(config.resection.max_perforation_sites);
   for (const Landmark& l : sim->prostate_.landmarks) {
     if (l.name == "verumontanum") sim->verumontanum_z_m_ = l.position.z;
   }
@@ -91,14 +96,17 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
   sim->sweep_ = SweptVolume(sim->wire_loop_.size());
   sim->input_filter_ = JointFilter(config.input_filter);
   const RigidPose away = withdrawn_pose();
-  sim->tissue_->tool().reset_pose(sim->sheath_part_, away);
-  sim->tissue_->tool().reset_pose(sim->loop_part_, away);
+  for (std::unique_ptr<MassSpringTissue>& copy : sim->copies_) {
+    copy->tool().reset_pose(sim->sheath_part_, away);
+    copy->tool().reset_pose(sim->loop_part_, away);
+  }
+  sim->resection_stats_ = sim->resection_->stats();
   sim->placed_.poses = {withdrawn_pose(), withdrawn_pose()};
   sim->searching_ = sim->published_ = sim->placed_;
   sim->state_hash_ = sim->tissue_->state_hash();
   if (config.collision_thread) {
     Simulation* raw = sim.get();
-    sim->collision_thread_ = std::make_unique<JobThread>([raw] { raw->run_collision_search(); });
+    sim->collision_thread_ = std::make_unique<JobThread>([raw] { raw->run_collision_job(); });
   }
   return sim;
 }
@@ -128,19 +136,20 @@ bool Simulation::loop_cutting() const {
   return cut_pedal_ && placed_.present && placed_joints_.loop_travel_m >= kBeakTravelM;
 }
 
-void Simulation::update_topology() {
-  const SweptVolume* sweep = nullptr;
-  if (loop_cutting()) {
+void Simulation::prepare_cut() {
+  cut_job_.cutting = loop_cutting();
+  if (cut_job_.cutting) {
     for (std::size_t i = 0; i < wire_loop_.size(); ++i) wire_to_[i] = placed_.poses.loop.apply_point(wire_loop_[i]);
     sweep_.set(wire_from_valid_ ? wire_from_ : wire_to_, wire_to_, tissue_->parameters().si(TissueParameter::kCuttingRadius));
-    sweep = &sweep_;
     std::copy(wire_to_.begin(), wire_to_.end(), wire_from_.begin());
     wire_from_valid_ = true;
   } else {
     wire_from_valid_ = false;
   }
-  const bool distal = placed_.present && placed_.poses.loop.apply_point(loop_front_tool_).z < verumontanum_z_m_;
-  last_cut_ = resection_->step(sweep, cut_pedal_, distal, config_.tick_s() * config_.physics_per_collision);
+  cut_job_.pedal_down = cut_pedal_;
+  cut_job_.distal = placed_.present && placed_.poses.loop.apply_point(loop_front_tool_).z < verumontanum_z_m_;
+  cut_job_.period_s = config_.tick_s() * config_.physics_per_collision;
+  cut_job_.parameters = tissue_->parameters();
 }
 
 void Simulation::step(const TickInput& input, std::span<const ParameterCommand> commands, FrameProfiler* profiler) {
@@ -176,26 +185,18 @@ void Simulation::step(const TickInput& input, std::span<const ParameterCommand> 
   ++tick_;
 }
 
+// Two copies. Resection's edits cost milliseconds while the loop cuts into fresh tissue (refining it,
+// removing, finding hanging pieces and chips), far past a 960 Hz tick's spare time, so they are not
+// made on the core's thread. At a collision tick the core hands the wire's sweep to the collision
+// step's job, which cuts the copy of the tissue the physics is not stepping (after replaying on it
+// the edits the front already holds) at this tick's positions, and then refits and searches that
+// copy. At the next collision tick the edited copy adopts the front's motion (positions and
+// velocities; its new nodes at their parents' current midpoints) and becomes the front, with the
+// candidates found on it. A cut thus reaches the physics one collision period (16.7 ms) after the
+// wire swept it, in batch and real-time runs alike; steps that edit nothing keep the front and search it.
 void Simulation::advance_collision_pipeline(std::uint64_t tick, FrameProfiler* profiler) {
-  if (search_pending_) {
-    {
-      // Normally the search finished long ago and this costs nothing; in batch mode, or when the
-      // machine is overloaded, the core waits here rather than go on with other candidates.
-      RESECTO_PROFILE_STAGE(profiler, Stage::kCollisionWait, tick);
-      if (collision_thread_) collision_thread_->wait();
-    }
-    tissue_->end_collision_step();
-    published_ = searching_;
-    if (profiler) {
-      profiler->record(Stage::kRefit, search_timing_.tick, search_timing_.begin_ns, search_timing_.refit_end_ns);
-      profiler->record(Stage::kQuery, search_timing_.tick, search_timing_.refit_end_ns, search_timing_.query_end_ns);
-    }
-  }
-  {
-    // With no search in flight: the edits change the surface and tree the next search reads.
-    RESECTO_PROFILE_STAGE(profiler, Stage::kTopology, tick);
-    update_topology();
-  }
+  if (search_pending_) collect_collision_step(tick, profiler);
+  prepare_cut();
   tissue_->begin_collision_step();
   // The candidates found now are used from the next collision tick to the one after it, so the search
   // looks for the tool where it will be in the middle of that window, 1.5 collision periods ahead,
@@ -221,18 +222,69 @@ void Simulation::advance_collision_pipeline(std::uint64_t tick, FrameProfiler* p
   last_search_present_ = placed_.present;
   search_timing_.tick = tick;
   search_pending_ = true;
+  copies_[static_cast<std::size_t>(1 - front_)]->tool().copy_query_state(tissue_->tool());
   if (collision_thread_) {
     collision_thread_->launch();
   } else {
-    run_collision_search();
+    run_collision_job();
   }
 }
 
-void Simulation::run_collision_search() {
+void Simulation::collect_collision_step(std::uint64_t tick, FrameProfiler* profiler) {
+  {
+    // Normally the job finished long ago and this costs nothing; in batch mode, or when the machine
+    // is overloaded, the core waits here rather than go on with other candidates.
+    RESECTO_PROFILE_STAGE(profiler, Stage::kCollisionWait, tick);
+    if (collision_thread_) collision_thread_->wait();
+  }
+  if (job_edited_) {
+    RESECTO_PROFILE_STAGE(profiler, Stage::kAdopt, tick);
+    MassSpringTissue& edited = *copies_[static_cast<std::size_t>(1 - front_)];
+    edited.adopt_motion(*tissue_, lag_log_.midpoint_parents(), lag_log_.orphans());
+    front_ = 1 - front_;
+    tissue_ = &edited;
+  }
+  tissue_->end_collision_step();
+  published_ = searching_;
+  last_cut_ = job_cut_;
+  resection_stats_ = resection_->stats();
+  search_pending_ = false;
+  if (profiler) {
+    profiler->record(Stage::kTopology, search_timing_.tick, search_timing_.begin_ns, search_timing_.topology_end_ns);
+    profiler->record(Stage::kRefit, search_timing_.tick, search_timing_.topology_end_ns, search_timing_.refit_end_ns);
+    profiler->record(Stage::kQuery, search_timing_.tick, search_timing_.refit_end_ns, search_timing_.query_end_ns);
+  }
+}
+
+void Simulation::settle() {
+  if (search_pending_) collect_collision_step(tick_, nullptr);
+  update_resection_metrics();
+}
+
+void Simulation::run_collision_job() {
   search_timing_.begin_ns = FrameProfiler::now_ns();
-  tissue_->refit_surface_tree();
+  MassSpringTissue& front = *tissue_;
+  MassSpringTissue& other = *copies_[static_cast<std::size_t>(1 - front_)];
+  if (!lag_log_.empty()) {
+    other.replay(lag_log_);
+    lag_log_.clear();
+  }
+  other.match_parameters(cut_job_.parameters);
+  // The front's positions at the collision tick (begin_collision_step took them for the search).
+  const std::span<const Vec3> positions(front.surface().positions.data(), front.node_count());
+  if (cut_job_.cutting) other.set_positions(positions);
+  other.set_edit_log(&lag_log_);
+  resection_->bind(other);
+  job_cut_ = resection_->step(cut_job_.cutting ? &sweep_ : nullptr, cut_job_.pedal_down, cut_job_.distal, cut_job_.period_s);
+  other.set_edit_log(nullptr);
+  job_edited_ = !lag_log_.empty();
+  if (job_edited_ && !cut_job_.cutting) other.set_positions(positions);  // a compaction adds no node
+  search_timing_.topology_end_ns = FrameProfiler::now_ns();
+  MassSpringTissue& searched = job_edited_ ? other : front;
+  if (job_edited_) other.take_search_positions();
+  searched.refit_surface_tree();
   search_timing_.refit_end_ns = FrameProfiler::now_ns();
-  tissue_->search_contact_candidates();
+  searched.search_contact_candidates();
   search_timing_.query_end_ns = FrameProfiler::now_ns();
 }
 
@@ -271,7 +323,11 @@ void Simulation::update_metrics(const TickInput& input, bool collision_tick) {
     metrics_.distal_margin_mm = std::min(metrics_.distal_margin_mm.value_or(margin_mm), margin_mm);
     if (margin_m < 0.0) ++metrics_.verumontanum_violations;
   }
-  const ResectionStats& cut = resection_->stats();
+  update_resection_metrics();
+}
+
+void Simulation::update_resection_metrics() {
+  const ResectionStats& cut = resection_stats_;
   const double grams_per_m3 = tissue_->parameters().si(TissueParameter::kDensity) * 1000.0;
   constexpr auto kCapsule = static_cast<std::size_t>(TissueRegion::kCapsule), kAdenoma = static_cast<std::size_t>(TissueRegion::kAdenoma);
   metrics_.initial_tissue_g = grams_per_m3 * (cut.initial_m3[kCapsule] + cut.initial_m3[kAdenoma]);
@@ -338,8 +394,10 @@ std::array<double, kStageCount> default_stage_budgets_us(const SimulationConfig&
   budgets[static_cast<int>(Stage::kInput)] = 0.05 * tick_us;
   budgets[static_cast<int>(Stage::kKinematics)] = 0.02 * tick_us;
   budgets[static_cast<int>(Stage::kCollisionWait)] = 0.02 * tick_us;
-  // Resection's edits take one tick's spare time at a collision tick while the loop cuts.
-  budgets[static_cast<int>(Stage::kTopology)] = 0.30 * tick_us;
+  // Resection's edits run on the collision thread before the refit and query, sharing its period;
+  // the core's part is the edited copy adopting the front's motion (a copy of the node arrays).
+  budgets[static_cast<int>(Stage::kAdopt)] = 0.10 * tick_us;
+  budgets[static_cast<int>(Stage::kTopology)] = 0.30 * collision_period_us;
   budgets[static_cast<int>(Stage::kPhysics)] = 0.40 * tick_us;
   budgets[static_cast<int>(Stage::kRefit)] = 0.15 * collision_period_us;
   budgets[static_cast<int>(Stage::kQuery)] = 0.45 * collision_period_us;

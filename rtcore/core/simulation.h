@@ -6,6 +6,7 @@
 // search finishes, or on which thread it ran. Wall-clock time never enters: the profiler only watches.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -170,10 +171,21 @@ class Simulation {
   /// The hash taken at the last collision step.
   std::uint64_t state_hash() const { return state_hash_; }
   const ProcedureMetrics& metrics() const { return metrics_; }
+  /// The copy of the tissue the physics steps (the front; see "Two copies" in simulation.cpp).
   const MassSpringTissue& tissue() const { return *tissue_; }
+  /// Resection runs in the collision step's job: read it between steps of a run without a collision
+  /// thread, or after settle().
   const Resection& resection() const { return *resection_; }
-  /// What the last collision step's topology update removed and refined.
+  /// Resection's totals as of the last collected collision step: they account for exactly the edits
+  /// tissue() holds, whichever thread cut (a copy taken at each collection).
+  const ResectionStats& resection_stats() const { return resection_stats_; }
+  /// What the last collected collision step's topology update removed and refined.
   const ResectionStep& last_resection_step() const { return last_cut_; }
+  /// Waits for the collision step in flight and takes in its result (the edited copy becomes the
+  /// front, the candidates are published, the resection metrics renewed), so that tissue(),
+  /// resection() and metrics() agree: call once a run ends, before reading the tissue it left.
+  /// Stepping on afterwards starts the next collision step at the next collision tick as usual.
+  void settle();
   const ProstateModel& prostate() const { return prostate_; }
   const SimulationConfig& config() const { return config_; }
   const ToolPoses& tool_poses() const { return placed_.poses; }
@@ -190,19 +202,43 @@ class Simulation {
   Simulation() = default;
   void place_tool(const TickInput& input);
   void update_metrics(const TickInput& input, bool collision_tick);
-  /// Publishes the running collision step's candidates (waiting for its search) and starts the next.
+  /// Takes in the running collision step (collect_collision_step) and starts the next.
   void advance_collision_pipeline(std::uint64_t tick, FrameProfiler* profiler);
-  /// The collision step's refit and search, on whichever thread runs them; timed for the profiler.
-  void run_collision_search();
-  /// Resection's part of a collision tick: the wire's sweep since the last one, the cut, the edits.
-  void update_topology();
+  /// Waits for the collision step's job; if it edited the other copy, that copy adopts the front's
+  /// motion and becomes the front; publishes its candidates.
+  void collect_collision_step(std::uint64_t tick, FrameProfiler* profiler);
+  /// The collision step's job, on whichever thread runs it: the other copy catches up on the front's
+  /// edits and is cut; then the copy that will be the front is refitted and searched. Timed.
+  void run_collision_job();
+  /// Resection's part of a collision tick on the core: the wire's sweep since the last one, for the job.
+  void prepare_cut();
+  /// The resection part of the metrics, from the last collected step's statistics.
+  void update_resection_metrics();
   /// Whether the loop cuts this tick: pedal down, tool placed, loop out of the sheath's beak.
   bool loop_cutting() const;
 
   SimulationConfig config_;
   ProstateModel prostate_;
-  std::unique_ptr<MassSpringTissue> tissue_;
+  // Two copies of the tissue: the physics steps *tissue_ (the front) while a collision step's job
+  // edits the other; lag_log_ holds the edits the copy behind has not made yet.
+  std::array<std::unique_ptr<MassSpringTissue>, 2> copies_;
+  int front_ = 0;
+  MassSpringTissue* tissue_ = nullptr;
+  TissueEditLog lag_log_;
   std::unique_ptr<Resection> resection_;
+  /// What the core hands a collision step's job (written at launch, read by the job).
+  struct CutJob {
+    bool cutting = false;  // sweep_ holds the wire's path
+    bool pedal_down = false;
+    bool distal = false;
+    double period_s = 0.0;
+    TissueParameters parameters;
+  };
+  CutJob cut_job_;
+  // Written by the job, read after the wait.
+  bool job_edited_ = false;
+  ResectionStep job_cut_;
+  ResectionStats resection_stats_;  // the core's copy, taken at each collection
   SweptVolume sweep_;
   std::vector<Vec3> wire_loop_;  // the cutting arc in the loop's frame
   std::vector<Vec3> wire_from_, wire_to_;  // the arc in the world at the last and this collision tick
@@ -212,7 +248,7 @@ class Simulation {
   /// When the last refit and search ran (written by their thread, read after the wait).
   struct SearchTiming {
     std::uint64_t tick = 0;
-    std::int64_t begin_ns = 0, refit_end_ns = 0, query_end_ns = 0;
+    std::int64_t begin_ns = 0, topology_end_ns = 0, refit_end_ns = 0, query_end_ns = 0;
   };
   SearchTiming search_timing_;
   bool search_pending_ = false;  ///< a collision step's candidates await publishing

@@ -24,15 +24,15 @@ bool holds(const Tetrahedron& tet, std::uint32_t n) { return std::find(tet.begin
 }  // namespace
 
 Resection::Resection(MassSpringTissue& tissue, const ResectionConfig& config)
-    : tissue_(tissue), config_(config), refiner_(tissue.node_capacity(), tissue.topology().tetrahedron_capacity()) {
-  const TetTopology& topo = tissue_.topology();
+    : tissue_(&tissue), config_(config), refiner_(tissue.node_capacity(), tissue.topology().tetrahedron_capacity()) {
+  const TetTopology& topo = tissue_->topology();
   const std::size_t slots = topo.tetrahedron_capacity();
-  const std::size_t nodes = tissue_.node_capacity();
+  const std::size_t nodes = tissue_->node_capacity();
   slot_longest_.assign(slots, 0.0);
   node_reach_.assign(nodes, 0.0);
   for (std::uint32_t t = 0; t < topo.slot_count(); ++t) {
     if (!topo.alive(t)) continue;
-    stats_.initial_m3[static_cast<std::size_t>(topo.region(t))] += tissue_.rest_volume_m3(t);
+    stats_.initial_m3[static_cast<std::size_t>(topo.region(t))] += tissue_->rest_volume_m3(t);
     slot_longest_[t] = longest_rest_edge(t);
     for (std::uint32_t n : topo.tetrahedron(t)) node_reach_[n] = std::max(node_reach_[n], slot_longest_[t]);
   }
@@ -40,10 +40,10 @@ Resection::Resection(MassSpringTissue& tissue, const ResectionConfig& config)
   outer_node_.assign(nodes, 0);
   std::vector<std::uint8_t> on_channel(nodes, 0);
   const Vec3 axis = glm::normalize(config_.channel_direction);
-  const TriangleMesh& surface = tissue_.surface();
-  std::span<const Vec3> rest = tissue_.rest_positions();
+  const TriangleMesh& surface = tissue_->surface();
+  std::span<const Vec3> rest = tissue_->rest_positions();
   for (std::size_t s = 0; s < surface.triangles.size(); ++s) {
-    if (tissue_.surface_face_owner(s) < 0) continue;
+    if (tissue_->surface_face_owner(s) < 0) continue;
     const Triangle& tri = surface.triangles[s];
     const Vec3 n = cross(rest[tri[1]] - rest[tri[0]], rest[tri[2]] - rest[tri[0]]);
     const Vec3 c = (rest[tri[0]] + rest[tri[1]] + rest[tri[2]]) / 3.0;
@@ -56,7 +56,7 @@ Resection::Resection(MassSpringTissue& tissue, const ResectionConfig& config)
   // Dijkstra from every anchored node over the springs at rest length, ties by node: deterministic.
   anchor_distance_.assign(nodes, std::numeric_limits<double>::infinity());
   {
-    const SpringNetwork& network = tissue_.network();
+    const SpringNetwork& network = tissue_->network();
     std::vector<std::uint32_t> first(rest.size() + 1, 0), other;  // each node's springs' other ends
     std::vector<double> length;
     for (std::size_t s = 0; s < network.spring_count(); ++s) {
@@ -74,7 +74,7 @@ Resection::Resection(MassSpringTissue& tissue, const ResectionConfig& config)
     }
     std::vector<std::pair<double, std::uint32_t>> heap;
     for (std::uint32_t n = 0; n < rest.size(); ++n) {
-      if (tissue_.anchored(n)) {
+      if (tissue_->anchored(n)) {
         anchor_distance_[n] = 0.0;
         heap.push_back({0.0, n});
       }
@@ -136,14 +136,14 @@ std::uint32_t Resection::next_stamp() {
 }
 
 Vec3 Resection::centroid(std::uint32_t t) const {
-  const Tetrahedron& tet = tissue_.topology().tetrahedron(t);
-  std::span<const Vec3> x = tissue_.positions();
+  const Tetrahedron& tet = tissue_->topology().tetrahedron(t);
+  std::span<const Vec3> x = tissue_->positions();
   return 0.25 * (x[tet[0]] + x[tet[1]] + x[tet[2]] + x[tet[3]]);
 }
 
 double Resection::longest_rest_edge(std::uint32_t t) const {
-  const Tetrahedron& tet = tissue_.topology().tetrahedron(t);
-  std::span<const Vec3> rest = tissue_.rest_positions();
+  const Tetrahedron& tet = tissue_->topology().tetrahedron(t);
+  std::span<const Vec3> rest = tissue_->rest_positions();
   double longest2 = 0.0;
   for (const auto& e : kTetEdgeCorners) {
     longest2 = std::max(longest2, length_squared(rest[tet[static_cast<std::size_t>(e[0])]] - rest[tet[static_cast<std::size_t>(e[1])]]));
@@ -151,14 +151,16 @@ double Resection::longest_rest_edge(std::uint32_t t) const {
   return std::sqrt(longest2);
 }
 
-RegionVolumes Resection::remaining_m3() const {
+RegionVolumes remaining_m3(const MassSpringTissue& tissue) {
   RegionVolumes out{};
-  const TetTopology& topo = tissue_.topology();
+  const TetTopology& topo = tissue.topology();
   for (std::uint32_t t = 0; t < topo.slot_count(); ++t) {
-    if (topo.alive(t)) out[static_cast<std::size_t>(topo.region(t))] += tissue_.rest_volume_m3(t);
+    if (topo.alive(t)) out[static_cast<std::size_t>(topo.region(t))] += tissue.rest_volume_m3(t);
   }
   return out;
 }
+
+RegionVolumes Resection::remaining_m3() const { return resecto::remaining_m3(*tissue_); }
 
 ResectionStep Resection::step(const SweptVolume* sweep, bool pedal_down, bool distal, double period_s) {
   ResectionStep out;
@@ -174,11 +176,11 @@ ResectionStep Resection::step(const SweptVolume* sweep, bool pedal_down, bool di
     // The cut: live candidates whose centroid the wire's path came within the radius of, by slot.
     removing_.clear();
     for (std::uint32_t t : candidates_) {
-      if (tissue_.topology().alive(t) && sweep->contains(centroid(t))) removing_.push_back(t);
+      if (tissue_->topology().alive(t) && sweep->contains(centroid(t))) removing_.push_back(t);
     }
     if (!removing_.empty()) {
       // A removed tetrahedron with a face on the gland's outer surface opens it.
-      const TetTopology& topo = tissue_.topology();
+      const TetTopology& topo = tissue_->topology();
       for (std::uint32_t t : removing_) {
         for (int f = 0; f < 4 && !out.perforated; ++f) {
           if (topo.neighbor(t, f) != TetTopology::kNone) continue;
@@ -186,7 +188,7 @@ ResectionStep Resection::step(const SweptVolume* sweep, bool pedal_down, bool di
           if (outer_node_[face[0]] && outer_node_[face[1]] && outer_node_[face[2]]) {
             out.perforated = true;
             if (!stroke_perforated_ && stats_.perforation_sites.size() < config_.max_perforation_sites) {
-              std::span<const Vec3> x = tissue_.positions();
+              std::span<const Vec3> x = tissue_->positions();
               stats_.perforation_sites.push_back((x[face[0]] + x[face[1]] + x[face[2]]) / 3.0);
             }
           }
@@ -221,9 +223,9 @@ ResectionStep Resection::step(const SweptVolume* sweep, bool pedal_down, bool di
     }
   }
   if (pedal_down && !removed) stats_.loop_on_idle_s += period_s;
-  const double springs = static_cast<double>(tissue_.network().spring_count());
-  if (!pedal_down && static_cast<double>(tissue_.dead_spring_count()) > config_.compact_dead_spring_fraction * springs) {
-    tissue_.compact_springs();
+  const double springs = static_cast<double>(tissue_->network().spring_count());
+  if (!pedal_down && static_cast<double>(tissue_->dead_spring_count()) > config_.compact_dead_spring_fraction * springs) {
+    tissue_->compact_springs();
     ++stats_.spring_compactions;
   }
   return out;
@@ -236,7 +238,7 @@ void Resection::gather_candidates(const SweptVolume& sweep) {
   // path; the path has since moved at most `wire` and the radius grown by `grown`, so it can be a
   // candidate now only if its centroid moved more than what is left, which needs one of its nodes
   // to have: those nodes' stars are read directly.
-  std::span<const Vec3> x = tissue_.positions();
+  std::span<const Vec3> x = tissue_->positions();
   const double wire = near_valid_ ? sweep.sample_displacement(near_sweep_) : 0.0;
   const double left = config_.candidate_skin_m - wire - std::max(0.0, sweep.radius() - near_sweep_.radius());
   moved_nodes_.clear();
@@ -260,7 +262,7 @@ void Resection::gather_candidates(const SweptVolume& sweep) {
   }
   candidates_.clear();
   const std::uint32_t stamp = next_stamp();
-  const TetTopology& topo = tissue_.topology();
+  const TetTopology& topo = tissue_->topology();
   const double radius = sweep.radius();
   auto consider = [&](std::uint32_t t) {
     if (slot_stamp_[t] == stamp) return;
@@ -282,8 +284,8 @@ void Resection::search_near(const SweptVolume& sweep, double extra, std::vector<
   // follows the loop's neighbourhood, not the gland's size.
   constexpr double kNodeReach = 0.25 + 0.75 * 1.5;
   const std::uint32_t stamp = next_stamp();
-  const TetTopology& topo = tissue_.topology();
-  std::span<const Vec3> x = tissue_.positions();
+  const TetTopology& topo = tissue_->topology();
+  std::span<const Vec3> x = tissue_->positions();
   const double radius = sweep.radius() + extra;
   for (std::uint32_t n = 0; n < x.size(); ++n) {
     if (!sweep.may_be_within(x[n], radius + kNodeReach * node_reach_[n])) continue;
@@ -296,7 +298,7 @@ void Resection::search_near(const SweptVolume& sweep, double extra, std::vector<
 }
 
 void Resection::note_refinement(std::span<const std::uint32_t> added_slots) {
-  const TetTopology& topo = tissue_.topology();
+  const TetTopology& topo = tissue_->topology();
   for (std::uint32_t t : added_slots) slot_longest_[t] = longest_rest_edge(t);
   const std::uint32_t stamp = next_stamp();
   for (std::uint32_t t : added_slots) {
@@ -314,7 +316,7 @@ int Resection::refine_near(const SweptVolume& sweep) {
   int refined = 0;
   const double target = config_.target_edge_per_radius * sweep.radius();
   for (int round = 0; round < config_.max_refinement_rounds; ++round) {
-    const TetTopology& topo = tissue_.topology();
+    const TetTopology& topo = tissue_->topology();
     marked_.clear();
     for (std::uint32_t t : candidates_) {
       // A closure's children are not refined again (their parent's split is not regular; splitting
@@ -326,9 +328,9 @@ int Resection::refine_near(const SweptVolume& sweep) {
       if (sweep.within(centroid(t), sweep.radius() + 0.25 * longest)) marked_.push_back(t);
     }
     if (marked_.empty()) break;
-    const TetMeshView view{tissue_.rest_positions(), topo.tetrahedra(), topo.alive_flags(), topo.regions(), &topo};
+    const TetMeshView view{tissue_->rest_positions(), topo.tetrahedra(), topo.alive_flags(), topo.regions(), &topo};
     const RefinementEdit& edit = refiner_.plan(view, marked_);
-    if (!tissue_.can_edit(edit.new_node_parents.size(), edit.added_tetrahedra.size(), edit.removed_tetrahedra.size())) {
+    if (!tissue_->can_edit(edit.new_node_parents.size(), edit.added_tetrahedra.size(), edit.removed_tetrahedra.size())) {
       ++stats_.refusals;
       break;
     }
@@ -341,28 +343,28 @@ int Resection::refine_near(const SweptVolume& sweep) {
       const bool closure = slot_closure_[parent] || child_count_[parent] != 8;
       child_info_.push_back(static_cast<std::uint8_t>((slot_level_[parent] + 1) | (closure ? 0x80 : 0)));
     }
-    tissue_.add_midpoint_nodes(edit.new_node_parents);
+    tissue_->add_midpoint_nodes(edit.new_node_parents);
     for (std::size_t k = 0; k < edit.new_node_parents.size(); ++k) {
       const auto& [a, b] = edit.new_node_parents[k];
       outer_node_[edit.first_new_node + k] = outer_node_[a] && outer_node_[b];
       anchor_distance_[edit.first_new_node + k] = 0.5 * (anchor_distance_[a] + anchor_distance_[b]);
     }
-    const TopologyChange change = tissue_.edit_tetrahedra(edit.removed_tetrahedra, edit.added_tetrahedra, edit.added_regions);
+    const TopologyChange change = tissue_->edit_tetrahedra(edit.removed_tetrahedra, edit.added_tetrahedra, edit.added_regions);
     if (change.refused) {
       ++stats_.refusals;
       break;
     }
     refined += edit.red_tetrahedra + edit.closure_tetrahedra;
-    note_refinement(tissue_.added_slots());
-    for (std::uint32_t t : tissue_.added_slots()) near_.push_back(t);  // the children replace their parents
-    for (std::size_t k = 0; k < tissue_.added_slots().size(); ++k) {
-      const std::uint32_t t = tissue_.added_slots()[k];
+    note_refinement(tissue_->added_slots());
+    for (std::uint32_t t : tissue_->added_slots()) near_.push_back(t);  // the children replace their parents
+    for (std::size_t k = 0; k < tissue_->added_slots().size(); ++k) {
+      const std::uint32_t t = tissue_->added_slots()[k];
       slot_level_[t] = static_cast<std::uint8_t>(child_info_[k] & 0x7f);
       slot_closure_[t] = (child_info_[k] & 0x80) != 0;
     }
     // The candidates now: the survivors and the children, by slot.
-    std::erase_if(candidates_, [&](std::uint32_t t) { return !tissue_.topology().alive(t); });
-    for (std::uint32_t t : tissue_.added_slots()) candidates_.push_back(t);
+    std::erase_if(candidates_, [&](std::uint32_t t) { return !tissue_->topology().alive(t); });
+    for (std::uint32_t t : tissue_->added_slots()) candidates_.push_back(t);
     sort_unique(candidates_);
   }
   stats_.refined_tetrahedra += refined;
@@ -371,11 +373,11 @@ int Resection::refine_near(const SweptVolume& sweep) {
 
 void Resection::remove(std::vector<std::uint32_t>& slots, bool chip, ResectionStep& out) {
   sort_unique(slots);
-  const TetTopology& topo = tissue_.topology();
+  const TetTopology& topo = tissue_->topology();
   RegionVolumes volume{};
   const std::size_t nodes_before = removed_nodes_.size(), edges_before = removed_edges_.size(), seeds_before = seeds_.size();
   for (std::uint32_t t : slots) {
-    volume[static_cast<std::size_t>(topo.region(t))] += tissue_.rest_volume_m3(t);
+    volume[static_cast<std::size_t>(topo.region(t))] += tissue_->rest_volume_m3(t);
     const Tetrahedron& tet = topo.tetrahedron(t);
     for (std::uint32_t n : tet) removed_nodes_.push_back(n);
     for (const auto& e : kTetEdgeCorners) {
@@ -387,7 +389,7 @@ void Resection::remove(std::vector<std::uint32_t>& slots, bool chip, ResectionSt
       if (n != TetTopology::kNone) seeds_.push_back(static_cast<std::uint32_t>(n));
     }
   }
-  const TopologyChange change = tissue_.edit_tetrahedra(slots, {}, {});
+  const TopologyChange change = tissue_->edit_tetrahedra(slots, {}, {});
   if (change.refused) {
     ++stats_.refusals;
     removed_nodes_.resize(nodes_before);
@@ -406,7 +408,7 @@ void Resection::remove(std::vector<std::uint32_t>& slots, bool chip, ResectionSt
 
 int Resection::star_groups(std::uint32_t a, std::uint32_t b) {
   // Flood through faces that hold a (and b): two tetrahedra of the star sharing a face share them.
-  const TetTopology& topo = tissue_.topology();
+  const TetTopology& topo = tissue_->topology();
   group_.assign(star_.size(), -1);
   group_size_.clear();
   int groups = 0;
@@ -440,7 +442,7 @@ int Resection::star_groups(std::uint32_t a, std::uint32_t b) {
 bool Resection::vertex_fan_is_disk(std::uint32_t v) {
   // The surface faces around v, each seen from v as an edge p -> q of its link: a closed fan when
   // they chain into one cycle (no vertex of the link starts two of them).
-  const TetTopology& topo = tissue_.topology();
+  const TetTopology& topo = tissue_->topology();
   fan_edges_.clear();
   for (std::uint32_t t : star_) {
     const Tetrahedron& tet = topo.tetrahedron(t);
@@ -471,7 +473,7 @@ void Resection::remove_hanging(ResectionStep& out) {
   // Around every node and edge the last removals touched, in ascending order: a star in more than one
   // face-connected group keeps its largest (ties: the one with the lowest slot) and loses the rest; a
   // node whose star is one group but whose surface there is not one closed fan loses its star.
-  const TetTopology& topo = tissue_.topology();
+  const TetTopology& topo = tissue_->topology();
   for (int round = 0; round < 64; ++round) {
     sort_unique(removed_nodes_);
     sort_unique(removed_edges_);
@@ -527,7 +529,7 @@ bool Resection::remove_chips(ResectionStep& out) {
   // held, shows the component is held; a component that runs out first is a chip. The walk's order
   // (distance, then slot) is fixed, so the result is the same every run; only the cost depends on
   // the guide, and a held component usually shows itself within a few dozen tetrahedra.
-  const TetTopology& topo = tissue_.topology();
+  const TetTopology& topo = tissue_->topology();
   bool any = false;
   sort_unique(seeds_);
   if (stamp_ > 0xF0000000u) restart_stamps();  // each walk takes a stamp; keep this pass's stamps ordered
@@ -553,7 +555,7 @@ bool Resection::remove_chips(ResectionStep& out) {
       std::pop_heap(frontier_.begin(), frontier_.end(), std::greater<>());
       const std::uint32_t t = frontier_.back().second;
       frontier_.pop_back();
-      for (std::uint32_t n : topo.tetrahedron(t)) held = held || tissue_.anchored(n);
+      for (std::uint32_t n : topo.tetrahedron(t)) held = held || tissue_->anchored(n);
       for (int f = 0; f < 4 && !held; ++f) {
         const std::int32_t n = topo.neighbor(t, f);
         if (n == TetTopology::kNone) continue;

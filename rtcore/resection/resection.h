@@ -84,6 +84,9 @@ struct ResectionStep {
   double removed_m3 = 0.0;
 };
 
+/// Rest volume of a tissue's live tetrahedra by region, summed afresh (for checks, O(tetrahedra)).
+RegionVolumes remaining_m3(const MassSpringTissue& tissue);
+
 class Resection {
  public:
   /// Reserves every scratch array for the tissue's capacities.
@@ -94,6 +97,9 @@ class Resection {
   /// loop is distal to the verumontanum. Call between physics steps with no refit or search running.
   ResectionStep step(const SweptVolume* sweep, bool pedal_down, bool distal, double period_s);
 
+  /// Edits `tissue` from now on: the core's other copy of the tissue, holding the same topology as the
+  /// one edited so far (MassSpringTissue::replay brings it there).
+  void bind(MassSpringTissue& tissue) { tissue_ = &tissue; }
   const ResectionStats& stats() const { return stats_; }
   /// How many times the candidate search's skin list was built (each a search over the nodes).
   std::int64_t candidate_list_builds() const { return near_builds_; }
@@ -128,7 +134,7 @@ class Resection {
   /// Zeroes every slot and node stamp (none is current any more).
   void restart_stamps();
 
-  MassSpringTissue& tissue_;
+  MassSpringTissue* tissue_;
   ResectionConfig config_;
   TetRefiner refiner_;
   ResectionStats stats_;

@@ -139,6 +139,10 @@ void MassSpringTissue::set_parameters(const TissueParameters& parameters) {
   update_material();
 }
 
+void MassSpringTissue::match_parameters(const TissueParameters& parameters) {
+  if (parameters.values != parameters_.values) set_parameters(parameters);
+}
+
 void MassSpringTissue::collision_step() {
   begin_collision_step();
   refit_surface_tree();

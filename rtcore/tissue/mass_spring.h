@@ -10,6 +10,7 @@
 #include "rtcore/collision/sphere_tree.h"
 #include "rtcore/tissue/spring_forces.h"
 #include "rtcore/tissue/springs.h"
+#include "rtcore/tissue/tissue_edit_log.h"
 #include "rtcore/tissue/tet_mesh.h"
 #include "rtcore/tissue/tet_topology.h"
 #include "rtcore/tissue/tissue_parameters.h"
@@ -144,6 +145,30 @@ class MassSpringTissue {
   /// changes no force and no state (a dead spring adds exactly zero), and frees their room.
   void compact_springs();
   std::int64_t spring_compactions() const { return spring_compactions_; }
+
+  // ---- The second copy (tissue_edit_log.h): the core steps one copy while the collision thread
+  // edits the other, which then takes over.
+  /// Records every edit made from now on (add_midpoint_nodes, edit_tetrahedra, compact_springs) into
+  /// `log`; null stops recording.
+  void set_edit_log(TissueEditLog* log) { edit_log_ = log; }
+  /// Makes the logged edits, in order, on this copy, which must hold the topology the logged copy
+  /// held before them: it ends with the same topology, springs and surface.
+  void replay(const TissueEditLog& log);
+  /// Sets the parameters if they differ from this copy's (a pass over the material when they do).
+  void match_parameters(const TissueParameters& parameters);
+  /// Overwrites the first positions.size() node positions (the front copy's, taken at a collision
+  /// tick), where the edits read them (a cut's centroids).
+  void set_positions(std::span<const Vec3> positions);
+  /// The search's positions become this copy's own (begin_collision_step without latching the tool,
+  /// whose query state is copied from the front's: ToolContacts::copy_query_state).
+  void take_search_positions();
+  /// Takes over `front`'s motion after this copy was edited ahead of it: positions, velocities and the
+  /// integrator's state of every node both hold; each node the edits added (`new_node_parents`, in
+  /// order, from front.node_count() on) gets its parents' averages of the current ones; `orphans`
+  /// stop; the tool's poses, the tissue's travel and the faults carry over, and the parameters if a
+  /// command changed them meanwhile. Allocates nothing.
+  void adopt_motion(const MassSpringTissue& front, std::span<const std::array<std::uint32_t, 2>> new_node_parents,
+                    std::span<const std::uint32_t> orphans);
   /// Rest volume of live slot t (m^3).
   double rest_volume_m3(std::uint32_t t) const;
   /// Whether `node` is held by a capsule anchor spring (and still by a tetrahedron).
@@ -274,6 +299,7 @@ class MassSpringTissue {
   };
   std::vector<NewSpring> new_springs_;
   std::uint32_t stamp_ = 0;
+  TissueEditLog* edit_log_ = nullptr;
   ToolContacts tool_;
   ToolReaction reaction_;
   TissueFaults faults_;

@@ -236,6 +236,7 @@ std::size_t MassSpringTissue::surface_growth_bound(std::span<const std::uint32_t
 
 void MassSpringTissue::add_midpoint_nodes(std::span<const std::array<std::uint32_t, 2>> parents) {
   assert(x_.size() + parents.size() <= topology_.node_capacity());
+  if (edit_log_ != nullptr) edit_log_->record_midpoint_nodes(parents);
   for (const auto& [a, b] : parents) {
     const auto node = static_cast<std::uint32_t>(x_.size());
     x_.push_back(0.5 * (x_[a] + x_[b]));
@@ -289,6 +290,7 @@ TopologyChange MassSpringTissue::edit_tetrahedra(std::span<const std::uint32_t> 
     ++faults_.topology_capacity_refusals;
     return change;
   }
+  if (edit_log_ != nullptr) edit_log_->record_edit(removed, added, added_regions);
   touched_nodes_.clear();
   touched_springs_.clear();
   exposed_faces_.clear();
@@ -432,6 +434,7 @@ TopologyChange MassSpringTissue::edit_tetrahedra(std::span<const std::uint32_t> 
     if (topology_.valence(n) == 0) {
       ++change.nodes_orphaned;
       v_[n] = Vec3(0.0);
+      if (edit_log_ != nullptr) edit_log_->record_orphan(n);
       dead_node_[n] = 1;
     }
     if (anchor_of_node_[n] >= 0) {
@@ -460,6 +463,7 @@ void MassSpringTissue::compact_springs() {
     if (network_.volume_share_m3[s] > 0.0) kept.push_back(s);
   }
   if (kept.size() == springs_.spring_count()) return;
+  if (edit_log_ != nullptr) edit_log_->record_compaction();
   springs_.keep(kept, x_.size());
   for (std::size_t k = 0; k < kept.size(); ++k) {
     const std::uint32_t s = kept[k];
@@ -488,6 +492,51 @@ void MassSpringTissue::compact_springs() {
   kept.clear();
   dead_springs_ = 0;
   ++spring_compactions_;
+}
+
+void MassSpringTissue::replay(const TissueEditLog& log) {
+  assert(edit_log_ == nullptr && "a replay is not itself recorded");
+  for (const TissueEditLog::Entry& e : log.entries()) {
+    switch (e.kind) {
+      case TissueEditLog::Kind::kMidpointNodes: add_midpoint_nodes(log.parents(e)); break;
+      case TissueEditLog::Kind::kEditTetrahedra: edit_tetrahedra(log.removed(e), log.added(e), log.regions(e)); break;
+      case TissueEditLog::Kind::kCompactSprings: compact_springs(); break;
+    }
+  }
+}
+
+void MassSpringTissue::set_positions(std::span<const Vec3> positions) {
+  assert(positions.size() <= x_.size());
+  std::copy(positions.begin(), positions.end(), x_.begin());
+}
+
+void MassSpringTissue::take_search_positions() { std::copy(x_.begin(), x_.end(), surface_.positions.begin()); }
+
+void MassSpringTissue::adopt_motion(const MassSpringTissue& front, std::span<const std::array<std::uint32_t, 2>> new_node_parents,
+                                   std::span<const std::uint32_t> orphans) {
+  const std::size_t shared = front.x_.size();
+  assert(shared + new_node_parents.size() == x_.size());
+  // A command applied to the front since this copy's job began is applied here too, before the bounds
+  // of the next step are formed from the material.
+  match_parameters(front.parameters_);
+  std::copy(front.x_.begin(), front.x_.end(), x_.begin());
+  std::copy(front.v_.begin(), front.v_.end(), v_.begin());
+  std::copy(front.step_mass_.begin(), front.step_mass_.end(), step_mass_.begin());
+  for (std::size_t k = 0; k < new_node_parents.size(); ++k) {
+    const auto [a, b] = new_node_parents[k];
+    x_[shared + k] = 0.5 * (x_[a] + x_[b]);
+    v_[shared + k] = 0.5 * (v_[a] + v_[b]);
+    step_mass_[shared + k] = 0.5 * (step_mass_[a] + step_mass_[b]);
+  }
+  for (std::uint32_t n : orphans) v_[n] = Vec3(0.0);
+  travel_m_ = front.travel_m_;
+  reaction_ = front.reaction_;
+  const std::int64_t refusals = faults_.topology_capacity_refusals;  // this copy made the newest edits
+  faults_ = front.faults_;
+  faults_.topology_capacity_refusals = refusals;
+  last_substeps_ = front.last_substeps_;
+  last_cg_iterations_ = front.last_cg_iterations_;
+  tool_.adopt_motion(front.tool_);
 }
 
 TriangleMesh MassSpringTissue::live_surface(bool rest_positions) const {

@@ -129,6 +129,7 @@ ToolContacts::ToolContacts(double margin_m, const ToolContactCapacity& capacity)
   search_.pair_distance2.resize(static_cast<std::size_t>(capacity.max_pair_entries));
   search_.node_clearance.resize(static_cast<std::size_t>(capacity.max_tissue_nodes));
   search_.vertex_clearance.resize(static_cast<std::size_t>(capacity.max_tool_vertices));
+  search_.sorting.resize(static_cast<std::size_t>(std::max(capacity.max_tissue_nodes, capacity.max_tool_vertices)));
   node_clearance_.resize(static_cast<std::size_t>(capacity.max_tissue_nodes));
   vertex_clearance_.resize(static_cast<std::size_t>(capacity.max_tool_vertices));
   stack_.reserve(256);
@@ -251,6 +252,38 @@ void ToolContacts::latch_query_poses(double tissue_travel_m) {
   }
 }
 
+void ToolContacts::adopt_motion(const ToolContacts& front) {
+  for (std::size_t k = 0; k < parts_.size(); ++k) {
+    parts_[k].pose = front.parts_[k].pose;
+    parts_[k].previous_pose = front.parts_[k].previous_pose;
+    parts_[k].enabled = front.parts_[k].enabled;
+  }
+  stats_ = front.stats_;
+  points_evaluated_ = front.points_evaluated_;
+  points_skipped_ = front.points_skipped_;
+}
+
+void ToolContacts::copy_query_state(const ToolContacts& front) {
+  query_tissue_travel_m_ = front.query_tissue_travel_m_;
+  for (std::size_t k = 0; k < parts_.size(); ++k) {
+    parts_[k].query_pose = front.parts_[k].query_pose;
+    parts_[k].query_enabled = front.parts_[k].query_enabled;
+  }
+}
+
+void ToolContacts::order_points(std::vector<PointCandidates>& points, std::vector<Clearance>& clearance, std::size_t count) {
+  std::vector<std::pair<PointCandidates, Clearance>>& sorting = search_.sorting;
+  for (std::size_t i = 0; i < count; ++i) sorting[i] = {points[i], clearance[i]};
+  const auto by_part_then_point = [](const std::pair<PointCandidates, Clearance>& a, const std::pair<PointCandidates, Clearance>& b) {
+    return a.first.part != b.first.part ? a.first.part < b.first.part : a.first.point < b.first.point;
+  };
+  std::sort(sorting.begin(), sorting.begin() + static_cast<std::ptrdiff_t>(count), by_part_then_point);
+  for (std::size_t i = 0; i < count; ++i) {
+    points[i] = sorting[i].first;
+    clearance[i] = sorting[i].second;
+  }
+}
+
 void ToolContacts::publish_candidates() {
   std::swap(node_candidates_, search_.nodes);
   std::swap(vertex_candidates_, search_.vertices);
@@ -338,6 +371,11 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
       }
     }
   }
+  // The collider's leaf order follows the trees' shapes, which edits, rebuilds and the copy searched
+  // (Simulation's two copies of the tissue) change; in (part, point) order the forces' sums, and so
+  // the state, do not depend on them.
+  order_points(out.nodes, out.node_clearance, out.node_count);
+  order_points(out.vertices, out.vertex_clearance, out.vertex_count);
   out.stats.tissue_nodes = static_cast<std::int32_t>(out.node_count);
   out.stats.tool_vertices = static_cast<std::int32_t>(out.vertex_count);
   out.stats.pair_entries = static_cast<std::int32_t>(out.pair_count);

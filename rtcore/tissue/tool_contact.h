@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "rtcore/collision/collide.h"
@@ -114,6 +115,12 @@ class ToolContacts {
   /// a growing surface does not allocate at a search.
   void reserve_tissue(std::size_t max_nodes, std::size_t max_faces);
   const ToolContactStats& stats() const { return stats_; }
+  /// For the tissue's second copy taking over (MassSpringTissue::adopt_motion): the parts' poses and
+  /// enabled flags, the last step's statistics and the point counters become `front`'s.
+  void adopt_motion(const ToolContacts& front);
+  /// The parts' latched query poses and flags and the latched tissue travel become `front`'s, so a
+  /// search here looks where the front's would (call while no search runs on either).
+  void copy_query_state(const ToolContacts& front);
   /// Point evaluations add_forces() ran and skipped on its certificates, since construction.
   std::int64_t points_evaluated() const { return points_evaluated_; }
   std::int64_t points_skipped() const { return points_skipped_; }
@@ -146,7 +153,10 @@ class ToolContacts {
     std::vector<Clearance> node_clearance, vertex_clearance;  // per point, at the searched positions
     std::size_t node_count = 0, vertex_count = 0, pair_count = 0;
     ToolContactStats stats;
+    std::vector<std::pair<PointCandidates, Clearance>> sorting;  // scratch of order_points()
   };
+  /// Puts the search's first `count` points in (part, point) order, with their certificates.
+  void order_points(std::vector<PointCandidates>& points, std::vector<Clearance>& clearance, std::size_t count);
   /// Appends the triangles of `tree` with a leaf sphere within `radius` of `point`, each once.
   void gather_triangles(const SphereTree& tree, const Vec3& point, double radius, std::vector<std::uint32_t>& seen);
   bool push_pair(std::uint32_t triangle);

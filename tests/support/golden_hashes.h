@@ -26,9 +26,9 @@ struct GoldenRun {
 
 inline constexpr GoldenRun kGoldenRuns[] = {
     // resecto run --headless --procedure demo --seconds 2 --triangles 1296 --json
-    {"--procedure demo --seconds 2 --triangles 1296", "9fa8795bcb033d89", "b4a6ac61b703c210", 0},
+    {"--procedure demo --seconds 2 --triangles 1296", "a8f80369fca18e0d", "ee80a6d6bee5fa0a", 0},
     // resecto run --headless --procedure turp --seconds 4 --triangles 1296 --json (two strokes cut)
-    {"--procedure turp --seconds 4 --triangles 1296", "665cda257060b4c1", "e9b666dbd4e440af", 2},
+    {"--procedure turp --seconds 4 --triangles 1296", "d21f58a89b204843", "fe0bc7dda1842084", 2},
 };
 
 }  // namespace resecto::testing

@@ -91,7 +91,7 @@ TEST(Score, LobeOrderFollowsTheDemo) {
 TEST(Score, HeatMapAccountsForTheRemovedVolumeOnBothSides) {
   const DemoRun& run = demo_run();
   const ResectionHeatMap& map = run.score.heat_map;
-  const ResectionStats& stats = run.sim->resection().stats();
+  const ResectionStats& stats = run.sim->resection_stats();
   constexpr auto kAdenoma = static_cast<std::size_t>(TissueRegion::kAdenoma), kCapsule = static_cast<std::size_t>(TissueRegion::kCapsule);
   const double initial = std::accumulate(map.initial_adenoma_m3.begin(), map.initial_adenoma_m3.end(), 0.0);
   EXPECT_NEAR(initial, stats.initial_m3[kAdenoma], 1e-9 * initial);

@@ -33,8 +33,8 @@ RunCheck run_checked(Simulation& sim, const Procedure& procedure) {
     sim.step(procedure_input(procedure, tick, tick_s), {});
     if (!sim.is_collision_tick(tick)) continue;
     ++check.collision_steps;
-    const ResectionStats& stats = sim.resection().stats();
-    const RegionVolumes remaining = sim.resection().remaining_m3();
+    const ResectionStats& stats = sim.resection_stats();
+    const RegionVolumes remaining = remaining_m3(sim.tissue());
     for (std::size_t r : {kCapsule, kAdenoma}) {
       const double error = std::abs(stats.initial_m3[r] - (remaining[r] + stats.removed_m3[r])) / stats.initial_m3[r];
       check.worst_conservation = std::max(check.worst_conservation, error);
@@ -48,7 +48,7 @@ void expect_valid_surface(const Simulation& sim, const char* what) {
   if (surface.triangles.empty() && sim.tissue().topology().live_count() == 0) return;  // all of it resected
   Result<SurfaceReport> report = validate_closed_surface(surface);
   ASSERT_TRUE(report) << what << ": " << report.error();
-  const RegionVolumes remaining = sim.resection().remaining_m3();
+  const RegionVolumes remaining = remaining_m3(sim.tissue());
   const double volume = remaining[kCapsule] + remaining[kAdenoma];
   EXPECT_NEAR(report->volume_m3, volume, 1e-9 * volume) << what;
 }
@@ -118,7 +118,7 @@ TEST(Resection, PedalUpOrLoopInTheSheathRemovesNothing) {
     const ProcedureMetrics& m = sim->metrics();
     EXPECT_EQ(m.resected_total_g, 0.0) << "variant " << variant;
     EXPECT_EQ(m.cuts, 0u);
-    EXPECT_EQ(sim->resection().stats().removed_tetrahedra, 0);
+    EXPECT_EQ(sim->resection_stats().removed_tetrahedra, 0);
     if (variant == 1) {
       EXPECT_GT(m.loop_on_idle_s, 1.0) << "the pedal was down with nothing cut";
     }
@@ -147,8 +147,8 @@ TEST(Resection, CuttingIntoTheCapsuleIsAPerforation) {
   const ProcedureMetrics& m = sim->metrics();
   EXPECT_GE(m.perforations, 1u);
   EXPECT_GT(m.resected_capsule_g, 0.0);
-  ASSERT_FALSE(sim->resection().stats().perforation_sites.empty());
-  EXPECT_GT(sim->resection().stats().perforation_sites.front().x, 0.010) << "on the left side";
+  ASSERT_FALSE(sim->resection_stats().perforation_sites.empty());
+  EXPECT_GT(sim->resection_stats().perforation_sites.front().x, 0.010) << "on the left side";
   EXPECT_LT(check.worst_conservation, 1e-12);
   expect_valid_surface(*sim, "after the perforation");
 }
@@ -183,7 +183,7 @@ std::vector<std::uint64_t> collision_hashes(const SimulationConfig& config, cons
     (*sim)->step(procedure_input(procedure, tick, tick_s), {});
     if ((*sim)->is_collision_tick(tick)) hashes.push_back((*sim)->state_hash());
   }
-  EXPECT_GT((*sim)->resection().stats().removed_tetrahedra, 0);
+  EXPECT_GT((*sim)->resection_stats().removed_tetrahedra, 0);
   if (after) after(**sim);
   return hashes;
 }
@@ -225,7 +225,7 @@ TEST(Resection, CompactingDeadSpringsChangesNoHashAndLeavesNoneDead) {
     config.prostate_triangles = 1296;
     config.resection.compact_dead_spring_fraction = fraction;
     return collision_hashes(config, p, [&](const Simulation& sim) {
-      *compactions = sim.resection().stats().spring_compactions;
+      *compactions = sim.resection_stats().spring_compactions;
       *springs = sim.tissue().network().spring_count();
       *dead = sim.tissue().dead_spring_count();
     });
@@ -341,8 +341,8 @@ TEST(Resection, FuzzRandomStrokesKeepMassSurfaceAndNumbers) {
     run(a, b, 8, radius);
     at = b;
     at.cut = false;
-    const ResectionStats& stats = sim.resection().stats();
-    const RegionVolumes remaining = sim.resection().remaining_m3();
+    const ResectionStats& stats = sim.resection_stats();
+    const RegionVolumes remaining = remaining_m3(sim.tissue());
     for (std::size_t r : {kCapsule, kAdenoma}) {
       worst = std::max(worst, std::abs(stats.initial_m3[r] - (remaining[r] + stats.removed_m3[r])) / stats.initial_m3[r]);
     }
@@ -358,8 +358,8 @@ TEST(Resection, FuzzRandomStrokesKeepMassSurfaceAndNumbers) {
     }
   }
   std::printf("fuzz: %d strokes, %.1f%% of the tissue left, %lld chips, %lld refined, worst conservation %.2e\n", strokes,
-              100.0 * sim.metrics().remaining_tissue_g / sim.metrics().initial_tissue_g, static_cast<long long>(sim.resection().stats().chips),
-              static_cast<long long>(sim.resection().stats().refined_tetrahedra), worst);
+              100.0 * sim.metrics().remaining_tissue_g / sim.metrics().initial_tissue_g, static_cast<long long>(sim.resection_stats().chips),
+              static_cast<long long>(sim.resection_stats().refined_tetrahedra), worst);
   EXPECT_LT(worst, 1e-12);
   expect_valid_surface(sim, "after the fuzz");
 }
