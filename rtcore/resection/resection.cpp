@@ -102,6 +102,7 @@ Resection::Resection(MassSpringTissue& tissue, const ResectionConfig& config)
   near_positions_.reserve(nodes);
   moved_nodes_.reserve(kMaxMovedNodes + 1);
   marked_.reserve(slots);
+  by_distance_.reserve(slots);
   removing_.reserve(slots);
   queue_.reserve(slots);
   seeds_.reserve(4 * slots);
@@ -312,6 +313,19 @@ void Resection::note_refinement(std::span<const std::uint32_t> added_slots) {
   }
 }
 
+void Resection::keep_nearest_the_start(const SweptVolume& sweep) {
+  Vec3 start(0.0);
+  for (const Vec3& p : sweep.start()) start += p;
+  start /= static_cast<double>(std::max<std::size_t>(1, sweep.start().size()));
+  by_distance_.clear();
+  for (std::uint32_t t : marked_) by_distance_.push_back({length_squared(centroid(t) - start), t});
+  const auto keep = static_cast<std::ptrdiff_t>(config_.max_marked_per_step);
+  std::nth_element(by_distance_.begin(), by_distance_.begin() + keep, by_distance_.end());  // ties by slot: pairs compare both
+  marked_.clear();
+  for (auto it = by_distance_.begin(); it != by_distance_.begin() + keep; ++it) marked_.push_back(it->second);
+  std::sort(marked_.begin(), marked_.end());
+}
+
 int Resection::refine_near(const SweptVolume& sweep) {
   int refined = 0;
   const double target = config_.target_edge_per_radius * sweep.radius();
@@ -328,6 +342,7 @@ int Resection::refine_near(const SweptVolume& sweep) {
       if (sweep.within(centroid(t), sweep.radius() + 0.25 * longest)) marked_.push_back(t);
     }
     if (marked_.empty()) break;
+    if (marked_.size() > config_.max_marked_per_step) keep_nearest_the_start(sweep);
     const TetMeshView view{tissue_->rest_positions(), topo.tetrahedra(), topo.alive_flags(), topo.regions(), &topo};
     const RefinementEdit& edit = refiner_.plan(view, marked_);
     if (!tissue_->can_edit(edit.new_node_parents.size(), edit.added_tetrahedra.size(), edit.removed_tetrahedra.size())) {

@@ -35,6 +35,10 @@ struct ResectionConfig {
   double target_edge_per_radius = 2.0;
   /// Refinement rounds per collision step at most (each halves the edges it reaches).
   int max_refinement_rounds = 1;
+  /// Tetrahedra one collision step refines at most (before closures): a fresh stroke into coarse
+  /// tissue marks hundreds at once, milliseconds of edits. Past it, those nearest where the path
+  /// starts go first; the rest lie where the next step's path begins, which marks them again.
+  std::size_t max_marked_per_step = 64;
   /// Regular 1:8 splits a tetrahedron of the model may go through at most (closures' children are
   /// never split again).
   int max_refinement_levels = 2;
@@ -115,6 +119,8 @@ class Resection {
   /// candidates' own reach of the path, into `out` (unsorted).
   void search_near(const SweptVolume& sweep, double extra, std::vector<std::uint32_t>& out);
   int refine_near(const SweptVolume& sweep);
+  /// Cuts marked_ down to ResectionConfig::max_marked_per_step: those nearest where the path starts.
+  void keep_nearest_the_start(const SweptVolume& sweep);
   /// Removes `slots` through the tissue, accounting them; `chip` adds them to the chips' volume.
   void remove(std::vector<std::uint32_t>& slots, bool chip, ResectionStep& out);
   /// Removes tetrahedra hanging by an edge or a vertex around the nodes of `removed` until none is.
@@ -160,6 +166,7 @@ class Resection {
   // short walk outward instead of a flood.
   std::vector<double> anchor_distance_;  // per node (capacity)
   std::vector<std::pair<double, std::uint32_t>> frontier_;  // best-first heap: (distance, slot)
+  std::vector<std::pair<double, std::uint32_t>> by_distance_;  // refine_near's cap: (distance to the start, slot)
   // Stroke state.
   bool in_stroke_ = false, stroke_cut_ = false, stroke_perforated_ = false, stroke_distal_ = false;
   // Scratch, reserved for the capacities.

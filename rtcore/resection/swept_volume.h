@@ -31,6 +31,8 @@ class SweptVolume {
   /// by `reach` (no closest-point work; for filtering many points before the exact test).
   bool may_be_within(const Vec3& p, double reach) const;
   double radius() const { return radius_m_; }
+  /// The wire's samples where the path starts (the last collision tick's).
+  std::span<const Vec3> start() const { return from_; }
   /// The volume's bounding box (the path's, grown by the radius).
   const Aabb& bounds() const { return bounds_; }
   /// Exact volume of a straight stroke: a segment of length `span_m` moving `travel_m` across

@@ -11,12 +11,15 @@
 
 namespace {
 
-std::atomic<int> g_open_probes{0};
+std::atomic<int> g_open_probes{0};  // probes counting every thread
+thread_local int t_open_probes = 0;  // probes counting only the thread they were opened on
 std::atomic<long> g_allocations{0};
 std::atomic<long> g_locks{0};
 
+bool counting() { return g_open_probes.load(std::memory_order_relaxed) > 0 || t_open_probes > 0; }
+
 void* counted_allocation(std::size_t size) {
-  if (g_open_probes.load(std::memory_order_relaxed) > 0) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (counting()) g_allocations.fetch_add(1, std::memory_order_relaxed);
   if (void* p = std::malloc(size ? size : 1)) return p;
   throw std::bad_alloc();
 }
@@ -46,18 +49,28 @@ void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); 
 extern "C" int pthread_mutex_lock(pthread_mutex_t* mutex) {
   using Lock = int (*)(pthread_mutex_t*);
   static const Lock real = reinterpret_cast<Lock>(dlsym(RTLD_NEXT, "pthread_mutex_lock"));
-  if (g_open_probes.load(std::memory_order_relaxed) > 0) g_locks.fetch_add(1, std::memory_order_relaxed);
+  if (counting()) g_locks.fetch_add(1, std::memory_order_relaxed);
   return real(mutex);
 }
 
 namespace resecto::testing {
 
-RealtimeProbe::RealtimeProbe() {
+RealtimeProbe::RealtimeProbe(Threads threads) : this_thread_only_(threads == Threads::kThisOne) {
   g_allocations.store(0);
   g_locks.store(0);
-  g_open_probes.fetch_add(1);
+  if (this_thread_only_) {
+    ++t_open_probes;
+  } else {
+    g_open_probes.fetch_add(1);
+  }
 }
-RealtimeProbe::~RealtimeProbe() { g_open_probes.fetch_sub(1); }
+RealtimeProbe::~RealtimeProbe() {
+  if (this_thread_only_) {
+    --t_open_probes;
+  } else {
+    g_open_probes.fetch_sub(1);
+  }
+}
 long RealtimeProbe::allocations() const { return g_allocations.load(); }
 long RealtimeProbe::locks() const { return g_locks.load(); }
 

@@ -7,13 +7,19 @@ namespace resecto::testing {
 
 class RealtimeProbe {
  public:
-  RealtimeProbe();   ///< starts counting
+  /// Whose allocations and locks count: every thread's, or only the opening thread's (the core's,
+  /// while the collision thread works alongside and may allocate).
+  enum class Threads { kAll, kThisOne };
+  explicit RealtimeProbe(Threads threads = Threads::kAll);  ///< starts counting
   ~RealtimeProbe();  ///< stops counting
   RealtimeProbe(const RealtimeProbe&) = delete;
   RealtimeProbe& operator=(const RealtimeProbe&) = delete;
 
   long allocations() const;
   long locks() const;
+
+ private:
+  bool this_thread_only_;
 };
 
 }  // namespace resecto::testing

@@ -295,6 +295,45 @@ TEST(Resection, PhysicsTicksWhileCuttingAllocateNothingAndNoTickLocks) {
   EXPECT_EQ(topology_locks, 0);
 }
 
+TEST(Resection, WithTheCollisionThreadNoCoreTickAllocatesOrLocksWhileCutting) {
+  // The real-time arrangement: resection's edits, the refit and the search run on the collision
+  // thread (which may allocate, e.g. a sphere-tree rebuild); every tick of the core's own thread,
+  // collision ticks included (the wait, the edited copy adopting the motion, the publish, the next
+  // launch), allocates nothing and takes no lock.
+  SimulationConfig config;
+  config.prostate_triangles = 1296;
+  config.collision_thread = true;
+  auto created = Simulation::create(config);
+  ASSERT_TRUE(created) << created.error();
+  auto sim = std::move(*created);
+  const Procedure p = left_lobe_stroke(true, "1.0", true);
+  const double tick_s = sim->config().tick_s();
+  const auto ticks = static_cast<std::uint64_t>(std::llround(p.duration_s() / tick_s));
+  const std::uint64_t warm_up = static_cast<std::uint64_t>(1.85 / tick_s);
+  long allocations = 0, locks = 0;
+  std::int64_t adoptions = 0;
+  for (std::uint64_t tick = 0; tick < ticks; ++tick) {
+    const TickInput input = procedure_input(p, tick, tick_s);
+    if (tick < warm_up) {
+      sim->step(input, {});
+      continue;
+    }
+    const std::uint64_t version = sim->tissue().topology_version();
+    {
+      testing::RealtimeProbe probe(testing::RealtimeProbe::Threads::kThisOne);
+      sim->step(input, {});
+      allocations += probe.allocations();
+      locks += probe.locks();
+    }
+    adoptions += sim->tissue().topology_version() != version;
+  }
+  std::printf("core ticks while cutting with the collision thread: %ld allocations, %ld locks; %lld edited copies adopted\n", allocations, locks,
+              static_cast<long long>(adoptions));
+  EXPECT_GT(adoptions, 10);
+  EXPECT_EQ(allocations, 0);
+  EXPECT_EQ(locks, 0);
+}
+
 TEST(Resection, FuzzRandomStrokesKeepMassSurfaceAndNumbers) {
   // RESECTO_FUZZ_STROKES=10000 runs the full count (about an hour under ASan+UBSan).
   const char* env = std::getenv("RESECTO_FUZZ_STROKES");
