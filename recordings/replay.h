@@ -23,6 +23,9 @@ class Replayer {
   std::uint64_t run_to(std::uint64_t tick);
   /// As run_to, checking each collision step's hash against the recording.
   const Simulation& simulation() const { return *sim_; }
+  /// Takes in the collision step still in flight (Simulation::settle), as the recorded run did when it
+  /// ended: call once the replay has reached the end, before reading the tissue it left.
+  void settle() { sim_->settle(); }
 
   std::uint64_t verified_hashes() const { return verified_; }
   std::uint64_t mismatches() const { return mismatches_; }

@@ -139,6 +139,7 @@ Result<RecordingScore> score_recording(const std::filesystem::path& path, const 
                  " (recorded hash " + std::to_string(replayer.first_mismatch_recorded()) + "); recorded by a different build?"};
   }
   if (progress) progress(end, end);
+  replayer.settle();
   RecordingScore out;
   out.file = name;
   out.procedure = recording->header().procedure;
