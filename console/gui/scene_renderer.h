@@ -4,6 +4,7 @@
 // round image) and from outside (the gland translucent, the tool inside, landmark markers).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -21,6 +22,13 @@ enum class SurfaceLook : std::uint8_t {
   kCapsuleOut,  ///< the gland's outer surface
   kAdenoma,     ///< cut hyperplastic tissue
   kCapsuleCut,  ///< cut capsule: resected too deep
+};
+
+/// A surface face's nodes in ascending order, and the look it was given.
+using FaceKey = std::array<std::uint32_t, 3>;
+struct FaceLook {
+  FaceKey key;
+  SurfaceLook look;
 };
 
 /// Where a marker or label lands in an image: pixels from the top left, and whether it is in front.
@@ -65,9 +73,11 @@ class SceneRenderer {
   std::uint64_t topology_version_ = UINT64_MAX;
   std::uint32_t triangle_count_ = 0;
   std::uint64_t topology_uploads_ = 0;
-  std::vector<std::uint8_t> initial_surface_node_;  ///< nodes on the surface before any cut
+  std::vector<FaceLook> face_looks_;  ///< the surface's faces by key, with their looks
+  std::vector<SurfaceLook> looks_;    ///< per face of the last snapshot
   std::vector<Vec3> rest_;  ///< node positions in the first snapshot, where surface detail is painted
   std::vector<glm::vec3> node_color_;
+  std::vector<float> node_lining_;  ///< 1 where all the node's faces are original surface, 0 where all are cut
   std::vector<glm::vec3> node_normal_;
   std::vector<MeshVertex> vertices_;
   std::vector<std::uint32_t> indices_;

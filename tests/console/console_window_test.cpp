@@ -4,12 +4,14 @@
 // its next tick, the first frame after shows it, and the state hashes differ from that tick on
 // (against the headless run of the same procedure); slow frames never hold the core back; a session
 // recorded in the console replays in it, showing the recorded tool pose at a scrubbed time, and
-// verifies hash for hash. Each test
+// verifies hash for hash; once the loop has cut, the endoscope shows the cut adenoma and capsule in
+// colours of their own, which the same motion with the pedal up never shows. Each test
 // skips, saying why, where no X server can be started.
 #include <gtest/gtest.h>
 #include <stb_image.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
@@ -26,6 +28,7 @@ namespace {
 
 using testing::CommandOutput;
 using testing::read_text;
+using testing::run_resecto;
 using testing::scratch_directory;
 
 bool x_server_available() {
@@ -205,6 +208,90 @@ TEST(ConsoleWindow, StiffnessActionAppliesAtTheNextTickAndTheFirstFrameAfterShow
     }
   }
   EXPECT_GT(after, 0u);
+}
+
+/// A stroke tilted through the lateral lobe into the capsule (the careless trainee's perforation of
+/// score_test, started inside the gland), then the loop in and the sheath drawn back, tilted toward
+/// the trough, to look at it. With `cut` false the same motion with the pedal up.
+std::filesystem::path write_deep_stroke_procedure(const std::filesystem::path& dir, bool cut) {
+  const auto path = dir / (cut ? "deep_stroke.txt" : "deep_stroke_pedal_up.txt");
+  const char* pedal = cut ? "1" : "0";
+  std::ofstream(path) << "# time_s yaw pitch roll insertion loop cut coagulate\n"
+                         "0.0  0 0   0 168  0 0 0\n"
+                         "0.5  0 0 -90 168  0 0 0\n"
+                         "1.1 -6 0 -90 168 14 0 0\n"
+                         "1.2 -6 0 -90 168 14 " << pedal << " 0\n"
+                         "2.7 -6 0 -90 168  1 " << pedal << " 0\n"
+                         "2.8 -6 0 -90 168  1 0 0\n"
+                         "3.6 -3 0 -90 162  0 0 0\n";
+  return path;
+}
+
+/// The colours the endoscope gives cut tissue (scene_renderer.cpp), told apart by hue whatever the
+/// light's fall-off (which scales all three channels alike) and the lining's mottle and vessels. The
+/// lining's red has green and blue nearly equal (and its wet highlights wash toward white, not
+/// toward yellow); the cut adenoma is a salmon-tan, its green well above its blue; the capsule's
+/// fibres are cream-white, green just below red, where the metal of loop and sheath has green at or
+/// above red.
+struct CutColours {
+  std::size_t pixels = 0, adenoma = 0, capsule = 0;
+  double adenoma_share() const { return static_cast<double>(adenoma) / static_cast<double>(pixels); }
+  double capsule_share() const { return static_cast<double>(capsule) / static_cast<double>(pixels); }
+};
+CutColours count_cut_colours(const Image& image, const Circle& circle) {
+  CutColours c;
+  for_each_in(image, circle, [&](int x, int y) {
+    const std::uint8_t* p = image.at(x, y);
+    ++c.pixels;
+    const double r = p[0], g = p[1], b = p[2];
+    if (r < 70.0) return;  // too dark to tell
+    if (g >= 0.905 * r && g <= 0.975 * r && g - b >= 0.05 * r) {
+      ++c.capsule;
+    } else if (g >= 0.75 * r && g < 0.905 * r && g - b >= 0.08 * r) {
+      ++c.adenoma;
+    }
+  });
+  return c;
+}
+
+TEST(ConsoleWindow, EndoscopeShowsCutAdenomaAndCapsuleInTheirOwnColours) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_cut_colours");
+  // The procedure does cut both tissues: the headless run of it says how much of each.
+  const auto cut_procedure = write_deep_stroke_procedure(dir, true);
+  const CommandOutput headless = run_resecto("run --headless --triangles 1296 --seconds 4 --procedure " + cut_procedure.string() +
+                                             " --report " + (dir / "headless.json").string());
+  ASSERT_EQ(headless.exit_code, 0) << headless.err;
+  const nlohmann::json headless_report = load_json(dir / "headless.json");
+  const nlohmann::json& resected = headless_report.at("metrics").at("resected_g");
+  ASSERT_GT(resected.at("adenoma").get<double>(), 0.2);
+  ASSERT_GT(resected.at("capsule").get<double>(), 0.1) << "the stroke reaches the capsule";
+
+  // The console, the board stepped with the core, each frame at least 100 ms: 60 frames outlast the
+  // procedure's 3.6 s, so the last frame shows the trough from the final pose.
+  auto look = [&](const std::filesystem::path& procedure, const std::string& name) {
+    const auto shot = dir / (name + ".png"), report = dir / (name + ".json");
+    const CommandOutput run = run_in_xvfb("console --lockstep --procedure " + procedure.string() +
+                                              " --triangles 1296 --frames 60 --slow-frame-ms 100 --width 1280 --height 800 --screenshot " +
+                                              shot.string() + " --report " + report.string(),
+                                          dir);
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    const nlohmann::json r = load_json(report);
+    EXPECT_GT(r.at("core").at("ticks").get<double>(), 4.5 * 960.0) << "the core reached the final pose before the last frames";
+    const Image image = load_png(shot);
+    EXPECT_EQ(image.width, 1280);
+    return count_cut_colours(image, endoscope_circle(r));
+  };
+  const CutColours cut = look(cut_procedure, "cut");
+  const CutColours uncut = look(write_deep_stroke_procedure(dir, false), "pedal_up");
+  ASSERT_GT(cut.pixels, 10000u);
+  std::printf("cut: adenoma %.2f%%, capsule %.2f%% of the endoscope's image; pedal up: adenoma %.2f%%, capsule %.2f%%\n",
+              100.0 * cut.adenoma_share(), 100.0 * cut.capsule_share(), 100.0 * uncut.adenoma_share(), 100.0 * uncut.capsule_share());
+  EXPECT_GT(cut.adenoma_share(), 0.05) << "the cut adenoma fills a good part of the image";
+  EXPECT_GT(cut.capsule_share(), 0.01) << "the capsule shows where the stroke went through the adenoma";
+  // The same motion without the cutting current: only lining, loop and sheath, none of either colour.
+  EXPECT_LT(uncut.adenoma_share(), 0.002);
+  EXPECT_LT(uncut.capsule_share(), 0.002);
 }
 
 TEST(ConsoleWindow, SlowFramesNeverHoldTheCoreBack) {
