@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -179,19 +180,31 @@ FaceKey face_key(const Triangle& t) {
 
 bool original_look(SurfaceLook look) { return look == SurfaceLook::kMucosa || look == SurfaceLook::kCapsuleOut; }
 
-/// Whether point `p` lies on triangle (a, b, c): within a twentieth of its longest edge of its plane
-/// and inside it (barycentric coordinates above -2%). A face refinement split is the part of its
-/// parent's plane its children cover; a face a cut exposed lies a tetrahedron's height off the
-/// removed face it was behind.
+/// Whether point `p` lies on triangle (a, b, c): within 2% of its longest edge of its plane and
+/// inside it (barycentric coordinates above -2%).
 bool lies_on(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 ab = b - a, ac = c - a, ap = p - a;
   const Vec3 n = glm::cross(ab, ac);
   const double area2 = glm::length(n);
   const double longest = std::max({glm::length(ab), glm::length(ac), glm::length(c - b)});
-  if (area2 <= 0.0 || std::abs(glm::dot(ap, n)) / area2 > 0.05 * longest) return false;
+  if (area2 <= 0.0 || std::abs(glm::dot(ap, n)) / area2 > 0.02 * longest) return false;
   const double v = glm::dot(glm::cross(ap, ac), n) / (area2 * area2);
   const double w = glm::dot(glm::cross(ab, ap), n) / (area2 * area2);
   return v >= -0.02 && w >= -0.02 && v + w <= 1.02;
+}
+
+/// Whether face `t` is a piece of the face `parent` that refinement split: refinement's 1:4 split of
+/// a face gives pieces with at most one of its corners and every node on it. A face a cut exposed
+/// behind a removed surface face shares an edge (two nodes) with it, and its third node lies a
+/// tetrahedron's height off its plane; the shared-node rule keeps even a flat tetrahedron's inner face
+/// from passing as a piece of its outer one.
+bool piece_of(const Triangle& t, const FaceKey& parent, std::span<const Vec3> positions) {
+  int shared = 0;
+  for (int c = 0; c < 3; ++c) shared += (t[c] == parent[0] || t[c] == parent[1] || t[c] == parent[2]) ? 1 : 0;
+  if (shared > 1) return false;
+  for (int c = 0; c < 3; ++c)
+    if (!lies_on(positions[t[c]], positions[parent[0]], positions[parent[1]], positions[parent[2]])) return false;
+  return true;
 }
 
 }  // namespace
@@ -234,9 +247,10 @@ void SceneRenderer::classify_faces(const SimulationSnapshot& s) {
   }
   // Each face keeps the look it had while it stays on the surface. The first surface seen is the
   // uncut gland: the lining near the axis, the capsule's outside elsewhere. A face that appears later
-  // is a piece of a face that disappeared when refinement split it (it lies on it: it keeps that
-  // face's look), or a face the loop exposed: cut tissue, adenoma or capsule by the region of the
-  // tetrahedron behind it.
+  // is a piece of a face that disappeared when refinement split it (it keeps that face's look), or
+  // a face the loop exposed: cut tissue, adenoma or capsule by the region of the tetrahedron behind
+  // it. (Which faces count as pieces can differ by a few between sessions: the test is geometric,
+  // on whichever snapshots this console happened to draw.)
   const double lining_radius = 1.6 * shape_.channel_radius_m;
   std::vector<std::uint8_t> kept(face_looks_.size(), 0);
   std::vector<std::uint32_t> appeared;
@@ -264,12 +278,10 @@ void SceneRenderer::classify_faces(const SimulationSnapshot& s) {
     if (!kept[i] && face_looks_[i].key[2] < nodes) gone.push_back(i);
   for (std::uint32_t f : appeared) {
     const Triangle& t = s.surface_triangles[f];
-    const Vec3 centroid = (s.node_positions[t[0]] + s.node_positions[t[1]] + s.node_positions[t[2]]) / 3.0;
     const bool capsule = f < s.surface_regions.size() && s.surface_regions[f] == TissueRegion::kCapsule;
     looks_[f] = capsule ? SurfaceLook::kCapsuleCut : SurfaceLook::kAdenoma;
     for (std::size_t i : gone) {
-      const FaceKey& k = face_looks_[i].key;
-      if (lies_on(centroid, s.node_positions[k[0]], s.node_positions[k[1]], s.node_positions[k[2]])) {
+      if (piece_of(t, face_looks_[i].key, std::span<const Vec3>(s.node_positions.data(), nodes))) {
         looks_[f] = face_looks_[i].look;
         break;
       }
