@@ -178,6 +178,12 @@ FaceKey face_key(const Triangle& t) {
   return k;
 }
 
+/// The entry of `key` in `looks` (sorted by key), or null.
+const FaceLook* find_face(const std::vector<FaceLook>& looks, const FaceKey& key) {
+  const auto it = std::lower_bound(looks.begin(), looks.end(), key, [](const FaceLook& l, const FaceKey& k) { return l.key < k; });
+  return it != looks.end() && it->key == key ? &*it : nullptr;
+}
+
 bool original_look(SurfaceLook look) { return look == SurfaceLook::kMucosa || look == SurfaceLook::kCapsuleOut; }
 
 /// Whether point `p` lies on triangle (a, b, c): within 2% of its longest edge of its plane and
@@ -246,7 +252,8 @@ void SceneRenderer::classify_faces(const SimulationSnapshot& s) {
                  s.node_positions.begin() + static_cast<std::ptrdiff_t>(nodes));
   }
   // Each face keeps the look it had while it stays on the surface. The first surface seen is the
-  // uncut gland: the lining near the axis, the capsule's outside elsewhere. A face that appears later
+  // uncut gland: the lining near the axis, the capsule's outside elsewhere; a face of it that comes
+  // back (a replay scrubbed back before the cut) takes its first look again. A face that appears later
   // is a piece of a face that disappeared when refinement split it (it keeps that face's look), or
   // a face the loop exposed: cut tissue, adenoma or capsule by the region of the tetrahedron behind
   // it. (Which faces count as pieces can differ by a few between sessions: the test is geometric,
@@ -263,10 +270,11 @@ void SceneRenderer::classify_faces(const SimulationSnapshot& s) {
       continue;
     }
     const FaceKey key = face_key(t);
-    const auto it = std::lower_bound(face_looks_.begin(), face_looks_.end(), key, [](const FaceLook& l, const FaceKey& k) { return l.key < k; });
-    if (it != face_looks_.end() && it->key == key) {
-      looks_[f] = it->look;
-      kept[static_cast<std::size_t>(it - face_looks_.begin())] = 1;
+    if (const FaceLook* known = find_face(face_looks_, key)) {
+      looks_[f] = known->look;
+      kept[static_cast<std::size_t>(known - face_looks_.data())] = 1;
+    } else if (const FaceLook* original = find_face(initial_looks_, key)) {
+      looks_[f] = original->look;  // back on the surface: a replay scrubbed to before the cut
     } else {
       appeared.push_back(f);
     }
@@ -290,6 +298,7 @@ void SceneRenderer::classify_faces(const SimulationSnapshot& s) {
   face_looks_.resize(s.surface_triangle_count);
   for (std::uint32_t f = 0; f < s.surface_triangle_count; ++f) face_looks_[f] = {face_key(s.surface_triangles[f]), looks_[f]};
   std::sort(face_looks_.begin(), face_looks_.end(), [](const FaceLook& a, const FaceLook& b) { return a.key < b.key; });
+  if (first) initial_looks_ = face_looks_;
 
   std::vector<glm::vec3> sum(nodes, glm::vec3(0.0f));
   std::vector<float> lining(nodes, 0.0f), weight(nodes, 0.0f);
@@ -318,6 +327,11 @@ void SceneRenderer::classify_faces(const SimulationSnapshot& s) {
 
 void SceneRenderer::update(const SimulationSnapshot& s, bool cutting) {
   if (s.topology_version != topology_version_ || s.surface_triangle_count != triangle_count_ || s.node_count > rest_.size()) {
+    // A surface naming a node the snapshot has no position for is not drawn (the last one stays):
+    // every per-node array here is indexed by those ids.
+    for (std::uint32_t f = 0; f < s.surface_triangle_count; ++f)
+      for (std::uint32_t id : s.surface_triangles[f])
+        if (id >= s.node_count) return;
     classify_faces(s);
     topology_version_ = s.topology_version;
     triangle_count_ = s.surface_triangle_count;

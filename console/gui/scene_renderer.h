@@ -73,7 +73,8 @@ class SceneRenderer {
   std::uint64_t topology_version_ = UINT64_MAX;
   std::uint32_t triangle_count_ = 0;
   std::uint64_t topology_uploads_ = 0;
-  std::vector<FaceLook> face_looks_;  ///< the surface's faces by key, with their looks
+  std::vector<FaceLook> face_looks_;     ///< the surface's faces by key, with their looks
+  std::vector<FaceLook> initial_looks_;  ///< the same for the first surface seen (the uncut gland)
   std::vector<SurfaceLook> looks_;    ///< per face of the last snapshot
   std::vector<Vec3> rest_;  ///< node positions in the first snapshot, where surface detail is painted
   std::vector<glm::vec3> node_color_;

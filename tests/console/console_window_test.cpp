@@ -5,7 +5,8 @@
 // (against the headless run of the same procedure); slow frames never hold the core back; a session
 // recorded in the console replays in it, showing the recorded tool pose at a scrubbed time, and
 // verifies hash for hash; once the loop has cut, the endoscope shows the cut adenoma and capsule in
-// colours of their own, which the same motion with the pedal up never shows. Each test
+// colours of their own, which the same motion with the pedal up never shows, and a replay of the cut
+// shows it and, scrubbed back, the uncut lining. Each test
 // skips, saying why, where no X server can be started.
 #include <gtest/gtest.h>
 #include <stb_image.h>
@@ -29,6 +30,7 @@ namespace {
 
 using testing::CommandOutput;
 using testing::read_text;
+using testing::run_resecto;
 using testing::scratch_directory;
 
 bool x_server_available() {
@@ -287,6 +289,34 @@ TEST(ConsoleWindow, EndoscopeShowsCutAdenomaAndCapsuleInTheirOwnColours) {
   // The same motion without the cutting current: only lining, loop and sheath, none of either colour.
   EXPECT_LT(uncut.adenoma_share(), 0.002);
   EXPECT_LT(uncut.capsule_share(), 0.002);
+}
+
+TEST(ConsoleWindow, ReplayOfACutShowsTheCutAndScrubbedBackTheUncutLining) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_replay_cut");
+  // Recorded headless: the stroke refines the mesh (node ids past the recording header's count) and
+  // cuts; the console once wrote those nodes out of bounds.
+  const auto recording = dir / "cut.resecto";
+  const CommandOutput recorded = run_resecto("run --headless --triangles 1296 --seconds 4 --procedure " +
+                                             write_deep_stroke_procedure(dir, true).string() + " --record " + recording.string());
+  ASSERT_EQ(recorded.exit_code, 0) << recorded.err;
+  std::ofstream(dir / "scrub.actions") << "frame 2 replay seek 3.9\n"
+                                       << "frame 6 screenshot " << (dir / "cut.png").string() << "\n"
+                                       << "frame 7 replay seek 0.45\n"
+                                       << "frame 11 screenshot " << (dir / "back.png").string() << "\n"
+                                       << "frame 12 quit\n";
+  const CommandOutput replayed = run_in_xvfb("console --triangles 1296 --width 1280 --height 800 --replay " + recording.string() +
+                                                 " --actions " + (dir / "scrub.actions").string() + " --report " + (dir / "report.json").string(),
+                                             dir);
+  ASSERT_EQ(replayed.exit_code, 0) << replayed.err;
+  const Circle circle = endoscope_circle(load_json(dir / "report.json"));
+  const CutColours cut = count_cut_colours(load_png(dir / "cut.png"), circle);
+  const CutColours back = count_cut_colours(load_png(dir / "back.png"), circle);
+  ASSERT_GT(cut.pixels, 10000u);
+  // Recordings carry no regions: a replay draws every cut face as adenoma.
+  EXPECT_GT(cut.adenoma_share(), 0.05);
+  EXPECT_LT(back.adenoma_share(), 0.002) << "scrubbed back before the cut, the lining is lining again";
+  EXPECT_LT(back.capsule_share(), 0.002);
 }
 
 TEST(ConsoleWindow, SlowFramesNeverHoldTheCoreBack) {
