@@ -279,17 +279,33 @@ void SceneRenderer::classify_faces(const SimulationSnapshot& s) {
       appeared.push_back(f);
     }
   }
-  // The faces that disappeared, tested by brute force: both lists are the few faces one frame's cut
-  // and refinement touched, and this runs only when the topology changed.
-  std::vector<std::size_t> gone;
-  for (std::size_t i = 0; i < face_looks_.size(); ++i)
-    if (!kept[i] && face_looks_[i].key[2] < nodes) gone.push_back(i);
+  // The faces that disappeared, tested by brute force behind a bounding-sphere check: live, both
+  // lists are the few faces one frame's cut and refinement touched (a replay's seek can make them
+  // long for that one frame), and this runs only when the topology changed.
+  const std::span<const Vec3> positions(s.node_positions.data(), nodes);
+  struct Gone {
+    std::size_t look;
+    Vec3 centre;
+    double radius2;
+  };
+  std::vector<Gone> gone;
+  for (std::size_t i = 0; i < face_looks_.size(); ++i) {
+    if (kept[i] || face_looks_[i].key[2] >= nodes) continue;
+    const FaceKey& k = face_looks_[i].key;
+    const Vec3 centre = (positions[k[0]] + positions[k[1]] + positions[k[2]]) / 3.0;
+    double r2 = 0.0;
+    for (std::uint32_t id : k) r2 = std::max(r2, glm::dot(positions[id] - centre, positions[id] - centre));
+    gone.push_back({i, centre, 1.1 * r2});
+  }
   for (std::uint32_t f : appeared) {
     const Triangle& t = s.surface_triangles[f];
     const bool capsule = f < s.surface_regions.size() && s.surface_regions[f] == TissueRegion::kCapsule;
     looks_[f] = capsule ? SurfaceLook::kCapsuleCut : SurfaceLook::kAdenoma;
-    for (std::size_t i : gone) {
-      if (piece_of(t, face_looks_[i].key, std::span<const Vec3>(s.node_positions.data(), nodes))) {
+    for (const Gone& g : gone) {
+      const Vec3 d = positions[t[0]] - g.centre;
+      if (glm::dot(d, d) > g.radius2) continue;
+      const std::size_t i = g.look;
+      if (piece_of(t, face_looks_[i].key, positions)) {
         looks_[f] = face_looks_[i].look;
         break;
       }
