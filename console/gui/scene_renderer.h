@@ -10,26 +10,12 @@
 #include <vector>
 
 #include "console/gui/gl_resources.h"
+#include "console/gui/surface_looks.h"
 #include "console/gui/view_cameras.h"
 #include "rtcore/anatomy/prostate.h"
 #include "rtcore/core/simulation.h"
 
 namespace resecto::gui {
-
-/// What the surface's triangles are, for their colour.
-enum class SurfaceLook : std::uint8_t {
-  kMucosa,      ///< the urethral channel's lining (the original surface near the axis)
-  kCapsuleOut,  ///< the gland's outer surface
-  kAdenoma,     ///< cut hyperplastic tissue
-  kCapsuleCut,  ///< cut capsule: resected too deep
-};
-
-/// A surface face's nodes in ascending order, and the look it was given.
-using FaceKey = std::array<std::uint32_t, 3>;
-struct FaceLook {
-  FaceKey key;
-  SurfaceLook look;
-};
 
 /// Where a marker or label lands in an image: pixels from the top left, and whether it is in front.
 struct ProjectedPoint {
@@ -61,12 +47,6 @@ class SceneRenderer {
   SceneRenderer() = default;
   void draw_tool(bool endoscope) const;
   void classify_faces(const SimulationSnapshot& snapshot);
-  /// Finds, for the new nodes on faces that just appeared, the edge refinement split to make them.
-  void find_parents(const SimulationSnapshot& snapshot, const std::vector<std::uint32_t>& appeared);
-  /// Whether `node` is a corner of `face` or made (within `depth` splits) from nodes on it.
-  bool on_face(std::uint32_t node, const FaceKey& face, int depth) const;
-  /// Whether `t` is a piece refinement split from the face `parent`.
-  bool piece_of(const Triangle& t, const FaceKey& parent) const;
 
   ShaderProgram shader_;
   std::unique_ptr<MeshBuffers> tissue_, sheath_, loop_, marker_;
@@ -79,13 +59,7 @@ class SceneRenderer {
   std::uint64_t topology_version_ = UINT64_MAX;
   std::uint32_t triangle_count_ = 0;
   std::uint64_t topology_uploads_ = 0;
-  std::vector<FaceLook> face_looks_;     ///< the surface's faces by key, with their looks
-  std::vector<FaceLook> initial_looks_;  ///< the same for the first surface seen (the uncut gland)
-  std::vector<SurfaceLook> looks_;       ///< per face of the last snapshot
-  std::size_t initial_nodes_ = 0;        ///< nodes of the first snapshot: later ids are refinement's
-  static constexpr std::array<std::uint32_t, 2> kNoParents{UINT32_MAX, UINT32_MAX};
-  std::vector<std::array<std::uint32_t, 2>> node_parents_;  ///< per node: the edge split to make it
-  std::vector<std::uint8_t> parents_checked_;               ///< per node: parents looked for
+  SurfaceLooks looks_;
   std::vector<Vec3> rest_;  ///< node positions in the first snapshot, where surface detail is painted
   std::vector<glm::vec3> node_color_;
   std::vector<float> node_lining_;  ///< 1 where all the node's faces are original surface, 0 where all are cut
