@@ -3,40 +3,60 @@
 # (its session report): frame time median/p99 and input-to-photon latency at 8640 and 34560 surface
 # triangles under Xvfb (Mesa llvmpipe), each beside the headless real-time run of the same model and
 # the machine's own deadline floor, back to back in one invocation so they share the machine's state.
+# The procedure is the built-in `demo`, which cuts (both lateral lobes): the console's rows say how
+# many grams its session resected, so the figures are those of a session with topology changes.
+# The last lines compare the core's deadline misses with the console open against the headless run
+# and the floor: parity means the console's miss fraction is within the floor's of the headless one.
 # Usage: benchmarks/console_frames.sh [build-dir] [frames]   (prints a table; keep it in results/)
 set -euo pipefail
 build="${1:-build/release}"
 frames="${2:-60}"
 bin="$build/console/resecto"
 floor="$build/benchmarks/deadline_floor_bench"
+for need in "$bin" "$floor"; do
+  [ -x "$need" ] || { echo "console_frames.sh: $need is missing: build the resecto and deadline_floor_bench targets in $build" >&2; exit 2; }
+done
+command -v xvfb-run >/dev/null || { echo "console_frames.sh: xvfb-run is missing (apt-get install xvfb xauth)" >&2; exit 2; }
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
 field() { python3 -c "import json,sys; r=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$1" "$2"; }
 
 echo "console_frames $(date -u +%Y-%m-%dT%H:%MZ) on $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg)"
-printf '%-9s %-26s %8s %8s %8s %8s %9s %9s %8s\n' triangles run frames frame_med frame_p99 i2p_med ticks misses miss%
+printf '%-9s %-26s %8s %8s %8s %8s %9s %9s %8s %10s\n' triangles run frames frame_med frame_p99 i2p_med ticks misses miss% resected_g
+row() {  # triangles label report.json: one console row
+  local r="$3"
+  printf '%-9s %-26s %8s %8.1f %8.1f %8.1f %9s %9s %8.3f %10.2f\n' "$1" "$2" "$(field "$r" 'r["frames"]')" \
+    "$(field "$r" 'r["frame_ms"]["median"]')" "$(field "$r" 'r["frame_ms"]["p99"]')" "$(field "$r" 'r["input_to_photon_ms"]["median"]')" \
+    "$(field "$r" 'r["core"]["ticks"]')" "$(field "$r" 'r["core"]["deadline_misses"]')" "$(field "$r" '100*r["core"]["miss_fraction"]')" \
+    "$(field "$r" 'r["metrics"]["resected_g"]["total"]')"
+}
+declare -A console_miss headless_miss
 for tri in 8640 34560; do
   xvfb-run -a -s '-screen 0 1920x1200x24' "$bin" console --device emulator --procedure demo --triangles "$tri" --frames "$frames" \
     --report "$out/console-$tri.json" >/dev/null
   r="$out/console-$tri.json"
-  printf '%-9s %-26s %8s %8.1f %8.1f %8.1f %9s %9s %8.3f\n' "$tri" "console (llvmpipe, $(field "$r" 'r["renderer"]["view_scale"]')x views)" \
-    "$(field "$r" 'r["frames"]')" "$(field "$r" 'r["frame_ms"]["median"]')" "$(field "$r" 'r["frame_ms"]["p99"]')" \
-    "$(field "$r" 'r["input_to_photon_ms"]["median"]')" "$(field "$r" 'r["core"]["ticks"]')" "$(field "$r" 'r["core"]["deadline_misses"]')" \
-    "$(field "$r" '100*r["core"]["miss_fraction"]')"
+  row "$tri" "console (llvmpipe, $(field "$r" 'r["renderer"]["view_scale"]')x views)" "$r"
+  console_miss[$tri]="$(field "$r" '100*r["core"]["miss_fraction"]')"
   seconds="$(field "$r" 'round(r["core"]["ticks"]/960.0, 1)')"
   "$bin" run --headless --realtime --procedure demo --triangles "$tri" --seconds "$seconds" --report "$out/headless-$tri.json" >/dev/null
   h="$out/headless-$tri.json"
-  printf '%-9s %-26s %8s %8s %8s %8s %9s %9s %8.3f\n' "$tri" "headless --realtime" - - - - "$(field "$h" 'r["deadlines"]["ticks"]')" \
-    "$(field "$h" 'r["deadlines"]["misses"]')" "$(field "$h" '100*r["deadlines"]["miss_fraction"]')"
+  printf '%-9s %-26s %8s %8s %8s %8s %9s %9s %8.3f %10.2f\n' "$tri" "headless --realtime" - - - - "$(field "$h" 'r["deadlines"]["ticks"]')" \
+    "$(field "$h" 'r["deadlines"]["misses"]')" "$(field "$h" '100*r["deadlines"]["miss_fraction"]')" "$(field "$h" 'r["metrics"]["resected_g"]["total"]')"
+  headless_miss[$tri]="$(field "$h" '100*r["deadlines"]["miss_fraction"]')"
 done
 # Frame pacing: every frame made 100 ms slower on purpose; the core's misses should not move.
 xvfb-run -a -s '-screen 0 1920x1200x24' "$bin" console --device emulator --procedure demo --triangles 8640 --frames 40 \
   --slow-frame-ms 100 --report "$out/slow.json" >/dev/null
-r="$out/slow.json"
-printf '%-9s %-26s %8s %8.1f %8.1f %8.1f %9s %9s %8.3f\n' 8640 "console, frames +100 ms" "$(field "$r" 'r["frames"]')" \
-  "$(field "$r" 'r["frame_ms"]["median"]')" "$(field "$r" 'r["frame_ms"]["p99"]')" "$(field "$r" 'r["input_to_photon_ms"]["median"]')" \
-  "$(field "$r" 'r["core"]["ticks"]')" "$(field "$r" 'r["core"]["deadline_misses"]')" "$(field "$r" '100*r["core"]["miss_fraction"]')"
-if [ -x "$floor" ]; then
-  echo "the machine's floor (same schedule, each tick 300 us of busy waiting, 10 s):"
-  "$floor" --benchmark_filter='BM_DeadlineFloor/300/' 2>/dev/null | tail -2
-fi
+row 8640 "console, frames +100 ms" "$out/slow.json"
+echo "the machine's floor (same schedule, each tick 300 us of busy waiting, 10 s):"
+"$floor" --benchmark_filter='BM_DeadlineFloor/300/' 2>/dev/null | tail -2 | tee "$out/floor.txt"
+floor_miss="$(awk '$3 == "|" { sub("%", "", $6); print $6; exit }' "$out/floor.txt")"
+echo "parity (the core's miss % with the console open against the headless run's, within the floor's ${floor_miss}%):"
+for tri in 8640 34560; do
+  python3 -c "
+import sys
+c, h, f = map(float, sys.argv[2:5])
+verdict = 'within the floor' if abs(c - h) <= f else ('the console run missed more' if c > h else 'the headless run missed more')
+print(f'  {sys.argv[1]:>6} triangles: console {c:.3f}%, headless {h:.3f}%, difference {c - h:+.3f} points: {verdict}')
+" "$tri" "${console_miss[$tri]}" "${headless_miss[$tri]}" "$floor_miss"
+done

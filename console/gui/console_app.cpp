@@ -396,6 +396,7 @@ ordered_json make_report(CoreSession& session, ConsoleUi& ui, double wall_s, int
                                                  {"budget_us", st.budget_us}, {"over_budget", st.over_budget}};
   }
   r["stages"] = stages;
+  r["metrics"] = metrics_json(sim.metrics());
   ordered_json device = {{"transport", session.device_description()}};
   if (LiveDevice* live = session.live_device()) {
     const LinkCounters c = live->link().published_counters();

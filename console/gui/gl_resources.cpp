@@ -47,6 +47,7 @@ Status ShaderProgram::build(const char* name, const char* vertex_source, const c
   glBindAttribLocation(program_, 1, "in_normal");
   glBindAttribLocation(program_, 2, "in_color");
   glBindAttribLocation(program_, 3, "in_rest");
+  glBindAttribLocation(program_, 4, "in_lining");
   glLinkProgram(program_);
   glDeleteShader(*vertex);
   glDeleteShader(*fragment);
@@ -144,6 +145,8 @@ MeshBuffers::MeshBuffers() {
   glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(MeshVertex, color)));
   glEnableVertexAttribArray(3);
   glVertexAttribPointer(3, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(MeshVertex, rest)));
+  glEnableVertexAttribArray(4);
+  glVertexAttribPointer(4, 1, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(MeshVertex, lining)));
   glBindVertexArray(0);
 }
 

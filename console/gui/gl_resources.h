@@ -70,6 +70,7 @@ struct MeshVertex {
   float normal[3];
   float color[3];
   float rest[3];
+  float lining;  ///< 1 on the original lining and capsule, 0 on cut faces: how much mucosal detail to paint
 };
 
 class MeshBuffers {

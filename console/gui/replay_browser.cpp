@@ -72,13 +72,17 @@ const SimulationSnapshot& ReplayBrowser::snapshot() {
     Result<rec::SurfaceFrame> frame = recording_->decode_keyframe(keyframe);
     if (frame) {
       // Vertices come with their mesh node ids: write them where the live snapshot would have them.
-      for (std::size_t v = 0; v < frame->positions.size(); ++v) {
-        const std::uint32_t id = frame->node_ids[v];
-        if (id < snapshot_.node_positions.size()) snapshot_.node_positions[id] = frame->positions[v];
-      }
+      // Refinement adds nodes past the header's count: grow to the largest id this keyframe uses.
+      // A keyframe without ids (the format allows it) is drawn with its own vertex numbering.
+      const bool ids = frame->node_ids.size() == frame->positions.size();
+      auto node_of = [&](std::size_t v) { return ids ? frame->node_ids[v] : static_cast<std::uint32_t>(v); };
+      std::size_t needed = 0;
+      for (std::size_t v = 0; v < frame->positions.size(); ++v) needed = std::max<std::size_t>(needed, node_of(v) + 1u);
+      if (needed > snapshot_.node_positions.size()) snapshot_.node_positions.resize(needed, Vec3(0.0));
+      for (std::size_t v = 0; v < frame->positions.size(); ++v) snapshot_.node_positions[node_of(v)] = frame->positions[v];
       const std::size_t count = std::min(frame->triangles.size(), snapshot_.surface_triangles.size());
       for (std::size_t t = 0; t < count; ++t) {
-        for (int c = 0; c < 3; ++c) snapshot_.surface_triangles[t][c] = frame->node_ids[frame->triangles[t][c]];
+        for (int c = 0; c < 3; ++c) snapshot_.surface_triangles[t][c] = node_of(frame->triangles[t][c]);
       }
       snapshot_.node_count = static_cast<std::uint32_t>(snapshot_.node_positions.size());
       snapshot_.surface_triangle_count = static_cast<std::uint32_t>(count);

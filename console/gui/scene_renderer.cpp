@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -16,14 +17,17 @@ in vec3 in_position;
 in vec3 in_normal;
 in vec3 in_color;
 in vec3 in_rest;
+in float in_lining;
 uniform mat4 model;
 uniform mat4 view_projection;
 out vec3 world_position;
 out vec3 world_normal;
 out vec3 base_color;
 out vec3 rest_mm;
+out float lining;
 void main() {
   rest_mm = in_rest * 1000.0;
+  lining = in_lining;
   vec4 world = model * vec4(in_position, 1.0);
   world_position = world.xyz;
   world_normal = mat3(model) * in_normal;
@@ -32,8 +36,10 @@ void main() {
 }
 )";
 
-// Tissue surfaces carry procedural mucosal detail painted at their rest position (so it moves with
-// the tissue): a mottled colour and a net of fine vessels, as the lining looks through the lens.
+// Tissue surfaces carry procedural detail painted at their rest position (so it moves with the
+// tissue): the lining a mottled colour and a net of fine vessels, as it looks through the lens; cut
+// faces no vessels but a granular speckle, and the capsule (the whitest base colour) fine fibres that
+// run around the urethra (across its axis, world z), the cue that the loop has gone too deep.
 // A point light at `light_position` (the endoscope's tip, or the outside view's eye) with an
 // inverse-square fall-off beyond `falloff_m`, a wet specular highlight, and for the endoscope a
 // round image with a soft black edge, as a rod-lens telescope shows it.
@@ -42,6 +48,7 @@ in vec3 world_position;
 in vec3 world_normal;
 in vec3 base_color;
 in vec3 rest_mm;
+in float lining;
 uniform int mucosa_detail;
 uniform sampler3D noise_volume;
 uniform vec3 eye;
@@ -63,13 +70,19 @@ vec3 mucosa(vec3 color, vec3 p) {
   float fine = 1.0 - smoothstep(0.0, 0.03, abs(value_noise(p * 2.7 + 17.0) - 0.5));
   return mix(color, vec3(0.50, 0.06, 0.07), 0.65 * vessel + 0.35 * fine);
 }
+vec3 cut_surface(vec3 color, vec3 p) {
+  color *= 0.86 + 0.28 * value_noise(p * 3.1);
+  float capsule = smoothstep(0.70, 0.80, color.b / max(color.r, 1e-3));
+  float fibre = value_noise(vec3(p.x * 0.35, p.y * 0.35, p.z * 4.5));
+  return color * (1.0 - capsule * 0.22 * smoothstep(0.45, 0.7, fibre));
+}
 void main() {
   if (round_image == 1) {
     float r = length(gl_FragCoord.xy - 0.5 * viewport) / (0.5 * min(viewport.x, viewport.y));
     if (r > 1.0) discard;
   }
   vec3 color = color_override.a > 0.0 ? color_override.rgb : base_color;
-  if (mucosa_detail == 1) color = mucosa(color, rest_mm);
+  if (mucosa_detail == 1) color = mix(cut_surface(color, rest_mm), mucosa(color, rest_mm), lining);
   vec3 n = normalize(world_normal);
   if (!gl_FrontFacing) n = -n;
   vec3 to_light = light_position - world_position;
@@ -92,8 +105,11 @@ glm::vec3 look_color(SurfaceLook look) {
   switch (look) {
     case SurfaceLook::kMucosa: return {0.80f, 0.36f, 0.30f};      // pink-red urethral lining
     case SurfaceLook::kCapsuleOut: return {0.78f, 0.55f, 0.48f};  // the gland from outside
-    case SurfaceLook::kAdenoma: return {0.93f, 0.72f, 0.55f};     // pale, granular adenoma
-    case SurfaceLook::kCapsuleCut: return {0.95f, 0.93f, 0.86f};  // white fibres of the capsule
+    // Cut tissue, told apart by hue as well as by texture: the adenoma a pale salmon-tan (yellower than
+    // the lining, whose green and blue are nearly equal, and pinker than the capsule), the capsule's
+    // fibres cream-white (green a little below red, unlike the loop's and sheath's neutral metal).
+    case SurfaceLook::kAdenoma: return {0.92f, 0.66f, 0.52f};
+    case SurfaceLook::kCapsuleCut: return {0.94f, 0.90f, 0.78f};
   }
   return {1.0f, 0.0f, 1.0f};
 }
@@ -133,7 +149,7 @@ std::unique_ptr<MeshBuffers> upload_mesh(const TriangleMesh& mesh, glm::vec3 col
       const Vec3& p = mesh.positions[t[k]];
       indices.push_back(static_cast<std::uint32_t>(vertices.size()));
       vertices.push_back({{float(p.x), float(p.y), float(p.z)}, {float(n.x), float(n.y), float(n.z)}, {color.r, color.g, color.b},
-                          {float(p.x), float(p.y), float(p.z)}});
+                          {float(p.x), float(p.y), float(p.z)}, 0.0f});
     }
   }
   auto buffers = std::make_unique<MeshBuffers>();
@@ -153,17 +169,6 @@ glm::vec3 landmark_color(const std::string& name) {
   if (name == "verumontanum") return {1.0f, 0.85f, 0.1f};
   if (name == "bladder_neck") return {0.2f, 0.8f, 1.0f};
   return {1.0f, 0.3f, 0.9f};  // external sphincter: the line never to cross
-}
-
-/// The snapshot's tissue region of surface triangle `f` where the snapshot carries regions (after
-/// resection exists); 0 (unknown) otherwise. A template so the check compiles either way.
-template <class Snapshot>
-int surface_region(const Snapshot& snapshot, std::size_t f) {
-  if constexpr (requires { snapshot.surface_regions[f]; }) {
-    return f < snapshot.surface_regions.size() ? static_cast<int>(snapshot.surface_regions[f]) : 0;
-  } else {
-    return 0;
-  }
 }
 
 }  // namespace
@@ -198,51 +203,45 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const ProstateModel
 
 void SceneRenderer::classify_faces(const SimulationSnapshot& s) {
   const std::size_t nodes = s.node_count;
-  const bool first = initial_surface_node_.empty();
-  if (nodes > initial_surface_node_.size()) {
-    // Nodes refinement creates later are never original surface; their detail is painted where they
-    // first appear.
-    const std::size_t known = initial_surface_node_.size();
-    initial_surface_node_.resize(nodes, 0);
-    rest_.insert(rest_.end(), s.node_positions.begin() + static_cast<std::ptrdiff_t>(known),
+  if (nodes > rest_.size()) {
+    // Nodes refinement creates later have their detail painted where they first appear.
+    rest_.insert(rest_.end(), s.node_positions.begin() + static_cast<std::ptrdiff_t>(rest_.size()),
                  s.node_positions.begin() + static_cast<std::ptrdiff_t>(nodes));
   }
-  if (first) {
-    // The first surface seen is the uncut gland: its nodes are the original lining and capsule.
-    for (std::uint32_t f = 0; f < s.surface_triangle_count; ++f)
-      for (int c = 0; c < 3; ++c) initial_surface_node_[s.surface_triangles[f][c]] = 1;
-  }
+  looks_.classify(s, 1.6 * shape_.channel_radius_m);
+  const std::vector<SurfaceLook>& looks = looks_.looks();
   std::vector<glm::vec3> sum(nodes, glm::vec3(0.0f));
-  std::vector<float> weight(nodes, 0.0f);
-  const double lining_radius = 1.6 * shape_.channel_radius_m;
+  std::vector<float> lining(nodes, 0.0f), weight(nodes, 0.0f);
   indices_.resize(3u * s.surface_triangle_count);
-  // Faces in the snapshot's order: the same colours for the same surface every time.
   for (std::uint32_t f = 0; f < s.surface_triangle_count; ++f) {
     const Triangle& t = s.surface_triangles[f];
-    const bool original = initial_surface_node_[t[0]] && initial_surface_node_[t[1]] && initial_surface_node_[t[2]];
-    SurfaceLook look;
-    if (original) {
-      const Vec3 centroid = (s.node_positions[t[0]] + s.node_positions[t[1]] + s.node_positions[t[2]]) / 3.0;
-      look = std::hypot(centroid.x, centroid.y) < lining_radius ? SurfaceLook::kMucosa : SurfaceLook::kCapsuleOut;
-    } else {
-      look = surface_region(s, f) == 1 ? SurfaceLook::kCapsuleCut : SurfaceLook::kAdenoma;  // TissueRegion::kCapsule == 1
-    }
-    const glm::vec3 color = look_color(look);
+    const glm::vec3 color = look_color(looks[f]);
     for (int c = 0; c < 3; ++c) {
       sum[t[c]] += color;
+      lining[t[c]] += original_look(looks[f]) ? 1.0f : 0.0f;
       weight[t[c]] += 1.0f;
       indices_[3u * f + static_cast<unsigned>(c)] = t[c];
     }
   }
   node_color_.assign(nodes, glm::vec3(0.5f));
-  for (std::size_t n = 0; n < nodes; ++n)
-    if (weight[n] > 0.0f) node_color_[n] = sum[n] / weight[n];
+  node_lining_.assign(nodes, 0.0f);
+  for (std::size_t n = 0; n < nodes; ++n) {
+    if (weight[n] > 0.0f) {
+      node_color_[n] = sum[n] / weight[n];
+      node_lining_[n] = lining[n] / weight[n];
+    }
+  }
   tissue_->upload_indices(indices_.data(), indices_.size());
   ++topology_uploads_;
 }
 
 void SceneRenderer::update(const SimulationSnapshot& s, bool cutting) {
   if (s.topology_version != topology_version_ || s.surface_triangle_count != triangle_count_ || s.node_count > rest_.size()) {
+    // A surface naming a node the snapshot has no position for is not drawn (the last one stays):
+    // every per-node array here is indexed by those ids.
+    for (std::uint32_t f = 0; f < s.surface_triangle_count; ++f)
+      for (std::uint32_t id : s.surface_triangles[f])
+        if (id >= s.node_count) return;
     classify_faces(s);
     topology_version_ = s.topology_version;
     triangle_count_ = s.surface_triangle_count;
@@ -263,7 +262,8 @@ void SceneRenderer::update(const SimulationSnapshot& s, bool cutting) {
     const glm::vec3 n = len > 0.0f ? node_normal_[i] / len : glm::vec3(0.0f, 0.0f, 1.0f);
     const glm::vec3 c = i < node_color_.size() ? node_color_[i] : glm::vec3(0.5f);
     const glm::vec3 r = i < rest_.size() ? glm::vec3(rest_[i]) : p;
-    vertices_[i] = {{p.x, p.y, p.z}, {n.x, n.y, n.z}, {c.r, c.g, c.b}, {r.x, r.y, r.z}};
+    const float lined = i < node_lining_.size() ? node_lining_[i] : 0.0f;
+    vertices_[i] = {{p.x, p.y, p.z}, {n.x, n.y, n.z}, {c.r, c.g, c.b}, {r.x, r.y, r.z}, lined};
   }
   tissue_->upload_vertices(vertices_.data(), vertices_.size());
   sheath_model_ = model_matrix(s.tool.sheath);

@@ -4,24 +4,18 @@
 // round image) and from outside (the gland translucent, the tool inside, landmark markers).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
 
 #include "console/gui/gl_resources.h"
+#include "console/gui/surface_looks.h"
 #include "console/gui/view_cameras.h"
 #include "rtcore/anatomy/prostate.h"
 #include "rtcore/core/simulation.h"
 
 namespace resecto::gui {
-
-/// What the surface's triangles are, for their colour.
-enum class SurfaceLook : std::uint8_t {
-  kMucosa,      ///< the urethral channel's lining (the original surface near the axis)
-  kCapsuleOut,  ///< the gland's outer surface
-  kAdenoma,     ///< cut hyperplastic tissue
-  kCapsuleCut,  ///< cut capsule: resected too deep
-};
 
 /// Where a marker or label lands in an image: pixels from the top left, and whether it is in front.
 struct ProjectedPoint {
@@ -65,9 +59,10 @@ class SceneRenderer {
   std::uint64_t topology_version_ = UINT64_MAX;
   std::uint32_t triangle_count_ = 0;
   std::uint64_t topology_uploads_ = 0;
-  std::vector<std::uint8_t> initial_surface_node_;  ///< nodes on the surface before any cut
+  SurfaceLooks looks_;
   std::vector<Vec3> rest_;  ///< node positions in the first snapshot, where surface detail is painted
   std::vector<glm::vec3> node_color_;
+  std::vector<float> node_lining_;  ///< 1 where all the node's faces are original surface, 0 where all are cut
   std::vector<glm::vec3> node_normal_;
   std::vector<MeshVertex> vertices_;
   std::vector<std::uint32_t> indices_;

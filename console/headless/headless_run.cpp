@@ -68,6 +68,8 @@ ordered_json stage_json(const StageStatistics& s) {
           {"budget_us", s.budget_us}, {"samples", s.samples}, {"over_budget", s.over_budget}};
 }
 
+}  // namespace
+
 ordered_json metrics_json(const ProcedureMetrics& m) {
   return {{"contact_time_s", m.contact_time_s},
           {"cut_pedal_time_s", m.cut_pedal_time_s},
@@ -96,8 +98,6 @@ ordered_json metrics_json(const ProcedureMetrics& m) {
           {"refined_tetrahedra", m.refined_tetrahedra},
           {"topology_refusals", m.topology_refusals}};
 }
-
-}  // namespace
 
 std::string hex_hash(std::uint64_t hash) {
   char text[17];

@@ -50,6 +50,9 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options);
 /// A few lines a person reads at the end of a run.
 std::string summarize_report(const nlohmann::ordered_json& report);
 
+/// The procedure's metrics as the reports write them (`metrics` in the headless and console reports).
+nlohmann::ordered_json metrics_json(const ProcedureMetrics& metrics);
+
 /// 16 lower-case hex digits.
 std::string hex_hash(std::uint64_t hash);
 

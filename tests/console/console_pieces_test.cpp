@@ -1,6 +1,7 @@
 // The console's parts that need no window: the action script's parser and its messages, tissue
-// presets (round trip, clear errors), and the endoscope's camera (30 degrees toward the loop, turning
-// with the sheath's roll).
+// presets (round trip, clear errors), the endoscope's camera (30 degrees toward the loop, turning
+// with the sheath's roll), and the surface's looks (lining, cut adenoma, cut capsule) through
+// refinement, a cut and a replay's seek back.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <glm/geometric.hpp>
 
 #include "console/gui/action_script.h"
+#include "console/gui/surface_looks.h"
 #include "console/gui/tissue_presets.h"
 #include "console/gui/view_cameras.h"
 #include "rtcore/kinematics/tool_kinematics.h"
@@ -133,6 +135,57 @@ TEST(OrbitCamera, DragTurnsAndTiltsWithinLimitsAndZoomStaysBounded) {
   EXPECT_GE(orbit.distance_m, 0.03f);
   const CameraView v = orbit.view(1.5f);
   EXPECT_NEAR(glm::length(v.eye - orbit.target), orbit.distance_m, 1e-5f);
+}
+
+/// A snapshot with these node positions, faces and regions (adenoma where none is given).
+SimulationSnapshot surface_snapshot(const std::vector<Vec3>& nodes, const std::vector<Triangle>& faces,
+                                    const std::vector<TissueRegion>& regions = {}) {
+  SimulationSnapshot s;
+  s.node_positions = nodes;
+  s.node_count = static_cast<std::uint32_t>(nodes.size());
+  s.surface_triangles = faces;
+  s.surface_triangle_count = static_cast<std::uint32_t>(faces.size());
+  s.surface_regions = regions.empty() ? std::vector<TissueRegion>(faces.size(), TissueRegion::kAdenoma) : regions;
+  return s;
+}
+
+TEST(SurfaceLooks, RefinedPiecesKeepTheirFacesLookAndCutFacesShowTheirRegion) {
+  constexpr double kLining = 0.01;
+  // A lining face by the axis (0, 1, 2), a capsule face far from it (3, 4, 5), and an inner node (6)
+  // just under the lining face: a flat tetrahedron, whose inner faces lie nearly on the outer one.
+  std::vector<Vec3> nodes = {{-0.002, -0.001, 0.0}, {0.002, -0.001, 0.0}, {0.0, 0.002, 0.0},
+                             {0.03, 0.0, 0.0},      {0.04, 0.0, 0.0},     {0.035, 0.0, 0.008},
+                             {0.0, 0.0, -0.0001}};
+  SurfaceLooks looks;
+  looks.classify(surface_snapshot(nodes, {{0, 1, 2}, {3, 4, 5}}), kLining);
+  EXPECT_EQ(looks.looks(), (std::vector<SurfaceLook>{SurfaceLook::kMucosa, SurfaceLook::kCapsuleOut}));
+
+  // Refinement: the lining face quartered (7, 8, 9 the middles of its edges, pushed 0.4 mm off its
+  // plane, as the loop deforms tissue), the capsule face halved (10 the middle of 3-4).
+  auto middle = [&](int a, int b, double lift) { return 0.5 * (nodes[a] + nodes[b]) + Vec3(0.0, 0.0, lift); };
+  nodes.push_back(middle(0, 1, 0.0004));
+  nodes.push_back(middle(1, 2, -0.0003));
+  nodes.push_back(middle(2, 0, 0.0004));
+  nodes.push_back(middle(3, 4, 0.0));
+  const std::vector<Triangle> refined = {{0, 7, 9}, {7, 1, 8}, {9, 8, 2}, {7, 8, 9}, {3, 10, 5}, {10, 4, 5}};
+  looks.classify(surface_snapshot(nodes, refined), kLining);
+  EXPECT_EQ(looks.looks(), (std::vector<SurfaceLook>{SurfaceLook::kMucosa, SurfaceLook::kMucosa, SurfaceLook::kMucosa,
+                                                     SurfaceLook::kMucosa, SurfaceLook::kCapsuleOut, SurfaceLook::kCapsuleOut}));
+
+  // The cut removes the centre piece's tetrahedron: its three inner faces, all through node 6, show
+  // the region behind them, however close to the removed face they lie.
+  const std::vector<Triangle> cut = {{0, 7, 9}, {7, 1, 8}, {9, 8, 2}, {7, 8, 6}, {8, 9, 6}, {9, 7, 6}, {3, 10, 5}, {10, 4, 5}};
+  const std::vector<TissueRegion> regions = {TissueRegion::kAdenoma, TissueRegion::kAdenoma, TissueRegion::kAdenoma,
+                                             TissueRegion::kCapsule, TissueRegion::kAdenoma, TissueRegion::kAdenoma,
+                                             TissueRegion::kCapsule, TissueRegion::kCapsule};
+  looks.classify(surface_snapshot(nodes, cut, regions), kLining);
+  EXPECT_EQ(looks.looks(), (std::vector<SurfaceLook>{SurfaceLook::kMucosa, SurfaceLook::kMucosa, SurfaceLook::kMucosa,
+                                                     SurfaceLook::kCapsuleCut, SurfaceLook::kAdenoma, SurfaceLook::kAdenoma,
+                                                     SurfaceLook::kCapsuleOut, SurfaceLook::kCapsuleOut}));
+
+  // A replay scrubbed back to before the cut: the uncut faces take their first look again.
+  looks.classify(surface_snapshot(nodes, {{3, 4, 5}, {0, 1, 2}}), kLining);
+  EXPECT_EQ(looks.looks(), (std::vector<SurfaceLook>{SurfaceLook::kCapsuleOut, SurfaceLook::kMucosa}));
 }
 
 }  // namespace

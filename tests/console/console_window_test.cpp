@@ -4,16 +4,20 @@
 // its next tick, the first frame after shows it, and the state hashes differ from that tick on
 // (against the headless run of the same procedure); slow frames never hold the core back; a session
 // recorded in the console replays in it, showing the recorded tool pose at a scrubbed time, and
-// verifies hash for hash. Each test
+// verifies hash for hash; once the loop has cut, the endoscope shows the cut adenoma and capsule in
+// colours of their own, which the same motion with the pedal up never shows, and a replay of the cut
+// shows it and, scrubbed back, the uncut lining. Each test
 // skips, saying why, where no X server can be started.
 #include <gtest/gtest.h>
 #include <stb_image.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
 #include <memory>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -26,6 +30,7 @@ namespace {
 
 using testing::CommandOutput;
 using testing::read_text;
+using testing::run_resecto;
 using testing::scratch_directory;
 
 bool x_server_available() {
@@ -205,6 +210,113 @@ TEST(ConsoleWindow, StiffnessActionAppliesAtTheNextTickAndTheFirstFrameAfterShow
     }
   }
   EXPECT_GT(after, 0u);
+}
+
+/// A stroke tilted through the lateral lobe into the capsule (the careless trainee's perforation of
+/// score_test, started inside the gland), then the loop in and the sheath drawn back, tilted toward
+/// the trough, to look at it. With `cut` false the same motion with the pedal up.
+std::filesystem::path write_deep_stroke_procedure(const std::filesystem::path& dir, bool cut) {
+  const auto path = dir / (cut ? "deep_stroke.txt" : "deep_stroke_pedal_up.txt");
+  const char* pedal = cut ? "1" : "0";
+  std::ofstream(path) << "# time_s yaw pitch roll insertion loop cut coagulate\n"
+                         "0.0  0 0   0 168  0 0 0\n"
+                         "0.5  0 0 -90 168  0 0 0\n"
+                         "1.1 -6 0 -90 168 14 0 0\n"
+                         "1.2 -6 0 -90 168 14 " << pedal << " 0\n"
+                         "2.7 -6 0 -90 168  1 " << pedal << " 0\n"
+                         "2.8 -6 0 -90 168  1 0 0\n"
+                         "3.6 -3 0 -90 162  0 0 0\n";
+  return path;
+}
+
+/// The colours the endoscope gives cut tissue (scene_renderer.cpp), told apart by hue whatever the
+/// light's fall-off (which scales all three channels alike) and the lining's mottle and vessels. The
+/// lining's red has green and blue nearly equal (and its wet highlights wash toward white, not
+/// toward yellow); the cut adenoma is a salmon-tan, its green well above its blue; the capsule's
+/// fibres are cream-white, green just below red, where the metal of loop and sheath has green at or
+/// above red.
+struct CutColours {
+  std::size_t pixels = 0, adenoma = 0, capsule = 0;
+  double adenoma_share() const { return static_cast<double>(adenoma) / static_cast<double>(pixels); }
+  double capsule_share() const { return static_cast<double>(capsule) / static_cast<double>(pixels); }
+};
+CutColours count_cut_colours(const Image& image, const Circle& circle) {
+  CutColours c;
+  for_each_in(image, circle, [&](int x, int y) {
+    const std::uint8_t* p = image.at(x, y);
+    ++c.pixels;
+    const double r = p[0], g = p[1], b = p[2];
+    if (r < 70.0) return;  // too dark to tell
+    if (g >= 0.905 * r && g <= 0.975 * r && g - b >= 0.05 * r) {
+      ++c.capsule;
+    } else if (g >= 0.75 * r && g < 0.905 * r && g - b >= 0.08 * r) {
+      ++c.adenoma;
+    }
+  });
+  return c;
+}
+
+TEST(ConsoleWindow, EndoscopeShowsCutAdenomaAndCapsuleInTheirOwnColours) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_cut_colours");
+  const auto cut_procedure = write_deep_stroke_procedure(dir, true);
+  // The console, the board stepped with the core, each frame at least 100 ms: 60 frames outlast the
+  // procedure's 3.6 s, so the last frame shows the trough from the final pose.
+  auto look = [&](const std::filesystem::path& procedure, const std::string& name) {
+    const auto shot = dir / (name + ".png"), report = dir / (name + ".json");
+    const CommandOutput run = run_in_xvfb("console --lockstep --procedure " + procedure.string() +
+                                              " --triangles 1296 --frames 60 --slow-frame-ms 100 --width 1280 --height 800 --screenshot " +
+                                              shot.string() + " --report " + report.string(),
+                                          dir);
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    const nlohmann::json r = load_json(report);
+    EXPECT_GT(r.at("core").at("ticks").get<double>(), 4.5 * 960.0) << "the core reached the final pose before the last frames";
+    const Image image = load_png(shot);
+    EXPECT_EQ(image.width, 1280);
+    return std::make_pair(count_cut_colours(image, endoscope_circle(r)), r.at("metrics").at("resected_g"));
+  };
+  const auto [cut, cut_resected] = look(cut_procedure, "cut");
+  const auto [uncut, uncut_resected] = look(write_deep_stroke_procedure(dir, false), "pedal_up");
+  // The session's own metrics: the stroke cut both tissues; with the pedal up it cut nothing.
+  ASSERT_GT(cut_resected.at("adenoma").get<double>(), 0.2);
+  ASSERT_GT(cut_resected.at("capsule").get<double>(), 0.1) << "the stroke reaches the capsule";
+  ASSERT_EQ(uncut_resected.at("total").get<double>(), 0.0);
+  ASSERT_GT(cut.pixels, 10000u);
+  std::printf("cut: adenoma %.2f%%, capsule %.2f%% of the endoscope's image; pedal up: adenoma %.2f%%, capsule %.2f%%\n",
+              100.0 * cut.adenoma_share(), 100.0 * cut.capsule_share(), 100.0 * uncut.adenoma_share(), 100.0 * uncut.capsule_share());
+  EXPECT_GT(cut.adenoma_share(), 0.05) << "the cut adenoma fills a good part of the image";
+  EXPECT_GT(cut.capsule_share(), 0.01) << "the capsule shows where the stroke went through the adenoma";
+  // The same motion without the cutting current: only lining, loop and sheath, none of either colour.
+  EXPECT_LT(uncut.adenoma_share(), 0.002);
+  EXPECT_LT(uncut.capsule_share(), 0.002);
+}
+
+TEST(ConsoleWindow, ReplayOfACutShowsTheCutAndScrubbedBackTheUncutLining) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_replay_cut");
+  // Recorded headless: the stroke refines the mesh (node ids past the recording header's count) and
+  // cuts; the console once wrote those nodes out of bounds.
+  const auto recording = dir / "cut.resecto";
+  const CommandOutput recorded = run_resecto("run --headless --triangles 1296 --seconds 4 --procedure " +
+                                             write_deep_stroke_procedure(dir, true).string() + " --record " + recording.string());
+  ASSERT_EQ(recorded.exit_code, 0) << recorded.err;
+  std::ofstream(dir / "scrub.actions") << "frame 2 replay seek 3.9\n"
+                                       << "frame 6 screenshot " << (dir / "cut.png").string() << "\n"
+                                       << "frame 7 replay seek 0.45\n"
+                                       << "frame 11 screenshot " << (dir / "back.png").string() << "\n"
+                                       << "frame 12 quit\n";
+  const CommandOutput replayed = run_in_xvfb("console --triangles 1296 --width 1280 --height 800 --replay " + recording.string() +
+                                                 " --actions " + (dir / "scrub.actions").string() + " --report " + (dir / "report.json").string(),
+                                             dir);
+  ASSERT_EQ(replayed.exit_code, 0) << replayed.err;
+  const Circle circle = endoscope_circle(load_json(dir / "report.json"));
+  const CutColours cut = count_cut_colours(load_png(dir / "cut.png"), circle);
+  const CutColours back = count_cut_colours(load_png(dir / "back.png"), circle);
+  ASSERT_GT(cut.pixels, 10000u);
+  // Recordings carry no regions: a replay draws every cut face as adenoma.
+  EXPECT_GT(cut.adenoma_share(), 0.05);
+  EXPECT_LT(back.adenoma_share(), 0.002) << "scrubbed back before the cut, the lining is lining again";
+  EXPECT_LT(back.capsule_share(), 0.002);
 }
 
 TEST(ConsoleWindow, SlowFramesNeverHoldTheCoreBack) {
