@@ -313,13 +313,13 @@ void Resection::note_refinement(std::span<const std::uint32_t> added_slots) {
   }
 }
 
-void Resection::keep_nearest_the_start(const SweptVolume& sweep) {
+void Resection::keep_nearest_the_start(const SweptVolume& sweep, std::size_t keep_count) {
   Vec3 start(0.0);
   for (const Vec3& p : sweep.start()) start += p;
   start /= static_cast<double>(std::max<std::size_t>(1, sweep.start().size()));
   by_distance_.clear();
   for (std::uint32_t t : marked_) by_distance_.push_back({length_squared(centroid(t) - start), t});
-  const auto keep = static_cast<std::ptrdiff_t>(config_.max_marked_per_step);
+  const auto keep = static_cast<std::ptrdiff_t>(keep_count);
   std::nth_element(by_distance_.begin(), by_distance_.begin() + keep, by_distance_.end());  // ties by slot: pairs compare both
   marked_.clear();
   for (auto it = by_distance_.begin(); it != by_distance_.begin() + keep; ++it) marked_.push_back(it->second);
@@ -342,9 +342,14 @@ int Resection::refine_near(const SweptVolume& sweep) {
       if (sweep.within(centroid(t), sweep.radius() + 0.25 * longest)) marked_.push_back(t);
     }
     if (marked_.empty()) break;
-    if (marked_.size() > config_.max_marked_per_step) keep_nearest_the_start(sweep);
     const TetMeshView view{tissue_->rest_positions(), topo.tetrahedra(), topo.alive_flags(), topo.regions(), &topo};
-    const RefinementEdit& edit = refiner_.plan(view, marked_);
+    if (marked_.size() > config_.max_refined_per_step) keep_nearest_the_start(sweep, config_.max_refined_per_step);
+    const RefinementEdit* plan = &refiner_.plan(view, marked_);
+    while (static_cast<std::size_t>(plan->red_tetrahedra + plan->closure_tetrahedra) > config_.max_refined_per_step && marked_.size() > 1) {
+      keep_nearest_the_start(sweep, marked_.size() / 2);
+      plan = &refiner_.plan(view, marked_);
+    }
+    const RefinementEdit& edit = *plan;
     if (!tissue_->can_edit(edit.new_node_parents.size(), edit.added_tetrahedra.size(), edit.removed_tetrahedra.size())) {
       ++stats_.refusals;
       break;

@@ -35,10 +35,12 @@ struct ResectionConfig {
   double target_edge_per_radius = 2.0;
   /// Refinement rounds per collision step at most (each halves the edges it reaches).
   int max_refinement_rounds = 1;
-  /// Tetrahedra one collision step refines at most (before closures): a fresh stroke into coarse
-  /// tissue marks hundreds at once, milliseconds of edits. Past it, those nearest where the path
-  /// starts go first; the rest lie where the next step's path begins, which marks them again.
-  std::size_t max_marked_per_step = 64;
+  /// Tetrahedra one collision step splits at most, closures included: a fresh stroke into coarse
+  /// tissue marks hundreds at once, and with their closures that is tens of milliseconds of edits
+  /// (about 20 us each, and as much again to replay them on the core's other copy). Past it, the marked
+  /// ones nearest where the path starts are kept (halving until the plan fits); the rest lie where
+  /// the next step's path begins, which marks them again.
+  std::size_t max_refined_per_step = 128;
   /// Regular 1:8 splits a tetrahedron of the model may go through at most (closures' children are
   /// never split again).
   int max_refinement_levels = 2;
@@ -119,8 +121,8 @@ class Resection {
   /// candidates' own reach of the path, into `out` (unsorted).
   void search_near(const SweptVolume& sweep, double extra, std::vector<std::uint32_t>& out);
   int refine_near(const SweptVolume& sweep);
-  /// Cuts marked_ down to ResectionConfig::max_marked_per_step: those nearest where the path starts.
-  void keep_nearest_the_start(const SweptVolume& sweep);
+  /// Cuts marked_ down to its `keep` tetrahedra nearest where the path starts.
+  void keep_nearest_the_start(const SweptVolume& sweep, std::size_t keep);
   /// Removes `slots` through the tissue, accounting them; `chip` adds them to the chips' volume.
   void remove(std::vector<std::uint32_t>& slots, bool chip, ResectionStep& out);
   /// Removes tetrahedra hanging by an edge or a vertex around the nodes of `removed` until none is.

@@ -28,7 +28,7 @@ inline constexpr GoldenRun kGoldenRuns[] = {
     // resecto run --headless --procedure demo --seconds 2 --triangles 1296 --json
     {"--procedure demo --seconds 2 --triangles 1296", "a8f80369fca18e0d", "ee80a6d6bee5fa0a", 0},
     // resecto run --headless --procedure turp --seconds 4 --triangles 1296 --json (two strokes cut)
-    {"--procedure turp --seconds 4 --triangles 1296", "d21f58a89b204843", "fe0bc7dda1842084", 2},
+    {"--procedure turp --seconds 4 --triangles 1296", "f80b288bb6e1019d", "10bd2d22f580e888", 2},
 };
 
 }  // namespace resecto::testing

@@ -32,7 +32,7 @@ double stroke_ratio(double cell_m, bool refine, int steps, std::size_t max_marke
   MassSpringTissue tissue(block);
   ResectionConfig config;
   config.refine = refine;
-  config.max_marked_per_step = max_marked;
+  config.max_refined_per_step = max_marked;
   config.channel_origin = Vec3(-1.0);  // no channel: every boundary face is the outer surface
   Resection resection(tissue, config);
   const double r = 0.001, span = 0.006, travel = 0.008;
@@ -57,7 +57,7 @@ double stroke_ratio(double cell_m, bool refine, int steps, std::size_t max_marke
 
 TEST(SweptVolume, AStraightStrokeRemovesTheAnalyticVolumeAtTwoResolutions) {
   // The rule's accuracy: the whole stroke in one step, refinement uncapped (the default cap of
-  // ResectionConfig::max_marked_per_step is the real-time budget's; it leaves part of so long a
+  // ResectionConfig::max_refined_per_step is the real-time budget's; it leaves part of so long a
   // single step unrefined).
   constexpr std::size_t kUncapped = std::numeric_limits<std::size_t>::max();
   for (double cell : {0.002, 0.001}) {
