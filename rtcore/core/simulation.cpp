@@ -359,6 +359,13 @@ void Simulation::fill_snapshot(SimulationSnapshot& snapshot) const {
   const std::size_t nodes = std::min(snapshot.node_positions.size(), tissue_->node_count());
   tissue_->copy_mesh_positions(std::span<Vec3>(snapshot.node_positions.data(), nodes));
   snapshot.node_count = static_cast<std::uint32_t>(nodes);
+  // The connectivity changes only with topology_version (the two copies of the tissue count their
+  // edits alike): a slot that already holds this version's faces keeps them, which spares a pass over
+  // the surface at most collision ticks.
+  if (snapshot.topology_version == tissue_->topology_version()) {
+    snapshot.metrics = metrics_;
+    return;
+  }
   // The tissue's surface is in its own (locality) numbering and has free slots; the snapshot speaks
   // mesh ids and lists the live faces in slot order, each with its tetrahedron's region.
   const std::vector<Triangle>& faces = tissue_->surface().triangles;
@@ -380,6 +387,7 @@ SimulationSnapshot Simulation::make_snapshot() const {
   snapshot.node_positions.resize(tissue_->node_capacity());
   snapshot.surface_triangles.resize(tissue_->surface_face_capacity());
   snapshot.surface_regions.resize(tissue_->surface_face_capacity());
+  snapshot.topology_version = ~std::uint64_t{0};  // no faces yet: the fill copies them
   fill_snapshot(snapshot);
   return snapshot;
 }
