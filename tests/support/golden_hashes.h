@@ -26,9 +26,9 @@ struct GoldenRun {
 
 inline constexpr GoldenRun kGoldenRuns[] = {
     // resecto run --headless --procedure demo --seconds 2 --triangles 1296 --json
-    {"--procedure demo --seconds 2 --triangles 1296", "a8f80369fca18e0d", "ee80a6d6bee5fa0a", 0},
+    {"--procedure demo --seconds 2 --triangles 1296", "f67287b334913e3f", "428b47b5c6643171", 0},
     // resecto run --headless --procedure turp --seconds 4 --triangles 1296 --json (two strokes cut)
-    {"--procedure turp --seconds 4 --triangles 1296", "f80b288bb6e1019d", "10bd2d22f580e888", 2},
+    {"--procedure turp --seconds 4 --triangles 1296", "4c54591f33e68a43", "f2f89428bc1f003f", 2},
 };
 
 }  // namespace resecto::testing

@@ -1,11 +1,12 @@
-// StateHasher: word-wise FNV-1a checked against the definition written out, and the properties the
-// determinism checks rely on (order, length and every bit count).
+// StateHasher: word-wise FNV-1a (four lanes over 32-byte blocks) checked against the definition
+// written out, and the properties the determinism checks rely on (order, length and every bit count).
 #include "rtcore/base/state_hash.h"
 
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace resecto {
@@ -33,6 +34,41 @@ TEST(StateHasher, IsWordWiseFnv1aWithTheLengthMixedInLast) {
   StateHasher padded_hasher;
   padded_hasher.add(std::span<const std::uint8_t>(padded));
   EXPECT_NE(short_hasher.value(), padded_hasher.value());
+}
+
+TEST(StateHasher, LongSpansRunFourLanesThenTheRestAsOne) {
+  // 5 words: one 32-byte block in four lanes, folded; then the fifth word and the length.
+  const std::array<std::uint64_t, 5> words = {11, 22, 33, 44, 55};
+  StateHasher hasher;
+  hasher.add(std::span<const std::uint64_t>(words));
+  std::uint64_t lanes[4] = {kOffset, kOffset ^ 0x9e3779b97f4a7c15ull, kOffset ^ 0xbf58476d1ce4e5b9ull, kOffset ^ 0x94d049bb133111ebull};
+  for (int k = 0; k < 4; ++k) lanes[k] = (lanes[k] ^ words[static_cast<std::size_t>(k)]) * kPrime;
+  std::uint64_t expected = lanes[0];
+  for (int k = 1; k < 4; ++k) expected = (expected ^ lanes[k]) * kPrime;
+  expected = (expected ^ words[4]) * kPrime;
+  expected = (expected ^ 40u) * kPrime;
+  EXPECT_EQ(hasher.value(), expected);
+}
+
+TEST(StateHasher, LongSpansSeeEveryBitAndWhichLaneAWordIsIn) {
+  std::vector<std::uint64_t> words(64);
+  for (std::size_t i = 0; i < words.size(); ++i) words[i] = 0x9e3779b97f4a7c15ull * (i + 1);
+  StateHasher reference;
+  reference.add(std::span<const std::uint64_t>(words));
+  for (std::size_t i : {std::size_t{0}, std::size_t{1}, std::size_t{2}, std::size_t{3}, std::size_t{37}, std::size_t{63}}) {
+    for (int bit : {0, 31, 63}) {
+      std::vector<std::uint64_t> flipped = words;
+      flipped[i] ^= 1ull << bit;
+      StateHasher h;
+      h.add(std::span<const std::uint64_t>(flipped));
+      EXPECT_NE(h.value(), reference.value()) << "word " << i << " bit " << bit;
+    }
+  }
+  std::vector<std::uint64_t> swapped = words;  // two words of one block, in different lanes
+  std::swap(swapped[4], swapped[5]);
+  StateHasher h;
+  h.add(std::span<const std::uint64_t>(swapped));
+  EXPECT_NE(h.value(), reference.value());
 }
 
 TEST(StateHasher, SeesOrderAndEveryBit) {
