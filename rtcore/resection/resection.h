@@ -100,7 +100,8 @@ class Resection {
 
   /// One collision step of `period_s`. `sweep` is the wire's swept volume when the pedal is down and
   /// the loop out of the sheath (null otherwise); `pedal_down` alone counts idle time; `distal`: the
-  /// loop is distal to the verumontanum. Call between physics steps with no refit or search running.
+  /// loop is distal to the verumontanum. Call while nothing else uses the bound tissue (the core's
+  /// collision job, on the copy the physics is not stepping).
   ResectionStep step(const SweptVolume* sweep, bool pedal_down, bool distal, double period_s);
 
   /// Edits `tissue` from now on: the core's other copy of the tissue, holding the same topology as the

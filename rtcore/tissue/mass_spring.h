@@ -116,8 +116,8 @@ class MassSpringTissue {
   /// hashed once (about half the bytes at 8640 triangles); whatever changes the topology must renew it.
   std::uint64_t state_hash() const;
 
-  // ---- Topology edits (resection). Call between physics steps while no refit or search runs (the
-  // core does so at a collision tick, after publishing the candidates and before the next search).
+  // ---- Topology edits (resection). Call while no physics step, refit or search uses this tissue (the
+  // core's collision job edits the copy the physics is not stepping, before refitting and searching it).
   /// The live tetrahedra, their neighbours and each node's tetrahedra, in the tissue's numbering.
   const TetTopology& topology() const { return topology_; }
   /// Whether an edit adding `nodes` nodes and `added` tetrahedra, removing `removed`, fits the room
