@@ -161,8 +161,9 @@ class Simulation {
   static Result<std::unique_ptr<Simulation>> create(const SimulationConfig& config);
 
   /// Runs tick `tick()`: applies the commands stamped for it, places the tool; on collision ticks
-  /// publishes the previous collision step's candidates and starts this one's refit and search (on
-  /// the collision thread, or here); steps the tissue; on collision ticks hashes. Allocates nothing,
+  /// takes in the previous collision step (its edited copy of the tissue becomes the front, its
+  /// candidates are published) and starts this one's cut, refit and search (on the collision
+  /// thread, or here); steps the tissue; on collision ticks hashes. Allocates nothing,
   /// locks nothing, does no I/O.
   void step(const TickInput& input, std::span<const ParameterCommand> commands, FrameProfiler* profiler = nullptr);
 
