@@ -361,24 +361,22 @@ void Simulation::fill_snapshot(SimulationSnapshot& snapshot) const {
   snapshot.node_count = static_cast<std::uint32_t>(nodes);
   // The connectivity changes only with topology_version (the two copies of the tissue count their
   // edits alike): a slot that already holds this version's faces keeps them, which spares a pass over
-  // the surface at most collision ticks.
-  if (snapshot.topology_version == tissue_->topology_version()) {
-    snapshot.metrics = metrics_;
-    return;
+  // the surface at most collision ticks. The tissue's surface is in its own (locality) numbering and
+  // has free slots; the snapshot speaks mesh ids and lists the live faces in slot order, each with
+  // its tetrahedron's region.
+  if (snapshot.topology_version != tissue_->topology_version()) {
+    const std::vector<Triangle>& faces = tissue_->surface().triangles;
+    std::size_t count = 0;
+    for (std::size_t f = 0; f < faces.size() && count < snapshot.surface_triangles.size(); ++f) {
+      const std::int64_t owner = tissue_->surface_face_owner(f);
+      if (owner < 0) continue;
+      for (int c = 0; c < 3; ++c) snapshot.surface_triangles[count][c] = tissue_->mesh_node(faces[f][c]);
+      if (count < snapshot.surface_regions.size()) snapshot.surface_regions[count] = tissue_->topology().region(static_cast<std::uint32_t>(owner / 4));
+      ++count;
+    }
+    snapshot.surface_triangle_count = static_cast<std::uint32_t>(count);
+    snapshot.topology_version = tissue_->topology_version();
   }
-  // The tissue's surface is in its own (locality) numbering and has free slots; the snapshot speaks
-  // mesh ids and lists the live faces in slot order, each with its tetrahedron's region.
-  const std::vector<Triangle>& faces = tissue_->surface().triangles;
-  std::size_t count = 0;
-  for (std::size_t f = 0; f < faces.size() && count < snapshot.surface_triangles.size(); ++f) {
-    const std::int64_t owner = tissue_->surface_face_owner(f);
-    if (owner < 0) continue;
-    for (int c = 0; c < 3; ++c) snapshot.surface_triangles[count][c] = tissue_->mesh_node(faces[f][c]);
-    if (count < snapshot.surface_regions.size()) snapshot.surface_regions[count] = tissue_->topology().region(static_cast<std::uint32_t>(owner / 4));
-    ++count;
-  }
-  snapshot.surface_triangle_count = static_cast<std::uint32_t>(count);
-  snapshot.topology_version = tissue_->topology_version();
   snapshot.metrics = metrics_;
 }
 

@@ -242,49 +242,58 @@ TEST(Resection, CompactingDeadSpringsChangesNoHashAndLeavesNoneDead) {
   EXPECT_EQ(always_springs, never_springs - never_dead);
 }
 
+/// Runs the left-lobe stroke on the 1296 gland up to just before the pedal goes down, then hands
+/// every later tick to `probed_step`, which steps the simulation itself (under a probe).
+void run_stroke_probing(bool collision_thread, const std::function<void(Simulation&, const TickInput&, std::uint64_t tick)>& probed_step) {
+  SimulationConfig config;
+  config.prostate_triangles = 1296;
+  config.collision_thread = collision_thread;
+  auto created = Simulation::create(config);
+  ASSERT_TRUE(created) << created.error();
+  Simulation& sim = **created;
+  const Procedure p = left_lobe_stroke(true, "1.0", true);
+  const double tick_s = sim.config().tick_s();
+  const auto ticks = static_cast<std::uint64_t>(std::llround(p.duration_s() / tick_s));
+  const std::uint64_t warm_up = static_cast<std::uint64_t>(1.85 / tick_s);  // until just before the pedal goes down
+  for (std::uint64_t tick = 0; tick < ticks; ++tick) {
+    const TickInput input = procedure_input(p, tick, tick_s);
+    if (tick < warm_up) {
+      sim.step(input, {});
+    } else {
+      probed_step(sim, input, tick);
+    }
+  }
+}
+
 TEST(Resection, PhysicsTicksWhileCuttingAllocateNothingAndNoTickLocks) {
   // The physics ticks between collision ticks allocate nothing; no tick takes a lock. The collision
   // ticks' topology updates are counted and printed: a decayed sphere tree's rebuild allocates its
   // build scratch, and a few updates still allocate a little (README "Resection", what is not
   // done). The search runs inside the step (no collision thread), so an allocation, and a
   // sphere-tree rebuild, land in the tick that caused them.
-  SimulationConfig config;
-  config.prostate_triangles = 1296;
-  config.collision_thread = false;
-  auto created = Simulation::create(config);
-  ASSERT_TRUE(created) << created.error();
-  auto sim = std::move(*created);
-  const Procedure p = left_lobe_stroke(true, "1.0", true);
-  const double tick_s = sim->config().tick_s();
-  const auto ticks = static_cast<std::uint64_t>(std::llround(p.duration_s() / tick_s));
   long physics_allocations = 0, physics_locks = 0, topology_allocations = 0, topology_locks = 0;
-  std::int64_t rebuilds = sim->tissue().surface_tree_rebuilds(), rebuild_ticks = 0;
+  std::int64_t rebuilds = -1, rebuild_ticks = 0;
   std::int64_t cut_steps = 0;
-  const std::uint64_t warm_up = static_cast<std::uint64_t>(1.85 / tick_s);  // until just before the pedal goes down
-  for (std::uint64_t tick = 0; tick < ticks; ++tick) {
-    const TickInput input = procedure_input(p, tick, tick_s);
-    if (tick < warm_up) {
-      sim->step(input, {});
-      continue;
-    }
-    const bool collision = sim->is_collision_tick(tick);
+  run_stroke_probing(false, [&](Simulation& sim, const TickInput& input, std::uint64_t tick) {
+    if (rebuilds < 0) rebuilds = sim.tissue().surface_tree_rebuilds();
+    const bool collision = sim.is_collision_tick(tick);
     long allocations = 0, locks = 0;
     {
       testing::RealtimeProbe probe;
-      sim->step(input, {});
+      sim.step(input, {});
       allocations = probe.allocations();
       locks = probe.locks();
     }
     (collision ? topology_allocations : physics_allocations) += allocations;
-    if (collision && sim->tissue().surface_tree_rebuilds() != rebuilds) {
+    if (collision && sim.tissue().surface_tree_rebuilds() != rebuilds) {
       // A rebuild of the decayed sphere tree (its build scratch) is the one allowed allocation.
-      rebuilds = sim->tissue().surface_tree_rebuilds();
+      rebuilds = sim.tissue().surface_tree_rebuilds();
       ++rebuild_ticks;
       topology_allocations -= allocations;
     }
     (collision ? topology_locks : physics_locks) += locks;
-    if (collision && sim->last_resection_step().cut_tetrahedra > 0) ++cut_steps;
-  }
+    if (collision && sim.last_resection_step().cut_tetrahedra > 0) ++cut_steps;
+  });
   std::printf("while cutting (%lld collision steps that cut): physics ticks %ld allocations, %ld locks; collision ticks %ld allocations "
               "(besides %lld with a sphere-tree rebuild), %ld locks\n",
               static_cast<long long>(cut_steps), physics_allocations, physics_locks, topology_allocations, static_cast<long long>(rebuild_ticks),
@@ -300,33 +309,18 @@ TEST(Resection, WithTheCollisionThreadNoCoreTickAllocatesOrLocksWhileCutting) {
   // thread (which may allocate, e.g. a sphere-tree rebuild); every tick of the core's own thread,
   // collision ticks included (the wait, the edited copy adopting the motion, the publish, the next
   // launch), allocates nothing and takes no lock.
-  SimulationConfig config;
-  config.prostate_triangles = 1296;
-  config.collision_thread = true;
-  auto created = Simulation::create(config);
-  ASSERT_TRUE(created) << created.error();
-  auto sim = std::move(*created);
-  const Procedure p = left_lobe_stroke(true, "1.0", true);
-  const double tick_s = sim->config().tick_s();
-  const auto ticks = static_cast<std::uint64_t>(std::llround(p.duration_s() / tick_s));
-  const std::uint64_t warm_up = static_cast<std::uint64_t>(1.85 / tick_s);
   long allocations = 0, locks = 0;
   std::int64_t adoptions = 0;
-  for (std::uint64_t tick = 0; tick < ticks; ++tick) {
-    const TickInput input = procedure_input(p, tick, tick_s);
-    if (tick < warm_up) {
-      sim->step(input, {});
-      continue;
-    }
-    const std::uint64_t version = sim->tissue().topology_version();
+  run_stroke_probing(true, [&](Simulation& sim, const TickInput& input, std::uint64_t) {
+    const std::uint64_t version = sim.tissue().topology_version();
     {
       testing::RealtimeProbe probe(testing::RealtimeProbe::Threads::kThisOne);
-      sim->step(input, {});
+      sim.step(input, {});
       allocations += probe.allocations();
       locks += probe.locks();
     }
-    adoptions += sim->tissue().topology_version() != version;
-  }
+    adoptions += sim.tissue().topology_version() != version;
+  });
   std::printf("core ticks while cutting with the collision thread: %ld allocations, %ld locks; %lld edited copies adopted\n", allocations, locks,
               static_cast<long long>(adoptions));
   EXPECT_GT(adoptions, 10);

@@ -11,6 +11,7 @@
 #include "rtcore/collision/collide.h"
 #include "rtcore/resection/resection.h"
 #include "rtcore/tissue/springs.h"
+#include "tests/support/gland_strokes.h"
 #include "tests/support/tissue_models.h"
 
 namespace resecto {
@@ -80,25 +81,6 @@ void expect_tree_covers_its_leaves(const SphereTree& tree) {
       const Sphere& child = tree.spheres()[static_cast<std::size_t>(c)];
       EXPECT_LE(length(child.center - s.center) + child.radius, s.radius * (1.0 + 1e-9) + 1e-12) << "node " << n;
     }
-  }
-}
-
-/// Cuts a few sweeps through the 1296 gland with the wire at the channel wall.
-void cut_through_gland(Resection& resection, int steps) {
-  const std::vector<Vec3> arc = loop_cutting_arc();
-  SweptVolume sweep(arc.size());
-  std::vector<Vec3> from, to;
-  for (int step = 0; step < steps; ++step) {
-    from.clear();
-    to.clear();
-    // Wire in the plane z = const, hanging to the patient's left, drawn back from 30 to 14 mm.
-    for (const Vec3& p : arc) {
-      const Vec3 q{-p.y + 0.001, p.x, 0.0};
-      from.push_back(q + Vec3(0.0, 0.0, 0.030 - 0.001 * step));
-      to.push_back(q + Vec3(0.0, 0.0, 0.029 - 0.001 * step));
-    }
-    sweep.set(from, to, 0.0012);
-    (void)resection.step(&sweep, true, false, 1.0 / 60.0);
   }
 }
 

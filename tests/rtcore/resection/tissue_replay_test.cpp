@@ -5,28 +5,11 @@
 
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/resection/resection.h"
+#include "tests/support/gland_strokes.h"
 #include "tests/support/tissue_models.h"
 
 namespace resecto {
 namespace {
-
-/// Strokes through the 1296 gland with the wire at the channel wall, drawn back 1 mm a step.
-void cut(Resection& resection, int first_step, int steps) {
-  const std::vector<Vec3> arc = loop_cutting_arc();
-  SweptVolume sweep(arc.size());
-  std::vector<Vec3> from, to;
-  for (int step = first_step; step < first_step + steps; ++step) {
-    from.clear();
-    to.clear();
-    for (const Vec3& p : arc) {
-      const Vec3 q{-p.y + 0.001, p.x, 0.0};
-      from.push_back(q + Vec3(0.0, 0.0, 0.030 - 0.001 * step));
-      to.push_back(q + Vec3(0.0, 0.0, 0.029 - 0.001 * step));
-    }
-    sweep.set(from, to, 0.0012);
-    (void)resection.step(&sweep, true, false, 1.0 / 60.0);
-  }
-}
 
 void expect_same_tissue(const MassSpringTissue& a, const MassSpringTissue& b) {
   ASSERT_EQ(a.node_count(), b.node_count());
@@ -65,7 +48,7 @@ TEST(TissueReplay, ReplayingTheLogOfCutsRefinementsAndACompactionGivesTheSameTis
   Resection resection(edited, config);
   TissueEditLog log;
   edited.set_edit_log(&log);
-  cut(resection, 0, 6);
+  cut_through_gland(resection, 6);
   ASSERT_FALSE(log.empty());
   ASSERT_GT(resection.stats().refined_tetrahedra, 0);
   ASSERT_GT(resection.stats().removed_tetrahedra, 0);
@@ -78,7 +61,7 @@ TEST(TissueReplay, ReplayingTheLogOfCutsRefinementsAndACompactionGivesTheSameTis
   ASSERT_GT(resection.stats().spring_compactions, 0);
   behind.replay(log);
   log.clear();
-  cut(resection, 6, 6);
+  cut_through_gland(resection, 6, 6);
   behind.replay(log);
   edited.set_edit_log(nullptr);
   expect_same_tissue(edited, behind);
@@ -97,7 +80,7 @@ TEST(TissueReplay, TheEditedCopyAdoptsTheFrontsMotionWithNewNodesAtTheirParentsM
   Resection resection(edited);
   TissueEditLog log;
   edited.set_edit_log(&log);
-  cut(resection, 0, 4);
+  cut_through_gland(resection, 4);
   edited.set_edit_log(nullptr);
   ASSERT_FALSE(log.midpoint_parents().empty());
   const std::size_t shared = front.node_count();
