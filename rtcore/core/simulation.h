@@ -177,6 +177,9 @@ class Simulation {
   /// Resection runs in the collision step's job: read it between steps of a run without a collision
   /// thread, or after settle().
   const Resection& resection() const { return *resection_; }
+  /// Sphere-tree rebuilds of both copies of the tissue (each rebuilds its own when edits decay it).
+  /// Like resection(): between steps of a run without a collision thread, or after settle().
+  std::int64_t surface_tree_rebuilds() const { return copies_[0]->surface_tree_rebuilds() + copies_[1]->surface_tree_rebuilds(); }
   /// Resection's totals as of the last collected collision step: they account for exactly the edits
   /// tissue() holds, whichever thread cut (a copy taken at each collection).
   const ResectionStats& resection_stats() const { return resection_stats_; }

@@ -275,7 +275,7 @@ TEST(Resection, PhysicsTicksWhileCuttingAllocateNothingAndNoTickLocks) {
   std::int64_t rebuilds = -1, rebuild_ticks = 0;
   std::int64_t cut_steps = 0;
   run_stroke_probing(false, [&](Simulation& sim, const TickInput& input, std::uint64_t tick) {
-    if (rebuilds < 0) rebuilds = sim.tissue().surface_tree_rebuilds();
+    if (rebuilds < 0) rebuilds = sim.surface_tree_rebuilds();
     const bool collision = sim.is_collision_tick(tick);
     long allocations = 0, locks = 0;
     {
@@ -285,9 +285,9 @@ TEST(Resection, PhysicsTicksWhileCuttingAllocateNothingAndNoTickLocks) {
       locks = probe.locks();
     }
     (collision ? topology_allocations : physics_allocations) += allocations;
-    if (collision && sim.tissue().surface_tree_rebuilds() != rebuilds) {
+    if (collision && sim.surface_tree_rebuilds() != rebuilds) {
       // A rebuild of the decayed sphere tree (its build scratch) is the one allowed allocation.
-      rebuilds = sim.tissue().surface_tree_rebuilds();
+      rebuilds = sim.surface_tree_rebuilds();
       ++rebuild_ticks;
       topology_allocations -= allocations;
     }
