@@ -182,6 +182,7 @@ void Simulation::step(const TickInput& input, std::span<const ParameterCommand> 
       state_hash_ = hasher.value();
     }
   }
+  if (collision_tick) start_collision_job();
   ++tick_;
 }
 
@@ -223,6 +224,14 @@ void Simulation::advance_collision_pipeline(std::uint64_t tick, FrameProfiler* p
   search_timing_.tick = tick;
   search_pending_ = true;
   copies_[static_cast<std::size_t>(1 - front_)]->tool().copy_query_state(tissue_->tool());
+}
+
+// The job reads only what the collision tick fixed before its physics step (the positions taken for
+// the search, the latched poses, the sweep, the other copy), so where it starts changes no result.
+// It starts after the tick's physics and response: the collision tick, which also adopts, publishes
+// and hashes, then runs with the machine to itself, and the job's work falls on the plain ticks
+// after it, which have the room.
+void Simulation::start_collision_job() {
   if (collision_thread_) {
     collision_thread_->launch();
   } else {

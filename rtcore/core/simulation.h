@@ -206,8 +206,11 @@ class Simulation {
   Simulation() = default;
   void place_tool(const TickInput& input);
   void update_metrics(const TickInput& input, bool collision_tick);
-  /// Takes in the running collision step (collect_collision_step) and starts the next.
+  /// Takes in the running collision step (collect_collision_step) and prepares the next, which
+  /// start_collision_job() starts at the end of the tick.
   void advance_collision_pipeline(std::uint64_t tick, FrameProfiler* profiler);
+  /// Launches the prepared job on the collision thread, or runs it here without one.
+  void start_collision_job();
   /// Waits for the collision step's job; if it edited the other copy, that copy adopts the front's
   /// motion and becomes the front; publishes its candidates.
   void collect_collision_step(std::uint64_t tick, FrameProfiler* profiler);

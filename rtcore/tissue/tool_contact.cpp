@@ -4,7 +4,9 @@
 #include "rtcore/tissue/tool_contact.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 
 #include <glm/common.hpp>
 
@@ -138,8 +140,6 @@ ToolContacts::ToolContacts(double margin_m, const ToolContactCapacity& capacity)
 int ToolContacts::add_part(const TriangleMesh& mesh) {
   Part part;
   part.mesh = mesh;
-  part.inflated = mesh;
-  std::vector<Vec3> vertex_normals(mesh.vertex_count(), Vec3(0.0));
   for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
     const Vec3 n2 = triangle_normal_x2(mesh, t);
     const double length = glm::length(n2);
@@ -149,27 +149,41 @@ int ToolContacts::add_part(const TriangleMesh& mesh) {
     double radius = 0.0;
     for (std::uint32_t v : tri) radius = std::max(radius, glm::length(mesh.positions[v] - centroid));
     part.triangle_spheres.push_back({centroid, radius});
-    for (std::uint32_t v : mesh.triangles[t]) vertex_normals[v] += n2;
   }
-  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
-    const double length = glm::length(vertex_normals[v]);
-    if (length > 0.0) part.inflated.positions[v] += margin_m_ * vertex_normals[v] / length;
-  }
-  part.tree.build(part.inflated);
-  part.collider.set_pairs_wanted(false);  // the response reads only the leaf lists
-  // Spheres alone: a tissue triangle lying inside the margin's shell, parallel to it, meets no shell
-  // triangle, and the slabs would drop it; the spheres keep it a candidate.
-  part.collider.set_slabs(false);
+  part.grid.build(mesh, margin_m_);
+  build_vertex_clusters(part);
   parts_.push_back(std::move(part));
-  if (reserved_tree_nodes_ > 0) parts_.back().collider.reserve_tissue_nodes(reserved_tree_nodes_);
-  std::size_t max_triangles = 0;
-  for (const Part& p : parts_) max_triangles = std::max(max_triangles, p.mesh.triangle_count());
-  triangle_stamp_.assign(max_triangles, 0);
-  std::size_t vertices = 0;
-  for (const Part& p : parts_) vertices += p.mesh.vertex_count();
-  tool_vertex_stamp_.assign(vertices, 0);
-  stamp_ = 0;
   return static_cast<int>(parts_.size()) - 1;
+}
+
+void ToolContacts::build_vertex_clusters(Part& part) const {
+  // Vertices binned on a grid of twice the margin: a cluster is a few millimetres across, so its
+  // descent finds barely more tissue than one vertex's would, and a wire's many vertices share one.
+  const double cell = margin_m_;
+  std::vector<std::uint8_t> used(part.mesh.vertex_count(), 0);
+  for (const Triangle& t : part.mesh.triangles) {
+    for (std::uint32_t v : t) used[v] = 1;
+  }
+  std::map<std::array<std::int64_t, 3>, std::vector<std::uint32_t>> bins;  // ordered: the same clusters every run
+  for (std::uint32_t v = 0; v < part.mesh.vertex_count(); ++v) {
+    if (!used[v]) continue;
+    const Vec3 at = glm::floor(part.mesh.positions[v] / cell);
+    bins[{static_cast<std::int64_t>(at.x), static_cast<std::int64_t>(at.y), static_cast<std::int64_t>(at.z)}].push_back(v);
+  }
+  for (const auto& [key, vertices] : bins) {
+    Vec3 low(1e300), high(-1e300);
+    for (std::uint32_t v : vertices) {
+      low = glm::min(low, part.mesh.positions[v]);
+      high = glm::max(high, part.mesh.positions[v]);
+    }
+    VertexCluster cluster;
+    cluster.bound.center = 0.5 * (low + high);
+    for (std::uint32_t v : vertices) cluster.bound.radius = std::max(cluster.bound.radius, glm::length(part.mesh.positions[v] - cluster.bound.center));
+    cluster.first = static_cast<std::uint32_t>(part.cluster_vertices.size());
+    cluster.count = static_cast<std::uint32_t>(vertices.size());
+    part.cluster_vertices.insert(part.cluster_vertices.end(), vertices.begin(), vertices.end());
+    part.clusters.push_back(cluster);
+  }
 }
 
 void ToolContacts::set_pose(int part, const RigidPose& pose) {
@@ -193,8 +207,8 @@ bool ToolContacts::push_pair(std::uint32_t triangle) {
   return true;
 }
 
-void ToolContacts::gather_triangles(const SphereTree& tree, const Vec3& p, double radius, std::vector<std::uint32_t>& seen) {
-  // Depth-first, left child first: the pair order is a function of the tree alone.
+void ToolContacts::gather_triangles(const SphereTree& tree, const Vec3& p, double radius) {
+  near_triangles_.clear();
   if (tree.empty()) return;
   ++stamp_;
   stack_.clear();
@@ -207,9 +221,12 @@ void ToolContacts::gather_triangles(const SphereTree& tree, const Vec3& p, doubl
     if (!sphere_near(spheres[static_cast<std::size_t>(node)], p, radius)) continue;
     if (tree.is_leaf(node)) {
       const std::uint32_t t = tree.pieces()[static_cast<std::size_t>(node)].triangle;
-      if (seen[t] != stamp_) {
-        seen[t] = stamp_;
-        push_pair(t);
+      if (tissue_triangle_stamp_[t] == stamp_) continue;
+      tissue_triangle_stamp_[t] = stamp_;
+      if (near_triangles_.size() < near_triangles_.capacity()) {
+        near_triangles_.push_back(t);
+      } else {
+        search_.stats.overflowed = true;
       }
     } else if (stack_.size() + 2 <= stack_.capacity()) {
       stack_.push_back(links[static_cast<std::size_t>(node)].right);
@@ -303,82 +320,122 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
   // Sized once for this tissue; a tissue whose size changes (resection) grows them at that step.
   if (node_stamp_.size() < surface.vertex_count()) node_stamp_.assign(surface.vertex_count(), 0);
   if (tissue_triangle_stamp_.size() < surface.triangle_count()) tissue_triangle_stamp_.assign(surface.triangle_count(), 0);
+  if (near_triangles_.capacity() < surface.triangle_count()) near_triangles_.reserve(surface.triangle_count());
+  if (stack_.capacity() < 4 * surface.triangle_count()) stack_.reserve(4 * surface.triangle_count());
   if (stamp_ > 0xfff00000u) {  // keep the stamps from wrapping
     std::fill(node_stamp_.begin(), node_stamp_.end(), 0u);
     std::fill(tissue_triangle_stamp_.begin(), tissue_triangle_stamp_.end(), 0u);
-    std::fill(triangle_stamp_.begin(), triangle_stamp_.end(), 0u);
-    std::fill(tool_vertex_stamp_.begin(), tool_vertex_stamp_.end(), 0u);
     stamp_ = 0;
   }
-  CandidateSet& out = search_;
-  out.node_count = out.vertex_count = out.pair_count = 0;
-  out.stats = {};
-  const double search_radius = margin_m_;
-  std::uint32_t vertex_offset = 0;
-  // Parts in index order, leaves in the collider's order, triangles' corners in order: deterministic.
-  for (std::size_t pi = 0; pi < parts_.size(); vertex_offset += static_cast<std::uint32_t>(parts_[pi].mesh.vertex_count()), ++pi) {
-    Part& part = parts_[pi];
-    if (!part.query_enabled) continue;
-    const RigidPose& pose = part.query_pose;
-    if (!part.collider.collide(tissue_tree, surface, part.tree, part.inflated, pose)) out.stats.overflowed = true;
-    out.stats.tissue_leaves += static_cast<std::int32_t>(part.collider.tissue_leaves().size());
-    out.stats.tool_leaves += static_cast<std::int32_t>(part.collider.tool_leaves().size());
-
-    // Tissue nodes of the colliding tissue leaves, each once per part, against nearby tool triangles.
-    const std::uint32_t node_mark = ++stamp_;
-    for (std::int32_t leaf : part.collider.tissue_leaves()) {
-      const Triangle& tri = surface.triangles[tissue_tree.pieces()[static_cast<std::size_t>(leaf)].triangle];
-      for (std::uint32_t n : tri) {
-        if (node_stamp_[n] == node_mark) continue;
-        node_stamp_[n] = node_mark;
-        if (out.node_count >= out.nodes.size()) {
-          out.stats.overflowed = true;
-          continue;
-        }
-        const auto first = static_cast<std::uint32_t>(out.pair_count);
-        const Vec3 p = pose.inverse_apply_point(surface.positions[n]);
-        gather_triangles(part.tree, p, search_radius, triangle_stamp_);
-        keep_within_margin(first, p, part.mesh.positions, part.mesh.triangles);
-        const auto count = static_cast<std::uint32_t>(out.pair_count - first);
-        if (count > 0) {
-          const Closest best = nearest_tool_face(part.mesh, part.face_normals, part.triangle_spheres, p, &out.pair_triangles[first], count);
-          out.node_clearance[out.node_count] = certify(best, p, 0.0);
-          out.nodes[out.node_count++] = {n, static_cast<std::uint16_t>(pi), first, count};
-        }
-      }
-    }
-    // Tool vertices of the colliding tool leaves against nearby tissue triangles.
-    const std::uint32_t vertex_mark = ++stamp_;
-    for (std::int32_t leaf : part.collider.tool_leaves()) {
-      const Triangle& tri = part.mesh.triangles[part.tree.pieces()[static_cast<std::size_t>(leaf)].triangle];
-      for (std::uint32_t v : tri) {
-        if (tool_vertex_stamp_[vertex_offset + v] == vertex_mark) continue;
-        tool_vertex_stamp_[vertex_offset + v] = vertex_mark;
-        if (out.vertex_count >= out.vertices.size()) {
-          out.stats.overflowed = true;
-          continue;
-        }
-        const auto first = static_cast<std::uint32_t>(out.pair_count);
-        const Vec3 w = pose.apply_point(part.mesh.positions[v]);
-        gather_triangles(tissue_tree, w, search_radius, tissue_triangle_stamp_);
-        keep_within_margin(first, w, surface.positions, surface.triangles);
-        const auto count = static_cast<std::uint32_t>(out.pair_count - first);
-        if (count > 0) {
-          const Closest best = nearest_tissue_face(surface.positions.data(), surface.triangles, w, &out.pair_triangles[first], count);
-          out.vertex_clearance[out.vertex_count] = certify(best, w, query_tissue_travel_m_);
-          out.vertices[out.vertex_count++] = {v, static_cast<std::uint16_t>(pi), first, count};
-        }
-      }
-    }
+  search_.node_count = search_.vertex_count = search_.pair_count = 0;
+  search_.stats = {};
+  for (std::size_t pi = 0; pi < parts_.size(); ++pi) {
+    if (!parts_[pi].query_enabled) continue;
+    search_tissue_nodes(static_cast<std::uint16_t>(pi), tissue_tree, surface);
+    search_tool_vertices(static_cast<std::uint16_t>(pi), tissue_tree, surface);
   }
-  // The collider's leaf order follows the trees' shapes, which edits, rebuilds and the copy searched
-  // (Simulation's two copies of the tissue) change; in (part, point) order the forces' sums, and so
-  // the state, do not depend on them.
+  // The points were found in the order of the tissue tree's shape, which edits, rebuilds and the copy
+  // searched (Simulation's two copies of the tissue) change; in (part, point) order the forces'
+  // sums, and so the state, do not depend on them.
+  CandidateSet& out = search_;
   order_points(out.nodes, out.node_clearance, out.node_count);
   order_points(out.vertices, out.vertex_clearance, out.vertex_count);
   out.stats.tissue_nodes = static_cast<std::int32_t>(out.node_count);
   out.stats.tool_vertices = static_cast<std::int32_t>(out.vertex_count);
   out.stats.pair_entries = static_cast<std::int32_t>(out.pair_count);
+}
+
+void ToolContacts::search_tissue_nodes(std::uint16_t part_index, const SphereTree& tissue_tree, const TriangleMesh& surface) {
+  // A node within the margin of the part lies in the part's grid box, so the leaves of its faces
+  // reach that box: one descent of the tissue tree against the box (in the part's frame) finds every
+  // such node, and the grid answers which of the part's faces each may touch.
+  const Part& part = parts_[part_index];
+  CandidateSet& out = search_;
+  if (tissue_tree.empty() || part.grid.cell_count() == 0) return;
+  const RigidPose& pose = part.query_pose;
+  const Vec3& lower = part.grid.lower();
+  const Vec3& upper = part.grid.upper();
+  const auto& spheres = tissue_tree.spheres();
+  const auto& links = tissue_tree.links();
+  const std::uint32_t node_mark = ++stamp_;
+  stack_.clear();
+  stack_.push_back(tissue_tree.root());
+  while (!stack_.empty()) {
+    const std::int32_t tree_node = stack_.back();
+    stack_.pop_back();
+    const Sphere& sphere = spheres[static_cast<std::size_t>(tree_node)];
+    const Vec3 c = pose.inverse_apply_point(sphere.center);
+    const Vec3 gap = glm::max(glm::max(lower - c, c - upper), Vec3(0.0));
+    if (glm::dot(gap, gap) > sphere.radius * sphere.radius) continue;
+    if (!tissue_tree.is_leaf(tree_node)) {
+      if (stack_.size() + 2 > stack_.capacity()) {
+        out.stats.overflowed = true;
+        continue;
+      }
+      stack_.push_back(links[static_cast<std::size_t>(tree_node)].right);
+      stack_.push_back(links[static_cast<std::size_t>(tree_node)].left);
+      continue;
+    }
+    ++out.stats.tissue_leaves;
+    const Triangle& tri = surface.triangles[tissue_tree.pieces()[static_cast<std::size_t>(tree_node)].triangle];
+    for (std::uint32_t n : tri) {
+      if (node_stamp_[n] == node_mark) continue;
+      node_stamp_[n] = node_mark;
+      const Vec3 p = pose.inverse_apply_point(surface.positions[n]);
+      const std::span<const std::uint32_t> near = part.grid.candidates(p);
+      if (near.empty()) continue;
+      if (out.node_count >= out.nodes.size()) {
+        out.stats.overflowed = true;
+        continue;
+      }
+      const auto first = static_cast<std::uint32_t>(out.pair_count);
+      for (std::uint32_t t : near) {
+        if (sphere_near(part.triangle_spheres[t], p, margin_m_)) push_pair(t);
+      }
+      keep_within_margin(first, p, part.mesh.positions, part.mesh.triangles);
+      const auto count = static_cast<std::uint32_t>(out.pair_count - first);
+      if (count == 0) continue;
+      const Closest best = nearest_tool_face(part.mesh, part.face_normals, part.triangle_spheres, p, &out.pair_triangles[first], count);
+      out.node_clearance[out.node_count] = certify(best, p, 0.0);
+      out.nodes[out.node_count++] = {n, part_index, first, count};
+    }
+  }
+}
+
+void ToolContacts::search_tool_vertices(std::uint16_t part_index, const SphereTree& tissue_tree, const TriangleMesh& surface) {
+  // One descent per cluster of the part's vertices finds the tissue faces near any of them; each
+  // vertex then keeps those within the margin of it.
+  const Part& part = parts_[part_index];
+  CandidateSet& out = search_;
+  const RigidPose& pose = part.query_pose;
+  const double margin2 = margin_m_ * margin_m_;
+  const std::vector<Vec3>& x = surface.positions;
+  for (const VertexCluster& cluster : part.clusters) {
+    gather_triangles(tissue_tree, pose.apply_point(cluster.bound.center), cluster.bound.radius + margin_m_);
+    if (near_triangles_.empty()) continue;
+    ++out.stats.tool_clusters;
+    for (std::uint32_t k = cluster.first; k < cluster.first + cluster.count; ++k) {
+      const std::uint32_t v = part.cluster_vertices[k];
+      if (out.vertex_count >= out.vertices.size()) {
+        out.stats.overflowed = true;
+        break;
+      }
+      const auto first = static_cast<std::uint32_t>(out.pair_count);
+      const Vec3 w = pose.apply_point(part.mesh.positions[v]);
+      for (std::uint32_t face : near_triangles_) {
+        const Triangle& t = surface.triangles[face];
+        const Vec3 low = glm::min(x[t[0]], glm::min(x[t[1]], x[t[2]])), high = glm::max(x[t[0]], glm::max(x[t[1]], x[t[2]]));
+        const Vec3 gap = glm::max(glm::max(low - w, w - high), Vec3(0.0));
+        if (glm::dot(gap, gap) <= margin2) push_pair(face);
+      }
+      keep_within_margin(first, w, x, surface.triangles);
+      const auto count = static_cast<std::uint32_t>(out.pair_count - first);
+      if (count == 0) continue;
+      const Closest best = nearest_tissue_face(x.data(), surface.triangles, w, &out.pair_triangles[first], count);
+      out.vertex_clearance[out.vertex_count] = certify(best, w, query_tissue_travel_m_);
+      out.vertices[out.vertex_count++] = {v, part_index, first, count};
+    }
+  }
 }
 
 ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const Vec3> v, const std::vector<Triangle>& surface_triangles,
@@ -483,10 +540,10 @@ void ToolContacts::invalidate_tissue(std::span<const std::uint8_t> changed_face,
 void ToolContacts::reserve_tissue(std::size_t max_nodes, std::size_t max_faces) {
   if (node_stamp_.size() < max_nodes) node_stamp_.assign(max_nodes, 0);
   if (tissue_triangle_stamp_.size() < max_faces) tissue_triangle_stamp_.assign(max_faces, 0);
-  // A tissue tree has about two nodes per leaf and a leaf or two per face.
-  reserved_tree_nodes_ = static_cast<std::int32_t>(4 * max_faces);
-  stack_.reserve(static_cast<std::size_t>(reserved_tree_nodes_));
-  for (Part& part : parts_) part.collider.reserve_tissue_nodes(reserved_tree_nodes_);
+  near_triangles_.reserve(max_faces);
+  // A tissue tree has about two nodes per leaf and a leaf or two per face: a depth-first stack never
+  // holds more than the tree's nodes.
+  stack_.reserve(4 * max_faces);
 }
 
 }  // namespace resecto

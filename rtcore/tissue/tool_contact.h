@@ -1,6 +1,7 @@
 // Penalty contact between the tissue and the kinematic tool parts (sheath, loop): candidate pairs
-// found at the 60 Hz collision step from the sphere trees' colliding leaf lists, penalty forces with
-// damping evaluated on those pairs at every physics substep, and the reaction on the tool.
+// found at the 60 Hz collision step (the tissue's sphere tree queried against each rigid part's
+// proximity grid and vertex clusters), penalty forces with damping evaluated on those pairs at every
+// physics substep, and the reaction on the tool.
 #pragma once
 
 #include <cstdint>
@@ -8,9 +9,10 @@
 #include <utility>
 #include <vector>
 
-#include "rtcore/collision/collide.h"
 #include "rtcore/collision/sphere_tree.h"
+#include "rtcore/geometry/rigid_pose.h"
 #include "rtcore/mesh/triangle_mesh.h"
+#include "rtcore/tissue/tool_proximity_grid.h"
 
 namespace resecto {
 
@@ -30,8 +32,8 @@ struct ToolContactCapacity {
 
 /// What one collision step found, for the profiler and the tests.
 struct ToolContactStats {
-  std::int32_t tissue_leaves = 0;  ///< L1 entries over all parts
-  std::int32_t tool_leaves = 0;    ///< L2 entries over all parts
+  std::int32_t tissue_leaves = 0;  ///< tissue leaves that reached a part's grid, over all parts
+  std::int32_t tool_clusters = 0;  ///< tool vertex clusters that reached the tissue, over all parts
   std::int32_t tissue_nodes = 0;   ///< candidate tissue nodes
   std::int32_t tool_vertices = 0;  ///< candidate tool vertices
   std::int32_t pair_entries = 0;
@@ -39,7 +41,7 @@ struct ToolContactStats {
   bool overflowed = false;
 };
 
-/// The tool side of contact: the rigid parts, their (margin-inflated) sphere trees, their poses.
+/// The tool side of contact: the rigid parts, their proximity grids and vertex clusters, their poses.
 class ToolContacts {
  public:
   /// Proof that a point cannot touch its candidate triangles yet: at `at` (tool frame for a tissue
@@ -83,8 +85,10 @@ class ToolContacts {
   /// Replaces a part's latched pose with where the search should look for it instead (e.g. where the
   /// part is expected to be while the candidates are in use). Same rules as latch_query_poses().
   void set_query_pose(int part, const RigidPose& pose) { parts_[static_cast<std::size_t>(part)].query_pose = pose; }
-  /// Queries each part's tree (at its latched pose) against the tissue surface tree, already refitted
-  /// to `surface`'s positions, into a back buffer. Touches nothing add_forces() or set_pose() use, so
+  /// Finds, for each part at its latched pose, the tissue surface nodes within the margin of it and
+  /// the part's vertices within the margin of the tissue, each with every triangle of the other side
+  /// within the margin, from the tissue surface tree (already refitted to `surface`'s positions), into
+  /// a back buffer. Touches nothing add_forces() or set_pose() use, so
   /// it may run concurrently with them; never with latch_query_poses() or publish_candidates().
   /// Each point it keeps comes with its clearance certificate at the searched positions.
   void search_candidates(const SphereTree& tissue_tree, const TriangleMesh& surface);
@@ -115,6 +119,17 @@ class ToolContacts {
   /// a growing surface does not allocate at a search.
   void reserve_tissue(std::size_t max_nodes, std::size_t max_faces);
   const ToolContactStats& stats() const { return stats_; }
+  /// One published candidate point: a tissue node (against part `part`'s faces) or a tool vertex of
+  /// part `part` (against tissue faces), with its candidate faces nearest first.
+  struct CandidatePoint {
+    std::uint32_t point;
+    int part;
+    std::span<const std::uint32_t> faces;
+  };
+  std::size_t node_candidate_count() const { return node_count_; }
+  CandidatePoint node_candidate(std::size_t i) const { return view(node_candidates_[i]); }
+  std::size_t vertex_candidate_count() const { return vertex_count_; }
+  CandidatePoint vertex_candidate(std::size_t i) const { return view(vertex_candidates_[i]); }
   /// For the tissue's second copy taking over (MassSpringTissue::adopt_motion): the parts' poses and
   /// enabled flags, the last step's statistics and the point counters become `front`'s.
   void adopt_motion(const ToolContacts& front);
@@ -126,13 +141,19 @@ class ToolContacts {
   std::int64_t points_skipped() const { return points_skipped_; }
 
  private:
+  /// Vertices of a part near one another, searched against the tissue together: one tree descent
+  /// for the cluster instead of one per vertex. Vertices [first, first + count) of cluster_vertices.
+  struct VertexCluster {
+    Sphere bound;  // tool frame
+    std::uint32_t first = 0, count = 0;
+  };
   struct Part {
     TriangleMesh mesh;          // tool frame
-    TriangleMesh inflated;      // every vertex pushed out by the margin along its normal
     std::vector<Vec3> face_normals;  // unit, tool frame
     std::vector<Sphere> triangle_spheres;  // per face, tool frame: prunes the closest-point tests
-    SphereTree tree;            // over `inflated`, so the query's contact is the margin's
-    Collider collider;
+    ToolProximityGrid grid;     // the faces within the margin of a point of the tool frame
+    std::vector<VertexCluster> clusters;
+    std::vector<std::uint32_t> cluster_vertices;
     RigidPose pose, previous_pose;
     bool enabled = true;
     RigidPose query_pose;  // latched for the search (the search's thread reads only these)
@@ -155,10 +176,18 @@ class ToolContacts {
     ToolContactStats stats;
     std::vector<std::pair<PointCandidates, Clearance>> sorting;  // scratch of order_points()
   };
+  CandidatePoint view(const PointCandidates& pc) const { return {pc.point, pc.part, {pair_triangles_.data() + pc.first, pc.count}}; }
+  /// Groups a part's vertices into clusters (add_part).
+  void build_vertex_clusters(Part& part) const;
   /// Puts the search's first `count` points in (part, point) order, with their certificates.
   void order_points(std::vector<PointCandidates>& points, std::vector<Clearance>& clearance, std::size_t count);
-  /// Appends the triangles of `tree` with a leaf sphere within `radius` of `point`, each once.
-  void gather_triangles(const SphereTree& tree, const Vec3& point, double radius, std::vector<std::uint32_t>& seen);
+  /// Fills near_triangles_ with the triangles of `tree` whose leaf sphere is within `radius` of
+  /// `point`, each once.
+  void gather_triangles(const SphereTree& tree, const Vec3& point, double radius);
+  /// The tissue nodes of `part` (at `pose`) within the margin, with their candidate faces.
+  void search_tissue_nodes(std::uint16_t part_index, const SphereTree& tissue_tree, const TriangleMesh& surface);
+  /// The part's vertices within the margin of the tissue, with their candidate tissue faces.
+  void search_tool_vertices(std::uint16_t part_index, const SphereTree& tissue_tree, const TriangleMesh& surface);
   bool push_pair(std::uint32_t triangle);
   /// Drops the pairs from `first` on whose triangle is further than the margin from `p`, and orders
   /// the rest nearest first (ties by triangle index), so the closest-face search's exact prune
@@ -181,10 +210,10 @@ class ToolContacts {
   std::int64_t points_evaluated_ = 0, points_skipped_ = 0;
   // The search's side: its result and its scratch (stamps, stack), never read by add_forces().
   CandidateSet search_;
-  std::vector<std::uint32_t> node_stamp_, tool_vertex_stamp_, triangle_stamp_, tissue_triangle_stamp_;
+  std::vector<std::uint32_t> node_stamp_, tissue_triangle_stamp_;
   std::uint32_t stamp_ = 0;
   std::vector<std::int32_t> stack_;
-  std::int32_t reserved_tree_nodes_ = 0;  // reserve_tissue()'s room, for parts added after it
+  std::vector<std::uint32_t> near_triangles_;  // gather_triangles()'s result
   ToolContactStats stats_;
 };
 

@@ -11,6 +11,8 @@
 #include "rtcore/collision/collide.h"
 #include "rtcore/resection/resection.h"
 #include "rtcore/tissue/springs.h"
+#include "rtcore/scenes/indentation.h"
+#include "tests/support/contact_oracle.h"
 #include "tests/support/gland_strokes.h"
 #include "tests/support/tissue_models.h"
 
@@ -94,6 +96,20 @@ TEST(TissueEdits, AfterCutsTheTissueEqualsAFreshBuildAndTheTreeItsSurface) {
   expect_matches_fresh_build(tissue);
   tissue.collision_step();  // refit to the current positions
   expect_tree_covers_its_leaves(tissue.surface_tree());
+}
+
+TEST(TissueEdits, ContactCandidatesAfterCutsEqualBruteForce) {
+  const ProstateTissueModel& model = tissue_model(1296);
+  MassSpringTissue tissue(model.mesh);
+  Resection resection(tissue);
+  cut_through_gland(resection, 12);
+  ASSERT_GT(resection.stats().removed_tetrahedra, 10);
+  const std::vector<TriangleMesh> parts = {model.loop};
+  const int loop = tissue.tool().add_part(model.loop);
+  for (const double depth_mm : {0.0, 3.0}) {
+    tissue.tool().reset_pose(loop, indentation_loop_pose(model.anatomy, model.loop, depth_mm * 1e-3));
+    testing::expect_brute_force(tissue, parts, "after the cuts");
+  }
 }
 
 TEST(TissueEdits, CollisionPairsAfterCutsEqualBruteForce) {
