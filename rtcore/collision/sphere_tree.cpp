@@ -659,4 +659,9 @@ bool SphereTree::should_rebuild() const {
   return q.height > q.height_bound || q.radius_growth > 2.0;
 }
 
+bool SphereTree::must_rebuild() const {
+  const SphereTreeQuality q = quality();
+  return q.height > 2.0 * q.height_bound || q.radius_growth > 4.0;
+}
+
 }  // namespace resecto

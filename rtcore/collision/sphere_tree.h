@@ -135,6 +135,10 @@ class SphereTree {
   /// True when the tree is taller than the policy tolerates (over 2 log2(n) + 4) or its internal
   /// spheres have grown on average to more than twice their size at the last build.
   bool should_rebuild() const;
+  /// True when the tree has decayed twice as far as should_rebuild() tolerates (height over
+  /// 2 (2 log2(n) + 4), or internal spheres four times their built size): a rebuild that a caller
+  /// deferred to a quieter moment cannot wait any longer.
+  bool must_rebuild() const;
 
   std::int32_t root() const { return root_; }
   bool empty() const { return root_ == kNoNode; }

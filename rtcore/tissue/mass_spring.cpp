@@ -157,17 +157,33 @@ void MassSpringTissue::begin_collision_step() {
   tool_.latch_query_poses(travel_m_);
 }
 
-void MassSpringTissue::refit_surface_tree() {
+bool MassSpringTissue::refit_surface_tree(TreeRebuild rebuild) {
   // Edits insert and remove leaves in O(log n) each, which can unbalance the tree over many cuts;
   // judging that (a pass over the tree) and rebuilding belong here, off the core's tick, once per
   // collision step rather than once per edit. The refit after a rebuild makes every node's sphere
   // hold its children's (a build bounds the triangles below, which a child's sphere may exceed).
-  if (surface_tree_edited_ && surface_tree_.should_rebuild()) {
-    surface_tree_.rebuild(surface_);
-    ++surface_tree_rebuilds_;
+  bool rebuilt = false;
+  if (surface_tree_edited_) {
+    const bool due = rebuild == TreeRebuild::kWhenDue ? surface_tree_.should_rebuild() : surface_tree_.must_rebuild();
+    if (due) rebuilt = rebuild_surface_tree();
+    // Judged and found sound; a deferred rebuild keeps the tree marked for a quieter step.
+    if (rebuild == TreeRebuild::kWhenDue) surface_tree_edited_ = false;
   }
-  surface_tree_edited_ = false;
   surface_tree_.refit(surface_);
+  return rebuilt;
+}
+
+bool MassSpringTissue::rebuild_surface_tree_if_due() {
+  if (!surface_tree_edited_) return false;
+  surface_tree_edited_ = false;
+  return surface_tree_.should_rebuild() && rebuild_surface_tree();
+}
+
+bool MassSpringTissue::rebuild_surface_tree() {
+  surface_tree_.rebuild(surface_);
+  ++surface_tree_rebuilds_;
+  surface_tree_edited_ = false;
+  return true;
 }
 
 void MassSpringTissue::search_contact_candidates() { tool_.search_candidates(surface_tree_, surface_); }

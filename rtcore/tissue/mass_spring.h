@@ -100,10 +100,20 @@ class MassSpringTissue {
   /// Takes the node positions and the tool's poses the refit and search will use. Call between
   /// physics steps while no refit or search runs.
   void begin_collision_step();
+  /// When refit_surface_tree() rebuilds a sphere tree that edits have decayed.
+  enum class TreeRebuild {
+    kWhenDue,          ///< as soon as SphereTree::should_rebuild()
+    kOnlyWhenOverdue,  ///< only past SphereTree::must_rebuild(): the step is busy with edits already
+  };
   /// Refits the surface's sphere tree to the positions taken by begin_collision_step(), or rebuilds
-  /// it when edits since the last search have decayed it (SphereTree::should_rebuild). Reads and
-  /// writes nothing a physics step touches.
-  void refit_surface_tree();
+  /// it when edits have decayed it, as `rebuild` says; returns whether it rebuilt. Reads and writes
+  /// nothing a physics step touches. The tree's shape changes no result (the contact search finds
+  /// exact sets, in point order), so when it is rebuilt is only a matter of time spent.
+  bool refit_surface_tree(TreeRebuild rebuild = TreeRebuild::kWhenDue);
+  /// Rebuilds the tree, at the surface's current positions, when edits have decayed it
+  /// (SphereTree::should_rebuild); the next refit brings it to the search's positions. For the copy
+  /// of the tissue the physics is not stepping, in a collision step with time to spare.
+  bool rebuild_surface_tree_if_due();
   /// Finds the tool's candidate pairs against the refitted tree, into the tool's back buffer.
   void search_contact_candidates();
   /// Publishes the search's candidates to the physics steps; call between physics steps once the
@@ -213,6 +223,8 @@ class MassSpringTissue {
   int last_cg_iterations() const { return last_cg_iterations_; }
 
  private:
+  /// Rebuilds the surface's sphere tree over its present faces; counts it.
+  bool rebuild_surface_tree();
   struct OrderedMesh {
     std::vector<std::uint32_t> mesh_node;  // per tissue node, its mesh index
     TetMesh mesh;                          // renumbered
@@ -274,7 +286,7 @@ class MassSpringTissue {
   std::uint64_t topology_hash_ = 0;  // of the live tetrahedra and the surface's faces, kept per edit
   std::uint64_t topology_version_ = 0;
   std::int64_t surface_tree_rebuilds_ = 0;
-  bool surface_tree_edited_ = false;  // an edit since the last search: the search judges the tree
+  bool surface_tree_edited_ = false;  // an edit since the tree was last judged (or a rebuild deferred)
   TetTopology topology_;
   // Surface bookkeeping: per face slot, its owner 4 t + f (-1 free); per tetrahedron face, its slot.
   std::vector<std::int64_t> face_owner_;

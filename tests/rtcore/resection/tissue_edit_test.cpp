@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <map>
 #include <set>
 
@@ -110,6 +111,38 @@ TEST(TissueEdits, ContactCandidatesAfterCutsEqualBruteForce) {
     tissue.tool().reset_pose(loop, indentation_loop_pose(model.anatomy, model.loop, depth_mm * 1e-3));
     testing::expect_brute_force(tissue, parts, "after the cuts");
   }
+}
+
+TEST(TissueEdits, ContactCandidatesDoNotDependOnWhenTheTreeIsRebuilt) {
+  // The collision job defers a decayed tree's rebuild while it edits (TreeRebuild::kOnlyWhenOverdue)
+  // to a quieter step: the search must find the same candidates on the undecayed and decayed tree.
+  const ProstateTissueModel& model = tissue_model(1296);
+  MassSpringTissue prompt(model.mesh), deferred(model.mesh);
+  Resection cut_prompt(prompt), cut_deferred(deferred);
+  const int loop = prompt.tool().add_part(model.loop);
+  (void)deferred.tool().add_part(model.loop);
+  const RigidPose pose = indentation_loop_pose(model.anatomy, model.loop, 0.002);
+  prompt.tool().reset_pose(loop, pose);
+  deferred.tool().reset_pose(loop, pose);
+  for (int step = 0; step < 16; ++step) {
+    cut_through_gland(cut_prompt, 1, step);
+    cut_through_gland(cut_deferred, 1, step);
+    prompt.collision_step();
+    deferred.begin_collision_step();
+    (void)deferred.refit_surface_tree(MassSpringTissue::TreeRebuild::kOnlyWhenOverdue);
+    deferred.search_contact_candidates();
+    deferred.end_collision_step();
+    EXPECT_EQ(testing::published(deferred.tool(), true), testing::published(prompt.tool(), true)) << "step " << step;
+    EXPECT_EQ(testing::published(deferred.tool(), false), testing::published(prompt.tool(), false)) << "step " << step;
+    expect_tree_covers_its_leaves(deferred.surface_tree());
+  }
+  std::printf("rebuilds: prompt %lld, deferred %lld\n", static_cast<long long>(prompt.surface_tree_rebuilds()),
+              static_cast<long long>(deferred.surface_tree_rebuilds()));
+  EXPECT_LE(deferred.surface_tree_rebuilds(), prompt.surface_tree_rebuilds());
+  // The quiet step takes the deferred rebuild if the tree still wants it.
+  const bool wanted = deferred.surface_tree().should_rebuild();
+  EXPECT_EQ(deferred.rebuild_surface_tree_if_due(), wanted);
+  EXPECT_FALSE(deferred.rebuild_surface_tree_if_due()) << "judged once";
 }
 
 TEST(TissueEdits, CollisionPairsAfterCutsEqualBruteForce) {
