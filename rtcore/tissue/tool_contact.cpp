@@ -128,7 +128,7 @@ ToolContacts::ToolContacts(double margin_m, const ToolContactCapacity& capacity)
   search_.nodes.resize(static_cast<std::size_t>(capacity.max_tissue_nodes));
   search_.vertices.resize(static_cast<std::size_t>(capacity.max_tool_vertices));
   search_.pair_triangles.resize(static_cast<std::size_t>(capacity.max_pair_entries));
-  search_.pair_distance2.resize(static_cast<std::size_t>(capacity.max_pair_entries));
+  search_.kept.reserve(static_cast<std::size_t>(capacity.max_pair_entries));
   search_.node_clearance.resize(static_cast<std::size_t>(capacity.max_tissue_nodes));
   search_.vertex_clearance.resize(static_cast<std::size_t>(capacity.max_tool_vertices));
   search_.sorting.resize(static_cast<std::size_t>(std::max(capacity.max_tissue_nodes, capacity.max_tool_vertices)));
@@ -239,26 +239,20 @@ void ToolContacts::gather_triangles(const SphereTree& tree, const Vec3& p, doubl
 
 void ToolContacts::keep_within_margin(std::uint32_t first, const Vec3& p, const std::vector<Vec3>& positions,
                                       const std::vector<Triangle>& triangles) {
-  // The sphere descent over-approximates; the substeps only need triangles really within the margin.
-  // Kept in order by insertion (a point has tens of them): entry e is read before any shift reaches it.
+  // The gathered faces over-approximate; the substeps only need those really within the margin,
+  // nearest first. A tool vertex on the fine gland keeps hundreds, so they are sorted, not inserted.
   std::vector<std::uint32_t>& pairs = search_.pair_triangles;
-  std::vector<double>& distance2 = search_.pair_distance2;
-  std::size_t kept = first;
+  std::vector<std::pair<double, std::uint32_t>>& kept = search_.kept;
+  kept.clear();
   for (std::size_t e = first; e < search_.pair_count; ++e) {
-    const std::uint32_t triangle = pairs[e];
-    const Triangle& t = triangles[triangle];
+    const Triangle& t = triangles[pairs[e]];
     const Vec3 q = closest_point_on_triangle(p, positions[t[0]], positions[t[1]], positions[t[2]]);
     const double d2 = glm::dot(p - q, p - q);
-    if (d2 > margin_m_ * margin_m_) continue;
-    std::size_t slot = kept++;
-    for (; slot > first && (distance2[slot - 1] > d2 || (distance2[slot - 1] == d2 && pairs[slot - 1] > triangle)); --slot) {
-      pairs[slot] = pairs[slot - 1];
-      distance2[slot] = distance2[slot - 1];
-    }
-    pairs[slot] = triangle;
-    distance2[slot] = d2;
+    if (d2 <= margin_m_ * margin_m_) kept.emplace_back(d2, pairs[e]);
   }
-  search_.pair_count = kept;
+  std::sort(kept.begin(), kept.end());  // by distance², ties by face index: the same order every run
+  for (std::size_t k = 0; k < kept.size(); ++k) pairs[first + k] = kept[k].second;
+  search_.pair_count = first + kept.size();
 }
 
 void ToolContacts::latch_query_poses(double tissue_travel_m) {

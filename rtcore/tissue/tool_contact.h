@@ -170,7 +170,7 @@ class ToolContacts {
   struct CandidateSet {
     std::vector<PointCandidates> nodes, vertices;
     std::vector<std::uint32_t> pair_triangles;
-    std::vector<double> pair_distance2;  // scratch: each kept pair's distance at the search, for the order
+    std::vector<std::pair<double, std::uint32_t>> kept;  // scratch: a point's kept faces with their distance², for the order
     std::vector<Clearance> node_clearance, vertex_clearance;  // per point, at the searched positions
     std::size_t node_count = 0, vertex_count = 0, pair_count = 0;
     ToolContactStats stats;
