@@ -20,6 +20,7 @@
 #include "rtcore/concurrency/spsc_ring.h"
 #include "rtcore/concurrency/triple_buffer.h"
 #include "rtcore/core/fixed_step_scheduler.h"
+#include "rtcore/core/realtime_duty.h"
 #include "rtcore/core/thread_priority.h"
 #include "rtcore/mesh/mesh_io.h"
 #include "rtcore/base/state_hash.h"
@@ -122,6 +123,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   schedule.period_ns = period_ns;
   schedule.realtime = options.realtime;
   schedule.spin_ns = options.spin_us * 1000;
+  if (options.realtime) schedule.max_busy_fraction = realtime_busy_limit();
   FixedStepScheduler scheduler(schedule);
 
   const device::Calibration& calibration = options.calibration;

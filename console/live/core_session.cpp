@@ -10,6 +10,7 @@
 #include "device/calibration/calibration.h"
 #include "device/link/calibration_adapter.h"
 #include "recordings/recorder.h"
+#include "rtcore/core/realtime_duty.h"
 #include "rtcore/core/thread_priority.h"
 
 namespace resecto {
@@ -25,6 +26,7 @@ SchedulerConfig schedule_for(const CoreSessionOptions& options) {
   schedule.period_ns = static_cast<std::int64_t>(std::llround(options.simulation.tick_s() * 1e9));
   schedule.realtime = true;
   schedule.spin_ns = options.spin_us * 1000;
+  schedule.max_busy_fraction = realtime_busy_limit();
   return schedule;
 }
 

@@ -17,13 +17,21 @@ void FixedStepScheduler::sleep_until(std::int64_t deadline_ns) {
   }
 }
 
-void FixedStepScheduler::wait_until(std::int64_t deadline_ns) const {
-  if (config_.spin_ns <= 0) {
+void FixedStepScheduler::wait_until(std::int64_t deadline_ns) {
+  const std::int64_t now = FrameProfiler::now_ns();
+  if (awake_since_ns_ < 0) awake_since_ns_ = now;
+  const std::int64_t busy_ns = now - awake_since_ns_;
+  const std::int64_t spin_ns = duty_.allowed_spin_ns(std::min(config_.spin_ns, deadline_ns - now), busy_ns);
+  duty_.record(busy_ns);
+  if (spin_ns <= 0) {
     sleep_until(deadline_ns);
+    awake_since_ns_ = FrameProfiler::now_ns();
     return;
   }
-  const std::int64_t spin_from_ns = deadline_ns - config_.spin_ns;
-  if (FrameProfiler::now_ns() < spin_from_ns) sleep_until(spin_from_ns);
+  const std::int64_t spin_from_ns = deadline_ns - spin_ns;
+  if (now < spin_from_ns) sleep_until(spin_from_ns);
+  // The spin is running time: the next cycle counts it from here.
+  awake_since_ns_ = FrameProfiler::now_ns();
   while (FrameProfiler::now_ns() < deadline_ns) {
 #if defined(__x86_64__) || defined(__i386__)
     __builtin_ia32_pause();  // tells the core (and a hypervisor) this is a spin

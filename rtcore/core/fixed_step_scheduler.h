@@ -5,9 +5,11 @@
 // The step never sees the clock: only which tick it is.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 
 #include "rtcore/core/profiler.h"
+#include "rtcore/core/realtime_duty.h"
 
 namespace resecto {
 
@@ -23,6 +25,10 @@ struct SchedulerConfig {
   /// can come late by far more than a tick's slack (an idle virtual CPU halts, and the host wakes it
   /// when it pleases), a spinning one is already running. Costs that much CPU per tick.
   std::int64_t spin_ns = 0;
+  /// The share of each second the thread may run, spins included, before its spins give way to
+  /// sleep (RealtimeDuty); 0: no limit. A SCHED_FIFO core sets it a little under the kernel's
+  /// real-time bandwidth (realtime_bandwidth_fraction()).
+  double max_busy_fraction = 0.0;
 };
 
 /// How well the real-time schedule held.
@@ -36,7 +42,10 @@ struct DeadlineReport {
 
 class FixedStepScheduler {
  public:
-  explicit FixedStepScheduler(const SchedulerConfig& config) : config_(config) {}
+  explicit FixedStepScheduler(const SchedulerConfig& config)
+      : config_(config),
+        duty_(static_cast<std::size_t>(1'000'000'000 / std::max<std::int64_t>(config.period_ns, 1)) + 1,
+              static_cast<std::int64_t>(config.max_busy_fraction * 1e9)) {}
 
   /// Runs `step(tick)` for ticks [first, first + count), in order; `step` returns false to stop early.
   template <class Step>
@@ -76,11 +85,13 @@ class FixedStepScheduler {
 
  private:
   static void sleep_until(std::int64_t deadline_ns);
-  /// Sleeps until `spin_ns` before the deadline, then spins to it.
-  void wait_until(std::int64_t deadline_ns) const;
+  /// Sleeps until `spin_ns` (or what the duty allows of it) before the deadline, then spins to it.
+  void wait_until(std::int64_t deadline_ns);
 
   SchedulerConfig config_;
   DeadlineReport report_;
+  RealtimeDuty duty_;
+  std::int64_t awake_since_ns_ = -1;  // when the thread last stopped sleeping
 };
 
 }  // namespace resecto
