@@ -157,7 +157,7 @@ int ToolContacts::add_part(const TriangleMesh& mesh) {
 }
 
 void ToolContacts::build_vertex_clusters(Part& part) const {
-  // Vertices binned on a grid of twice the margin: a cluster is a few millimetres across, so its
+  // Vertices binned on a grid of the margin's size: a cluster is at most 2.6 mm across, so its
   // descent finds barely more tissue than one vertex's would, and a wire's many vertices share one.
   const double cell = margin_m_;
   std::vector<std::uint8_t> used(part.mesh.vertex_count(), 0);
