@@ -76,10 +76,20 @@ struct Closest {
 
 /// The nearest of a rigid part's candidate faces to p (tool frame): each face is skipped when its
 /// bounding sphere is further than the best so far (exact: same choice, fewer tests).
+/// Faces come nearest first with their distance at the search (`searched`, or null), and `moved`
+/// bounds how much nearer any of them can have come since: once a face's distance less that cannot
+/// win, no later one can, and the scan stops.
+bool cannot_win(const Closest& best, const double* searched, std::uint32_t e, double moved) {
+  if (searched == nullptr) return false;
+  const double lower = searched[e] - moved - 1e-12;  // a picometre for the rounding, as clearance() does
+  return lower > 0.0 && lower * lower > best.distance2 + Closest::kTie;
+}
+
 Closest nearest_tool_face(const TriangleMesh& mesh, const std::vector<Vec3>& unit_normals, const std::vector<Sphere>& bounds,
-                          const Vec3& p, const std::uint32_t* faces, std::uint32_t count) {
+                          const Vec3& p, const std::uint32_t* faces, std::uint32_t count, const double* searched = nullptr, double moved = 0.0) {
   Closest best;
   for (std::uint32_t e = 0; e < count; ++e) {
+    if (cannot_win(best, searched, e, moved)) break;
     const std::uint32_t face = faces[e];
     if (best.beyond(p, bounds[face].center, bounds[face].radius)) continue;
     const Triangle& t = mesh.triangles[face];
@@ -91,9 +101,10 @@ Closest nearest_tool_face(const TriangleMesh& mesh, const std::vector<Vec3>& uni
 /// The nearest of the tissue's candidate faces (corners at x) to w (world). The faces move, so
 /// their bounds are formed here: a box, cheaper than a sphere; a face's normal only for a winner.
 Closest nearest_tissue_face(const Vec3* x, const std::vector<Triangle>& triangles, const Vec3& w, const std::uint32_t* faces,
-                            std::uint32_t count) {
+                            std::uint32_t count, const double* searched = nullptr, double moved = 0.0) {
   Closest best;
   for (std::uint32_t e = 0; e < count; ++e) {
+    if (cannot_win(best, searched, e, moved)) break;
     const Triangle& t = triangles[faces[e]];
     if (best.beyond_box(w, glm::min(x[t[0]], glm::min(x[t[1]], x[t[2]])), glm::max(x[t[0]], glm::max(x[t[1]], x[t[2]])))) continue;
     const Vec3 q = closest_point_on_triangle(w, x[t[0]], x[t[1]], x[t[2]]);
@@ -129,6 +140,8 @@ ToolContacts::ToolContacts(double margin_m, const ToolContactCapacity& capacity)
   search_.vertices.resize(static_cast<std::size_t>(capacity.max_tool_vertices));
   search_.pair_triangles.resize(static_cast<std::size_t>(capacity.max_pair_entries));
   search_.kept.reserve(static_cast<std::size_t>(capacity.max_pair_entries));
+  search_.pair_distance.resize(static_cast<std::size_t>(capacity.max_pair_entries));
+  pair_distance_.resize(static_cast<std::size_t>(capacity.max_pair_entries));
   search_.node_clearance.resize(static_cast<std::size_t>(capacity.max_tissue_nodes));
   search_.vertex_clearance.resize(static_cast<std::size_t>(capacity.max_tool_vertices));
   search_.sorting.resize(static_cast<std::size_t>(std::max(capacity.max_tissue_nodes, capacity.max_tool_vertices)));
@@ -251,7 +264,10 @@ void ToolContacts::keep_within_margin(std::uint32_t first, const Vec3& p, const 
     if (d2 <= margin_m_ * margin_m_) kept.emplace_back(d2, pairs[e]);
   }
   std::sort(kept.begin(), kept.end());  // by distance², ties by face index: the same order every run
-  for (std::size_t k = 0; k < kept.size(); ++k) pairs[first + k] = kept[k].second;
+  for (std::size_t k = 0; k < kept.size(); ++k) {
+    pairs[first + k] = kept[k].second;
+    search_.pair_distance[first + k] = std::sqrt(kept[k].first);
+  }
   search_.pair_count = first + kept.size();
 }
 
@@ -299,6 +315,9 @@ void ToolContacts::publish_candidates() {
   std::swap(node_candidates_, search_.nodes);
   std::swap(vertex_candidates_, search_.vertices);
   std::swap(pair_triangles_, search_.pair_triangles);
+  std::swap(pair_distance_, search_.pair_distance);
+  candidates_travel_m_ = search_.tissue_travel_m;
+  distances_valid_ = true;
   node_count_ = search_.node_count;
   vertex_count_ = search_.vertex_count;
   pair_count_ = search_.pair_count;
@@ -323,6 +342,7 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
   }
   search_.node_count = search_.vertex_count = search_.pair_count = 0;
   search_.stats = {};
+  search_.tissue_travel_m = query_tissue_travel_m_;
   for (std::size_t pi = 0; pi < parts_.size(); ++pi) {
     if (!parts_[pi].query_enabled) continue;
     search_tissue_nodes(static_cast<std::uint16_t>(pi), tissue_tree, surface);
@@ -389,9 +409,10 @@ void ToolContacts::search_tissue_nodes(std::uint16_t part_index, const SphereTre
       keep_within_margin(first, p, part.mesh.positions, part.mesh.triangles);
       const auto count = static_cast<std::uint32_t>(out.pair_count - first);
       if (count == 0) continue;
-      const Closest best = nearest_tool_face(part.mesh, part.face_normals, part.triangle_spheres, p, &out.pair_triangles[first], count);
+      const Closest best = nearest_tool_face(part.mesh, part.face_normals, part.triangle_spheres, p, &out.pair_triangles[first], count,
+                                             &out.pair_distance[first], 0.0);
       out.node_clearance[out.node_count] = certify(best, p, 0.0);
-      out.nodes[out.node_count++] = {n, part_index, first, count};
+      out.nodes[out.node_count++] = {n, part_index, first, count, p};
     }
   }
 }
@@ -425,9 +446,9 @@ void ToolContacts::search_tool_vertices(std::uint16_t part_index, const SphereTr
       keep_within_margin(first, w, x, surface.triangles);
       const auto count = static_cast<std::uint32_t>(out.pair_count - first);
       if (count == 0) continue;
-      const Closest best = nearest_tissue_face(x.data(), surface.triangles, w, &out.pair_triangles[first], count);
+      const Closest best = nearest_tissue_face(x.data(), surface.triangles, w, &out.pair_triangles[first], count, &out.pair_distance[first], 0.0);
       out.vertex_clearance[out.vertex_count] = certify(best, w, query_tissue_travel_m_);
-      out.vertices[out.vertex_count++] = {v, part_index, first, count};
+      out.vertices[out.vertex_count++] = {v, part_index, first, count, w};
     }
   }
 }
@@ -451,7 +472,10 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
       ++skipped;
       continue;
     }
-    const Closest best = nearest_tool_face(part.mesh, part.face_normals, part.triangle_spheres, p, &pair_triangles_[pc.first], pc.count);
+    // In the tool's frame only the node moves.
+    const double* searched = clearance_skipping_ && distances_valid_ ? &pair_distance_[pc.first] : nullptr;
+    const Closest best = nearest_tool_face(part.mesh, part.face_normals, part.triangle_spheres, p, &pair_triangles_[pc.first], pc.count, searched,
+                                           glm::length(p - pc.searched_at));
     clearance = certify(best, p, 0.0);
     if (!(best.side < 0.0)) continue;
     // Along the closest face's normal, by the distance behind its plane: the signed distance's
@@ -482,7 +506,10 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
       ++skipped;
       continue;
     }
-    const Closest best = nearest_tissue_face(x.data(), surface_triangles, w, &pair_triangles_[pc.first], pc.count);
+    // The vertex's own motion and, for the faces' corners, the tissue's travel since the search.
+    const double* searched = clearance_skipping_ && distances_valid_ ? &pair_distance_[pc.first] : nullptr;
+    const Closest best = nearest_tissue_face(x.data(), surface_triangles, w, &pair_triangles_[pc.first], pc.count, searched,
+                                             glm::length(w - pc.searched_at) + (tissue_travel_m - candidates_travel_m_));
     clearance = certify(best, w, tissue_travel_m);
     if (!(best.side < 0.0)) continue;
     const Triangle& t = surface_triangles[best.triangle];
@@ -512,6 +539,7 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
 }
 
 void ToolContacts::invalidate_tissue(std::span<const std::uint8_t> changed_face, std::span<const std::uint8_t> dead_node) {
+  distances_valid_ = false;  // measured against a surface that is not the one now
   // In stored order, compacting each point's pairs in place: the survivors keep their order.
   for (std::size_t i = 0; i < node_count_; ++i) {
     PointCandidates& pc = node_candidates_[i];

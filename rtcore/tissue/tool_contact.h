@@ -104,9 +104,10 @@ class ToolContacts {
                           double stiffness_n_m, double damping_ns_m, double h_s, double tissue_travel_m, std::span<Vec3> force,
                           std::span<double> stiffness_bound, std::span<double> damping_bound);
 
-  /// Whether add_forces() may skip points whose clearance certificate still holds (on by default).
-  /// Off, every candidate point is tested at every step: the brute-force reference the tests and
-  /// benchmarks compare against. The forces are the same either way.
+  /// Whether add_forces() may skip points whose clearance certificate still holds, and stop a point's
+  /// scan at the first face its search distance proves cannot be the nearest (on by default). Off,
+  /// every candidate point is tested against every one of its faces at every step: the brute-force
+  /// reference the tests and benchmarks compare against. The forces are the same either way.
   void set_clearance_skipping(bool enabled) { clearance_skipping_ = enabled; }
 
   /// After a topology edit of the tissue (resection), between physics steps with no search running:
@@ -165,11 +166,14 @@ class ToolContacts {
     std::uint16_t part;
     std::uint32_t first;
     std::uint32_t count;
+    Vec3 searched_at;  // where the search found it (tool frame for a tissue node, world for a tool vertex)
   };
   /// A search's result, built in the back buffer and swapped in by publish_candidates().
   struct CandidateSet {
     std::vector<PointCandidates> nodes, vertices;
     std::vector<std::uint32_t> pair_triangles;
+    std::vector<double> pair_distance;  // per pair, its face's distance from the point at the search
+    double tissue_travel_m = 0.0;       // MassSpringTissue::travel_m at the searched positions
     std::vector<std::pair<double, std::uint32_t>> kept;  // scratch: a point's kept faces with their distance², for the order
     std::vector<Clearance> node_clearance, vertex_clearance;  // per point, at the searched positions
     std::size_t node_count = 0, vertex_count = 0, pair_count = 0;
@@ -202,6 +206,12 @@ class ToolContacts {
   std::vector<PointCandidates> node_candidates_;    // tissue node against tool triangles
   std::vector<PointCandidates> vertex_candidates_;  // tool vertex against tissue triangles
   std::vector<std::uint32_t> pair_triangles_;
+  // Per pair, its face's distance at the search: a face further than the best so far by more than
+  // the motion since cannot be the nearest, and the faces are nearest first, so a point's scan stops
+  // there (exact: the same face wins as when every face is tested).
+  std::vector<double> pair_distance_;
+  double candidates_travel_m_ = 0.0;  // the tissue's travel at the published search
+  bool distances_valid_ = false;      // false from a topology edit until the next publish
   std::size_t node_count_ = 0, vertex_count_ = 0, pair_count_ = 0;
   // Per published candidate point, its clearance certificate (the search's, renewed by add_forces()).
   std::vector<Clearance> node_clearance_, vertex_clearance_;
