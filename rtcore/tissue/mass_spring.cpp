@@ -165,8 +165,11 @@ bool MassSpringTissue::refit_surface_tree(TreeRebuild rebuild) {
   bool rebuilt = false;
   if (surface_tree_edited_) {
     const bool due = rebuild == TreeRebuild::kWhenDue ? surface_tree_.should_rebuild() : surface_tree_.must_rebuild();
-    if (due) rebuilt = rebuild_surface_tree();
-    // Judged and found sound; a deferred rebuild keeps the tree marked for a quieter step.
+    if (due) {
+      rebuild_surface_tree();
+      rebuilt = true;
+    }
+    // Judged (and rebuilt if due); a deferred rebuild keeps the tree marked for a quieter step.
     if (rebuild == TreeRebuild::kWhenDue) surface_tree_edited_ = false;
   }
   surface_tree_.refit(surface_);
@@ -176,14 +179,15 @@ bool MassSpringTissue::refit_surface_tree(TreeRebuild rebuild) {
 bool MassSpringTissue::rebuild_surface_tree_if_due() {
   if (!surface_tree_edited_) return false;
   surface_tree_edited_ = false;
-  return surface_tree_.should_rebuild() && rebuild_surface_tree();
+  if (!surface_tree_.should_rebuild()) return false;
+  rebuild_surface_tree();
+  return true;
 }
 
-bool MassSpringTissue::rebuild_surface_tree() {
+void MassSpringTissue::rebuild_surface_tree() {
   surface_tree_.rebuild(surface_);
   ++surface_tree_rebuilds_;
   surface_tree_edited_ = false;
-  return true;
 }
 
 void MassSpringTissue::search_contact_candidates() { tool_.search_candidates(surface_tree_, surface_); }

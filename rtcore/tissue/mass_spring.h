@@ -224,7 +224,7 @@ class MassSpringTissue {
 
  private:
   /// Rebuilds the surface's sphere tree over its present faces; counts it.
-  bool rebuild_surface_tree();
+  void rebuild_surface_tree();
   struct OrderedMesh {
     std::vector<std::uint32_t> mesh_node;  // per tissue node, its mesh index
     TetMesh mesh;                          // renumbered

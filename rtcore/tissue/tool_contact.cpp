@@ -316,7 +316,7 @@ void ToolContacts::publish_candidates() {
   std::swap(vertex_candidates_, search_.vertices);
   std::swap(pair_triangles_, search_.pair_triangles);
   std::swap(pair_distance_, search_.pair_distance);
-  candidates_travel_m_ = search_.tissue_travel_m;
+  candidates_travel_m_ = query_tissue_travel_m_;  // latched for that search; the next latch comes after
   distances_valid_ = true;
   node_count_ = search_.node_count;
   vertex_count_ = search_.vertex_count;
@@ -342,7 +342,6 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
   }
   search_.node_count = search_.vertex_count = search_.pair_count = 0;
   search_.stats = {};
-  search_.tissue_travel_m = query_tissue_travel_m_;
   for (std::size_t pi = 0; pi < parts_.size(); ++pi) {
     if (!parts_[pi].query_enabled) continue;
     search_tissue_nodes(static_cast<std::uint16_t>(pi), tissue_tree, surface);

@@ -173,7 +173,6 @@ class ToolContacts {
     std::vector<PointCandidates> nodes, vertices;
     std::vector<std::uint32_t> pair_triangles;
     std::vector<double> pair_distance;  // per pair, its face's distance from the point at the search
-    double tissue_travel_m = 0.0;       // MassSpringTissue::travel_m at the searched positions
     std::vector<std::pair<double, std::uint32_t>> kept;  // scratch: a point's kept faces with their distance², for the order
     std::vector<Clearance> node_clearance, vertex_clearance;  // per point, at the searched positions
     std::size_t node_count = 0, vertex_count = 0, pair_count = 0;
@@ -210,7 +209,7 @@ class ToolContacts {
   // the motion since cannot be the nearest, and the faces are nearest first, so a point's scan stops
   // there (exact: the same face wins as when every face is tested).
   std::vector<double> pair_distance_;
-  double candidates_travel_m_ = 0.0;  // the tissue's travel at the published search
+  double candidates_travel_m_ = 0.0;  // the tissue's travel at the published search (its latched one)
   bool distances_valid_ = false;      // false from a topology edit until the next publish
   std::size_t node_count_ = 0, vertex_count_ = 0, pair_count_ = 0;
   // Per published candidate point, its clearance certificate (the search's, renewed by add_forces()).

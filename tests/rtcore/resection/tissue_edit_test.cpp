@@ -87,24 +87,26 @@ void expect_tree_covers_its_leaves(const SphereTree& tree) {
   }
 }
 
-TEST(TissueEdits, AfterCutsTheTissueEqualsAFreshBuildAndTheTreeItsSurface) {
+/// The 1296 gland after twelve steps of one stroke: the tissue the after-cut tests examine.
+class TissueEditsAfterCuts : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    cut_through_gland(resection, 12);
+    ASSERT_GT(resection.stats().removed_tetrahedra, 10);
+  }
   const ProstateTissueModel& model = tissue_model(1296);
-  MassSpringTissue tissue(model.mesh);
-  Resection resection(tissue);
-  cut_through_gland(resection, 12);
-  ASSERT_GT(resection.stats().removed_tetrahedra, 10);
+  MassSpringTissue tissue{model.mesh};
+  Resection resection{tissue};
+};
+
+TEST_F(TissueEditsAfterCuts, TheTissueEqualsAFreshBuildAndTheTreeItsSurface) {
   ASSERT_GT(resection.stats().refined_tetrahedra, 10);
   expect_matches_fresh_build(tissue);
   tissue.collision_step();  // refit to the current positions
   expect_tree_covers_its_leaves(tissue.surface_tree());
 }
 
-TEST(TissueEdits, ContactCandidatesAfterCutsEqualBruteForce) {
-  const ProstateTissueModel& model = tissue_model(1296);
-  MassSpringTissue tissue(model.mesh);
-  Resection resection(tissue);
-  cut_through_gland(resection, 12);
-  ASSERT_GT(resection.stats().removed_tetrahedra, 10);
+TEST_F(TissueEditsAfterCuts, ContactCandidatesEqualBruteForce) {
   const std::vector<TriangleMesh> parts = {model.loop};
   const int loop = tissue.tool().add_part(model.loop);
   for (const double depth_mm : {0.0, 3.0}) {
