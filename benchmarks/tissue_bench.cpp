@@ -8,9 +8,11 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <string>
 
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/base/quantile.h"
+#include "rtcore/concurrency/loop_helper.h"
 #include "rtcore/scenes/indentation.h"
 
 namespace resecto {
@@ -62,11 +64,13 @@ struct Row {
   std::size_t nodes = 0, springs = 0, contacts = 0;
   std::vector<double> physics_us, collision_us;
 };
-/// The rows of the tables, by triangle count; `brute_force`: the physics step with every candidate
-/// point tested every step.
-std::map<int, Row>& rows(bool brute_force = false) {
-  static std::map<int, Row> r[2];
-  return r[brute_force ? 1 : 0];
+/// The physics step's variants measured.
+enum class Variant { kCertificates, kBruteForce, kWithHelper };
+/// The rows of the tables, by triangle count: the physics step as the core runs it alone, with every
+/// candidate point tested every step (brute force), or with its loops shared with a helper thread.
+std::map<int, Row>& rows(Variant variant = Variant::kCertificates) {
+  static std::map<int, Row> r[3];
+  return r[static_cast<int>(variant)];
 }
 
 /// The physics step as the core runs it: a collision step (untimed) publishes fresh candidates every
@@ -75,9 +79,12 @@ std::map<int, Row>& rows(bool brute_force = false) {
 void BM_PhysicsStep(benchmark::State& state) {
   const int triangles = static_cast<int>(state.range(0));
   const bool skipping = state.range(1) != 0;
+  const bool helped = state.range(2) > 1;
   auto tissue = pressed_tissue(triangles, {}, {});
   tissue->tool().set_clearance_skipping(skipping);
-  Row& row = rows(!skipping)[triangles];
+  LoopHelper helper;
+  if (helped) tissue->share_loops_with(&helper);
+  Row& row = rows(helped ? Variant::kWithHelper : skipping ? Variant::kCertificates : Variant::kBruteForce)[triangles];
   row.nodes = tissue->node_count();
   row.springs = tissue->network().spring_count();
   row.contacts = static_cast<std::size_t>(tissue->tool().stats().pair_entries);
@@ -102,7 +109,9 @@ void BM_PhysicsStep(benchmark::State& state) {
   const auto evaluated = static_cast<double>(tissue->tool().points_evaluated() - evaluated_before);
   const auto skipped = static_cast<double>(tissue->tool().points_skipped() - skipped_before);
   state.counters["points_skipped"] = skipped / std::max(1.0, evaluated + skipped);
-  state.SetLabel(skipping ? "clearance certificates" : "brute-force contact");
+  if (helped) state.counters["helped_share"] = static_cast<double>(helper.chunks_helped()) / std::max(1.0, static_cast<double>(helper.chunks_offered()));
+  state.SetLabel(std::string(skipping ? "clearance certificates" : "brute-force contact") + (helped ? ", with the helper thread" : ""));
+  tissue->share_loops_with(nullptr);
 }
 
 void BM_CollisionStep(benchmark::State& state) {
@@ -133,7 +142,8 @@ void BM_CollisionStep(benchmark::State& state) {
 }
 
 BENCHMARK(BM_PhysicsStep)
-    ->ArgsProduct({{1296, 8640, 34560, 138240}, {1, 0}})
+    ->ArgsProduct({{1296, 8640, 34560, 138240}, {1, 0}, {1}})
+    ->ArgsProduct({{1296, 8640, 34560, 138240}, {1}, {2}})
     ->Unit(benchmark::kMicrosecond)
     ->MinTime(1.0);
 BENCHMARK(BM_CollisionStep)->Arg(1296)->Arg(8640)->Arg(34560)->Arg(138240)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
@@ -203,6 +213,19 @@ BENCHMARK(BM_Integrator)->Args({0, 0})->Args({0, 1})->Args({2, 0})->Args({2, 1})
 BENCHMARK(BM_Integrator)->Args({1, 0})->Args({1, 1})->Unit(benchmark::kMicrosecond)->Iterations(5);
 
 }  // namespace
+
+/// The physics step's median as the core runs it against `other`'s, per size, and the ratio.
+void print_physics_comparison(const char* title, const char* core_header, const char* other_header, Variant other) {
+  std::printf("\n%s:\n%10s | %18s %18s | %8s\n", title, "triangles", core_header, other_header, "speed-up");
+  for (const auto& [triangles, row] : rows()) {
+    const auto found = rows(other).find(triangles);
+    if (found == rows(other).end() || found->second.physics_us.empty() || row.physics_us.empty()) continue;
+    const double core = quantile(row.physics_us, 0.5), compared = quantile(found->second.physics_us, 0.5);
+    const double speed_up = other == Variant::kWithHelper ? core / compared : compared / core;
+    std::printf("%10d | %18.1f %18.1f | %7.2fx\n", triangles, core, compared, speed_up);
+  }
+}
+
 }  // namespace resecto
 
 int main(int argc, char** argv) {
@@ -216,14 +239,10 @@ int main(int argc, char** argv) {
                 resecto::quantile(row.physics_us, 0.5), resecto::quantile(row.physics_us, 0.99),
                 resecto::quantile(row.collision_us, 0.5), resecto::quantile(row.collision_us, 0.99));
   }
-  std::printf("\nphysics step, contact by clearance certificates against brute force (every candidate point every step):\n");
-  std::printf("%10s | %18s %18s | %8s\n", "triangles", "certificates us", "brute force us", "speed-up");
-  for (const auto& [triangles, row] : resecto::rows()) {
-    const auto other = resecto::rows(true).find(triangles);
-    if (other == resecto::rows(true).end() || other->second.physics_us.empty() || row.physics_us.empty()) continue;
-    const double fast = resecto::quantile(row.physics_us, 0.5), slow = resecto::quantile(other->second.physics_us, 0.5);
-    std::printf("%10d | %18.1f %18.1f | %7.2fx\n", triangles, fast, slow, slow / fast);
-  }
+  resecto::print_physics_comparison("physics step, contact by clearance certificates against brute force (every candidate point every step)",
+                                    "certificates us", "brute force us", resecto::Variant::kBruteForce);
+  resecto::print_physics_comparison("physics step alone and with its spring and node loops shared with a helper thread (same state bit for bit)",
+                                    "alone us", "with helper us", resecto::Variant::kWithHelper);
   std::printf("budgets: physics step at 960 Hz within a third of a core = 347 us; collision step (on the collision thread, "
               "alongside the physics ticks) refit 15%% + query 45%% of the 16667 us collision period = 10000 us\n");
   return 0;

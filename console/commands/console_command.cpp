@@ -21,6 +21,10 @@ void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_r
     cmd.add_option("--collision-hz", o.collision_hz, "Collision steps per second")->check(CLI::Range(10, 1000))->capture_default_str();
     cmd.add_option("--substeps", o.substeps, "Physics steps per collision step")->check(CLI::Range(1, 64))->capture_default_str();
     cmd.add_option("--spin-us", o.spin_us, "Spin this long before each tick instead of sleeping")->check(CLI::Range(0, 100000))->capture_default_str();
+    cmd.add_option("--physics-threads", o.physics_threads,
+                   "Threads sharing each physics step's spring and node loops: 1, or 2 (the core and a helper); same state hashes")
+        ->check(CLI::Range(1, 2))
+        ->capture_default_str();
     cmd.add_option("--seed", o.seed, "Seed of the emulated sensors' noise")->capture_default_str();
     cmd.add_option("--calibration", o.calibration, "Device calibration file (default: the reference device's)");
   }
@@ -74,6 +78,7 @@ void open_console(const ConsoleCliOptions& o) {
   options.core.simulation.prostate_triangles = o.triangles;
   options.core.simulation.collision_hz = o.collision_hz;
   options.core.simulation.physics_per_collision = o.substeps;
+  options.core.simulation.physics_threads = o.physics_threads;
   TissueParameters parameters = parameters_from_assignments(o.sets);
   if (!o.preset.empty()) {
     Result<TissueParameters> preset = gui::load_preset(o.preset, parameters);

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "rtcore/core/fixed_step_scheduler.h"
+#include "rtcore/core/simulation.h"
 
 namespace resecto::cli {
 
@@ -34,6 +35,7 @@ struct ConsoleCliOptions {
   int collision_hz = 60;
   int substeps = 16;
   std::int64_t spin_us = kDefaultRealtimeSpinUs;
+  int physics_threads = default_physics_threads();
   std::uint64_t seed = 1;
   std::string calibration;
 };

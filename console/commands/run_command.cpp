@@ -33,6 +33,7 @@ struct RunOptions {
   int collision_hz = 60;
   int substeps = 16;
   bool inline_collision = false;
+  int physics_threads = default_physics_threads();
   bool raw_input = false;
   std::int64_t spin_us = kDefaultRealtimeSpinUs;
   std::uint64_t seed = 1;
@@ -51,6 +52,7 @@ void run(const RunOptions& o) {
     console.collision_hz = o.collision_hz;
     console.substeps = o.substeps;
     console.spin_us = o.spin_us;
+    console.physics_threads = o.physics_threads;
     console.seed = o.seed;
     console.calibration = o.calibration;
     console.report = o.report;
@@ -80,6 +82,7 @@ void run(const RunOptions& o) {
   options.simulation.collision_hz = o.collision_hz;
   options.simulation.physics_per_collision = o.substeps;
   options.simulation.collision_thread = !o.inline_collision;
+  options.simulation.physics_threads = o.physics_threads;
   options.simulation.input_filter.enabled = !o.raw_input;
   options.spin_us = o.spin_us;
   options.simulation.parameters = parameters_from_assignments(o.sets);
@@ -121,6 +124,10 @@ void register_run(CLI::App& app) {
   cmd->add_option("--substeps", o->substeps, "Physics steps per collision step")->check(CLI::Range(1, 64))->capture_default_str();
   cmd->add_flag("--inline-collision", o->inline_collision,
                 "Refit and query on the core's own thread instead of the collision thread (same state hashes)");
+  cmd->add_option("--physics-threads", o->physics_threads,
+                  "Threads sharing each physics step's spring and node loops: 1, or 2 (the core and a helper); same state hashes")
+      ->check(CLI::Range(1, 2))
+      ->capture_default_str();
   cmd->add_flag("--raw-input", o->raw_input, "Place the tool by the device's raw readings, without the One Euro smoothing");
   cmd->add_option("--spin-us", o->spin_us, "Real time: spin this long before each tick instead of sleeping")
       ->check(CLI::Range(0, 100000))

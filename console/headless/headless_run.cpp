@@ -170,15 +170,19 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   // both before any normal thread of the machine. Batch runs keep normal priority.
   std::optional<ScopedFifoPriority> core_priority;
   bool collision_raised = false;
+  bool helper_raised = false;
   bool recorder_raised = false;
   if (options.realtime) {
     core_priority.emplace(kCoreFifoPriority);
-    if (core_priority->raised() && sim.collision_thread()) {
-      collision_raised = raise_to_fifo(sim.collision_thread()->native_handle(), kCollisionFifoPriority);
+    if (core_priority->raised()) {
+      const RaisedThreads raised = raise_simulation_threads(sim);
+      collision_raised = raised.collision;
+      helper_raised = raised.physics_helper;
     }
     if (core_priority->raised() && recorder) recorder_raised = raise_to_fifo(recorder->native_handle(), kRecorderFifoPriority);
   }
   const auto wall_start = std::chrono::steady_clock::now();
+  scheduler.set_wake_hook([](void* simulation) { static_cast<Simulation*>(simulation)->prepare_for_tick(); }, &sim);
   scheduler.run(0, ticks, [&](std::uint64_t tick) {
     const std::int64_t tick_begin_ns = FrameProfiler::now_ns();
     TickInput input;
@@ -234,8 +238,13 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   r["wall_s"] = wall_s;
   r["rates_hz"] = {{"physics", 1.0 / tick_s}, {"collision", config.collision_hz}};
   r["collision_thread"] = config.collision_thread;
+  r["physics_threads"] = config.physics_threads;
+  if (LoopHelper* helper = sim.physics_helper()) {
+    r["physics_helper"] = {{"chunks", helper->chunks_offered()}, {"helped", helper->chunks_helped()}};
+  }
   r["scheduling"] = {{"core", core_raised ? "SCHED_FIFO " + std::to_string(kCoreFifoPriority) : std::string("normal")},
                      {"collision", collision_raised ? "SCHED_FIFO " + std::to_string(kCollisionFifoPriority) : std::string("normal")}};
+  if (sim.physics_helper()) r["scheduling"]["physics_helper"] = helper_raised ? "SCHED_FIFO " + std::to_string(kCoreFifoPriority) : std::string("normal");
   if (recorder) r["scheduling"]["recorder"] = recorder_raised ? "SCHED_FIFO " + std::to_string(kRecorderFifoPriority) : std::string("normal");
   r["model"] = {{"surface_triangles", sim.prostate().surface.triangle_count()},
                 {"tetrahedra", sim.tetrahedron_count()},

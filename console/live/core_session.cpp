@@ -100,10 +100,11 @@ void CoreSession::run_core() {
   std::optional<ScopedFifoPriority> priority;
   if (options_.realtime_priority) {
     priority.emplace(kCoreFifoPriority);
-    if (priority->raised() && sim_->collision_thread()) raise_to_fifo(sim_->collision_thread()->native_handle(), kCollisionFifoPriority);
+    if (priority->raised()) raise_simulation_threads(*sim_);
     priority_held_.store(priority->raised(), std::memory_order_release);
   }
   const double period_ns = static_cast<double>(schedule_for(options_).period_ns);
+  scheduler_.set_wake_hook([](void* simulation) { static_cast<Simulation*>(simulation)->prepare_for_tick(); }, sim_.get());
   scheduler_.run(0, UINT64_MAX / 2, [&](std::uint64_t) {
     if (stop_requested_.load(std::memory_order_acquire)) return false;
     const std::int64_t begin_ns = FrameProfiler::now_ns();

@@ -26,10 +26,12 @@ void FixedStepScheduler::wait_until(std::int64_t deadline_ns) {
   if (spin_ns <= 0) {
     sleep_until(deadline_ns);
     awake_since_ns_ = FrameProfiler::now_ns();
+    if (wake_hook_ != nullptr) wake_hook_(wake_context_);
     return;
   }
   const std::int64_t spin_from_ns = deadline_ns - spin_ns;
   if (now < spin_from_ns) sleep_until(spin_from_ns);
+  if (wake_hook_ != nullptr) wake_hook_(wake_context_);
   // The spin is running time: the next cycle counts it from here.
   awake_since_ns_ = FrameProfiler::now_ns();
   while (FrameProfiler::now_ns() < deadline_ns) {

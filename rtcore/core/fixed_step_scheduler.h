@@ -83,6 +83,14 @@ class FixedStepScheduler {
 
   const DeadlineReport& report() const { return report_; }
 
+  /// Real time: calls hook(context) each time the thread wakes for a tick, before its spin to the
+  /// deadline (so about spin_ns ahead of the tick): time for another thread to be woken and be
+  /// running when the tick begins.
+  void set_wake_hook(void (*hook)(void*), void* context) {
+    wake_hook_ = hook;
+    wake_context_ = context;
+  }
+
  private:
   static void sleep_until(std::int64_t deadline_ns);
   /// Sleeps until `spin_ns` (or what the duty allows of it) before the deadline, then spins to it.
@@ -92,6 +100,8 @@ class FixedStepScheduler {
   DeadlineReport report_;
   RealtimeDuty duty_;
   std::int64_t awake_since_ns_ = -1;  // when the thread last stopped sleeping
+  void (*wake_hook_)(void*) = nullptr;
+  void* wake_context_ = nullptr;
 };
 
 }  // namespace resecto

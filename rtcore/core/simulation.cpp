@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <thread>
 
 #include "rtcore/base/units.h"
+#include "rtcore/core/thread_priority.h"
 #include "rtcore/scenes/prostate_tissue.h"
 #include "rtcore/base/state_hash.h"
 
@@ -58,6 +60,7 @@ Status SimulationConfig::validate() const {
   if (physics_per_collision < 1 || physics_per_collision > 64) {
     return Error{"physics substeps " + std::to_string(physics_per_collision) + " per collision step is outside [1, 64]"};
   }
+  if (physics_threads < 1 || physics_threads > 2) return Error{"physics threads " + std::to_string(physics_threads) + " is outside [1, 2]"};
   if (prostate_triangles < 200 || prostate_triangles > 1'000'000) {
     return Error{"prostate triangles " + std::to_string(prostate_triangles) + " is outside [200, 1000000]"};
   }
@@ -104,11 +107,28 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
   sim->placed_.poses = {withdrawn_pose(), withdrawn_pose()};
   sim->searching_ = sim->published_ = sim->placed_;
   sim->state_hash_ = sim->tissue_->state_hash();
+  if (config.physics_threads > 1) {
+    sim->physics_helper_ = std::make_unique<LoopHelper>();
+    for (std::unique_ptr<MassSpringTissue>& copy : sim->copies_) copy->share_loops_with(sim->physics_helper_.get());
+  }
   if (config.collision_thread) {
     Simulation* raw = sim.get();
     sim->collision_thread_ = std::make_unique<JobThread>([raw] { raw->run_collision_job(); });
   }
   return sim;
+}
+
+int default_physics_threads() { return std::thread::hardware_concurrency() >= 2 ? 2 : 1; }
+
+RaisedThreads raise_simulation_threads(Simulation& sim) {
+  RaisedThreads raised;
+  if (sim.collision_thread()) raised.collision = raise_to_fifo(sim.collision_thread()->native_handle(), kCollisionFifoPriority);
+  if (sim.physics_helper()) raised.physics_helper = raise_to_fifo(sim.physics_helper()->native_handle(), kCoreFifoPriority);
+  return raised;
+}
+
+void Simulation::prepare_for_tick() {
+  if (physics_helper_free()) physics_helper_->call_in();
 }
 
 void Simulation::place_tool(const TickInput& input) {
@@ -167,6 +187,15 @@ void Simulation::step(const TickInput& input, std::span<const ParameterCommand> 
   if (collision_tick) advance_collision_pipeline(tick, profiler);
   {
     RESECTO_PROFILE_STAGE(profiler, Stage::kPhysics, tick);
+    // The helper shares this step's loops only while the collision job is not running: on a
+    // two-core machine they would share a core, and the job must finish within its period (helping
+    // during its first ticks too only moved the slow unhelped ticks later and made jobs overrun).
+    // Who runs a loop's chunks changes no bit of the state.
+    if (physics_helper_) {
+      const bool helped = physics_helper_free();
+      tissue_->share_loops_with(helped ? physics_helper_.get() : nullptr);
+      if (!helped) physics_helper_->send_home();  // called in by prepare_for_tick(), not needed after all
+    }
     reaction_ = tissue_->physics_step(config_.tick_s());
   }
   {

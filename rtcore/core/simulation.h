@@ -35,6 +35,9 @@ struct SimulationConfig {
   /// Runs each collision step's refit and search on a thread of its own, concurrently with the
   /// physics ticks that follow it. The results are the same either way (see Simulation::step).
   bool collision_thread = true;
+  /// Threads that share each physics step's spring and node loops: 1 (the core alone) or 2 (the core
+  /// and a helper). The results are the same bit for bit either way.
+  int physics_threads = 1;
   TissueParameters parameters;     ///< initial values; later changes come as commands
   GimbalGeometry gimbal;
   double max_tet_volume_m3 = 0.0;  ///< TetGen -a bound for the tissue model; 0 = unbounded
@@ -197,6 +200,12 @@ class Simulation {
   std::size_t tetrahedron_count() const { return tetrahedra_; }
   /// The thread that runs the collision refit and search; null when they run inline.
   JobThread* collision_thread() { return collision_thread_.get(); }
+  /// Real time, about a spin ahead of each tick: calls in the physics helper if the coming tick's
+  /// physics will share its loops with it, so the helper is running when they begin (a sleeping
+  /// helper on an idle virtual CPU takes tens of microseconds to wake). Changes no state.
+  void prepare_for_tick();
+  /// The physics step's helper thread (physics_threads = 2), else nullptr.
+  LoopHelper* physics_helper() { return physics_helper_.get(); }
 
   /// Copies the publishable state into `snapshot` (whose surface array is sized by make_snapshot()).
   void fill_snapshot(SimulationSnapshot& snapshot) const;
@@ -282,8 +291,25 @@ class Simulation {
   std::uint64_t contact_ticks_ = 0;
   double contact_force_sum_n_ = 0.0;
   ProcedureMetrics metrics_;
+  /// Whether the next physics step may share its loops with the helper (see prepare_for_tick()).
+  bool physics_helper_free() const { return physics_helper_ && (!collision_thread_ || collision_thread_->idle()); }
+  std::unique_ptr<LoopHelper> physics_helper_;
   std::unique_ptr<JobThread> collision_thread_;  // last: stops before what its job uses goes
 };
+
+/// Physics threads worth having on this machine: 2 where it has two or more processors, else 1.
+int default_physics_threads();
+
+/// Which of a simulation's own threads a real-time run raised to SCHED_FIFO.
+struct RaisedThreads {
+  bool collision = false;
+  bool physics_helper = false;
+};
+/// Real time, once the core's thread holds kCoreFifoPriority: the collision thread under it (it has
+/// a whole collision period) and the physics helper level with it (it runs only inside the core's
+/// physics step, and the core may wait on a chunk it holds, so nothing the core outranks may
+/// preempt it).
+RaisedThreads raise_simulation_threads(Simulation& sim);
 
 /// The stages' budgets at a tick rate, microseconds (the tick's time split among its stages).
 std::array<double, kStageCount> default_stage_budgets_us(const SimulationConfig& config);

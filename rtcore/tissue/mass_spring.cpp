@@ -201,19 +201,27 @@ void MassSpringTissue::accumulate_forces(double h_s) {
   // Springs first, each into its own slot; then per node, in node order: viscous damping, its
   // springs in ascending spring order (SpringForces::add_sums), its anchor. Each node's force is
   // thus the same sum in the same order every run, and the bounds start from their constant part.
-  const std::size_t compressed = springs_.compute(x_.data(), v_.data());
+  // Both passes run in chunks shared with the loop helper; every value belongs to one spring or one
+  // node, so the threads change no bit.
+  const std::size_t compressed = springs_.compute(x_.data(), v_.data(), helper_);
   const double viscous_rate = parameters_.si(TissueParameter::kViscousDamping);
   const std::size_t n = x_.size();
-  for (std::size_t i = 0; i < n; ++i) force_[i] = -viscous_rate * mass_[i] * v_[i];
-  springs_.add_sums(force_.data());
+  auto node_pass = [&](std::uint32_t chunk) {
+    const std::size_t begin = chunk * kNodesPerChunk, end = std::min(n, begin + kNodesPerChunk);
+    for (std::size_t i = begin; i < end; ++i) force_[i] = -viscous_rate * mass_[i] * v_[i];
+    springs_.add_sums(force_.data(), begin, end);
+    // Springs, dampers, anchors and viscous damping bound the same every step until a parameter
+    // changes (update_material); what varies is added on top.
+    std::copy(base_stiffness_bound_.begin() + static_cast<std::ptrdiff_t>(begin), base_stiffness_bound_.begin() + static_cast<std::ptrdiff_t>(end),
+              stiffness_bound_.begin() + static_cast<std::ptrdiff_t>(begin));
+    std::copy(base_damping_bound_.begin() + static_cast<std::ptrdiff_t>(begin), base_damping_bound_.begin() + static_cast<std::ptrdiff_t>(end),
+              damping_bound_.begin() + static_cast<std::ptrdiff_t>(begin));
+  };
+  for_each_chunk(helper_, chunks_covering(n, kNodesPerChunk), node_pass);
   for (std::size_t a = 0; a < anchor_k_.size(); ++a) {
     const std::uint32_t i = network_.anchor_nodes[a];
     force_[i] -= anchor_k_[a] * (x_[i] - rest_[i]);
   }
-  // Springs, dampers, anchors and viscous damping bound the same every step until a parameter
-  // changes (update_material); what varies is added on top.
-  std::copy(base_stiffness_bound_.begin(), base_stiffness_bound_.end(), stiffness_bound_.begin());
-  std::copy(base_damping_bound_.begin(), base_damping_bound_.end(), damping_bound_.begin());
   if (compressed > 0) [[unlikely]] springs_.add_compression_bounds(x_.data(), stiffness_bound_.data(), compressed);
   if (config_.integrator == TissueIntegrator::kImplicitEuler) springs_.linearise(x_.data(), spring_direction_.data(), spring_transverse_k_.data());
   reaction_ = tool_.add_forces(x_, v_, surface_.triangles, parameters_.si(TissueParameter::kPenaltyStiffness),
@@ -230,22 +238,35 @@ void MassSpringTissue::step_bounded_symplectic(double h_s) {
   // ranges diverged). So a rise of D keeps the momentum D v and a fall keeps the velocity: both can
   // only lower the kinetic energy 1/2 D v^2, and the step stays symplectic while D holds still.
   // The finite check rides along: a node's sum is formed once it has moved.
+  // Node by node, in chunks shared with the loop helper; each chunk keeps its own fastest speed and
+  // first non-finite node, and the maximum and the minimum over chunks do not depend on the order.
   const std::size_t n = x_.size();
-  std::size_t first_non_finite = n;
-  double fastest2 = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double d = mass_[i] + 0.5 * h_s * h_s * stiffness_bound_[i] + h_s * damping_bound_[i];
-    Vec3 v = v_[i];
-    if (d > step_mass_[i]) v *= step_mass_[i] / d;
-    step_mass_[i] = d;
-    v += (h_s / d) * force_[i];
-    const Vec3 x = x_[i] + h_s * v;
-    v_[i] = v;
-    x_[i] = x;
-    fastest2 = std::max(fastest2, glm::dot(v, v));
-    const double sum = x.x + x.y + x.z + v.x + v.y + v.z;
-    if (!std::isfinite(sum) && first_non_finite == n) first_non_finite = i;
-  }
+  const std::uint32_t chunks = chunks_covering(n, kNodesPerChunk);
+  fastest2_per_chunk_.resize(chunks);  // within the reserved room
+  first_non_finite_per_chunk_.resize(chunks);
+  auto integrate = [&](std::uint32_t chunk) {
+    const std::size_t begin = chunk * kNodesPerChunk, end = std::min(n, begin + kNodesPerChunk);
+    std::size_t first_non_finite = n;
+    double fastest2 = 0.0;
+    for (std::size_t i = begin; i < end; ++i) {
+      const double d = mass_[i] + 0.5 * h_s * h_s * stiffness_bound_[i] + h_s * damping_bound_[i];
+      Vec3 v = v_[i];
+      if (d > step_mass_[i]) v *= step_mass_[i] / d;
+      step_mass_[i] = d;
+      v += (h_s / d) * force_[i];
+      const Vec3 x = x_[i] + h_s * v;
+      v_[i] = v;
+      x_[i] = x;
+      fastest2 = std::max(fastest2, glm::dot(v, v));
+      const double sum = x.x + x.y + x.z + v.x + v.y + v.z;
+      if (!std::isfinite(sum) && first_non_finite == n) first_non_finite = i;
+    }
+    fastest2_per_chunk_[chunk] = fastest2;
+    first_non_finite_per_chunk_[chunk] = first_non_finite;
+  };
+  for_each_chunk(helper_, chunks, integrate);
+  const double fastest2 = chunks == 0 ? 0.0 : *std::max_element(fastest2_per_chunk_.begin(), fastest2_per_chunk_.end());
+  const std::size_t first_non_finite = chunks == 0 ? n : *std::min_element(first_non_finite_per_chunk_.begin(), first_non_finite_per_chunk_.end());
   if (first_non_finite < n) [[unlikely]] note_non_finite(first_non_finite);
   add_travel(h_s * std::sqrt(fastest2));
   last_substeps_ = 1;
@@ -353,6 +374,7 @@ void MassSpringTissue::step_implicit_euler(double h_s) {
 }
 
 ToolReaction MassSpringTissue::physics_step(double h_s) {
+  if (helper_ != nullptr) helper_->call_in();
   switch (config_.integrator) {
     case TissueIntegrator::kBoundedSymplectic: step_bounded_symplectic(h_s); break;  // checks finiteness itself
     case TissueIntegrator::kSubsteppedSymplectic:
@@ -364,6 +386,7 @@ ToolReaction MassSpringTissue::physics_step(double h_s) {
       check_finite();
       break;
   }
+  if (helper_ != nullptr) helper_->send_home();
   return reaction_;
 }
 

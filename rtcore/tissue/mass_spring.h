@@ -121,6 +121,9 @@ class MassSpringTissue {
   void end_collision_step();
   /// One physics step of h_s seconds (default 1/960 s). Returns the reaction on the tool.
   ToolReaction physics_step(double h_s);
+  /// Shares the physics step's spring and node loops with `helper` (nullptr: this thread alone).
+  /// The state is the same bit for bit either way; the helper must outlive its use here.
+  void share_loops_with(LoopHelper* helper) { helper_ = helper; }
 
   /// 64-bit hash of positions, velocities and topology, bytes in index order. The topology's part is
   /// hashed once (about half the bytes at 8640 triangles); whatever changes the topology must renew it.
@@ -268,6 +271,11 @@ class MassSpringTissue {
 
   // Hot, per node.
   std::vector<Vec3> x_, v_, rest_, force_;
+  // The physics step's node loops run in chunks of this many nodes, shared with helper_ if set.
+  static constexpr std::size_t kNodesPerChunk = 512;
+  LoopHelper* helper_ = nullptr;
+  std::vector<double> fastest2_per_chunk_;
+  std::vector<std::size_t> first_non_finite_per_chunk_;
   std::vector<double> mass_, stiffness_bound_, damping_bound_;
   std::vector<double> step_mass_;  // D of the last bounded symplectic step (0 before the first)
   // Hot, per spring, in network_ order.

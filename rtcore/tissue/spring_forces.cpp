@@ -54,6 +54,27 @@ void SpringForces::reserve(std::size_t spring_capacity, std::size_t node_capacit
   incidence_.second_first.reserve(node_capacity + 1);
   incidence_.first_first.reserve(node_capacity + 1);
   fill_.reserve(node_capacity + 1);
+  listed_per_chunk_.reserve(chunks_covering(spring_capacity, kSpringsPerChunk));
+}
+
+std::size_t SpringForces::compute(const Vec3* x, const Vec3* v, LoopHelper* helper) {
+  const std::size_t count = spring_count();
+  const std::uint32_t chunks = chunks_covering(count, kSpringsPerChunk);
+  listed_per_chunk_.resize(chunks);  // within the reserved room
+  std::uint32_t* compressed = arrays_.compressed.data();
+  auto chunk_pass = [&](std::uint32_t chunk) {
+    const std::size_t begin = chunk * kSpringsPerChunk, end = std::min(count, begin + kSpringsPerChunk);
+    listed_per_chunk_[chunk] = static_cast<std::uint32_t>(spring_forces(arrays_, x, v, begin, end, compressed + begin));
+  };
+  for_each_chunk(helper, chunks, chunk_pass);
+  // Each chunk listed its springs at its own start; close the gaps, in chunk order (so ascending).
+  std::size_t listed = 0;
+  for (std::uint32_t chunk = 0; chunk < chunks; ++chunk) {
+    const std::uint32_t* first = compressed + chunk * kSpringsPerChunk;
+    std::copy(first, first + listed_per_chunk_[chunk], compressed + listed);
+    listed += listed_per_chunk_[chunk];
+  }
+  return listed;
 }
 
 void SpringForces::append(std::uint32_t i, std::uint32_t j, double rest_m) {

@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "rtcore/concurrency/loop_helper.h"
 #include "rtcore/geometry/vec3.h"
 #include "rtcore/tissue/spring_kernel.h"
 #include "rtcore/tissue/springs.h"
@@ -26,13 +27,20 @@ class SpringForces {
     arrays_.c[s] = c_ns_m;
   }
 
-  /// The per-spring pass at positions x and velocities v (spring_kernel.h). Returns how many springs
-  /// are compressed below half their rest length (add_compression_bounds handles those; usually none).
-  std::size_t compute(const Vec3* x, const Vec3* v) { return spring_forces(arrays_, x, v); }
+  /// The springs one chunk of the per-spring pass covers (a multiple of the AVX2 kernel's four).
+  static constexpr std::size_t kSpringsPerChunk = 2048;
 
-  /// The per-node pass: adds to each force[n] (n < node count) n's spring forces of the last
-  /// compute(), in ascending spring order, which is the order a scatter would form them in.
-  void add_sums(Vec3* force) const { add_spring_sums(incidence_, arrays_.f.data(), force, incidence_.first_first.size() - 1); }
+  /// The per-spring pass at positions x and velocities v (spring_kernel.h), in chunks shared with
+  /// `helper` where there is one: every spring's force is its own, so the chunking changes no bit.
+  /// Returns how many springs are compressed below half their rest length, listed ascending
+  /// (add_compression_bounds handles those; usually none).
+  std::size_t compute(const Vec3* x, const Vec3* v, LoopHelper* helper = nullptr);
+
+  /// The per-node pass: adds to each force[n] (n in [begin, end)) n's spring forces of the last
+  /// compute(), in a fixed order (its springs as node j ascending, then as node i ascending). Each
+  /// node's sum is its own, so node ranges may run on different threads.
+  void add_sums(Vec3* force, std::size_t begin, std::size_t end) const { add_spring_sums(incidence_, arrays_.f.data(), force, begin, end); }
+  void add_sums(Vec3* force) const { add_sums(force, 0, incidence_.first_first.size() - 1); }
   const SpringIncidence& incidence() const { return incidence_; }
 
   // Resection's edits (between steps). A removed spring stays in place with k = c = 0 (it then
@@ -68,6 +76,7 @@ class SpringForces {
   SpringArrays arrays_;
   SpringIncidence incidence_;
   std::vector<std::uint32_t> fill_;  // scratch of rebuild_incidence
+  std::vector<std::uint32_t> listed_per_chunk_;  // compute(): compressed springs each chunk listed
 };
 
 }  // namespace resecto

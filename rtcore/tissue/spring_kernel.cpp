@@ -131,18 +131,24 @@ bool cpu_has_avx2() {
   return has;
 }
 
+std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end, std::uint32_t* compressed) {
+  return cpu_has_avx2() ? spring_forces_avx2(springs, x, v, begin, end, compressed) : spring_forces_portable(springs, x, v, begin, end, compressed);
+}
+
+void add_spring_sums(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t begin, std::size_t end) {
+  if (cpu_has_avx2()) {
+    add_spring_sums_avx2(incidence, f, force, begin, end);
+  } else {
+    add_spring_sums_portable(incidence, f, force, begin, end);
+  }
+}
+
 std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v) {
-  const std::size_t count = springs.i.size();
-  std::uint32_t* compressed = springs.compressed.data();
-  return cpu_has_avx2() ? spring_forces_avx2(springs, x, v, 0, count, compressed) : spring_forces_portable(springs, x, v, 0, count, compressed);
+  return spring_forces(springs, x, v, 0, springs.i.size(), springs.compressed.data());
 }
 
 void add_spring_sums(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t node_count) {
-  if (cpu_has_avx2()) {
-    add_spring_sums_avx2(incidence, f, force, 0, node_count);
-  } else {
-    add_spring_sums_portable(incidence, f, force, 0, node_count);
-  }
+  add_spring_sums(incidence, f, force, 0, node_count);
 }
 
 }  // namespace resecto

@@ -58,6 +58,12 @@ void add_spring_sums_avx2(const SpringIncidence& incidence, const SpringForce* f
 /// Whether this processor runs the AVX2 kernels (checked once).
 bool cpu_has_avx2();
 
+/// The fastest kernel this processor runs, over springs [begin, end) (listing the compressed ones at
+/// `compressed`, room for end - begin).
+std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end, std::uint32_t* compressed);
+/// The fastest node sums this processor runs, over nodes [begin, end).
+void add_spring_sums(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t begin, std::size_t end);
+
 /// The fastest kernels this processor runs, over all springs (listing the compressed ones in
 /// springs.compressed) and all nodes.
 std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v);

@@ -34,6 +34,8 @@ double signed_volume6(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d
 void MassSpringTissue::reserve_topology(std::size_t node_capacity, std::size_t tetrahedron_capacity) {
   const double factor = std::max(1.0, config_.topology_capacity_factor);
   for (auto* vec : {&x_, &v_, &rest_, &force_}) vec->reserve(node_capacity);
+  fastest2_per_chunk_.reserve(chunks_covering(node_capacity, kNodesPerChunk));
+  first_non_finite_per_chunk_.reserve(chunks_covering(node_capacity, kNodesPerChunk));
   for (auto* vec : {&mass_, &stiffness_bound_, &damping_bound_, &step_mass_, &base_stiffness_bound_, &base_damping_bound_,
                     &network_.node_volume_m3}) {
     vec->reserve(node_capacity);

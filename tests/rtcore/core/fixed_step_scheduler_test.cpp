@@ -57,6 +57,28 @@ TEST(FixedStepScheduler, SpinningTheLastStretchNeverStartsATickEarly) {
   for (std::size_t k = 1; k < starts.size(); ++k) EXPECT_GE(starts[k] - starts[0], static_cast<std::int64_t>(k) * 1'000'000 - 20'000) << k;
 }
 
+TEST(FixedStepScheduler, TheWakeHookRunsOnceBeforeEachWaitedTickAndAheadOfIt) {
+  SchedulerConfig config;
+  config.realtime = true;
+  config.period_ns = 1'000'000;
+  config.spin_ns = 300'000;
+  FixedStepScheduler scheduler(config);
+  std::vector<std::int64_t> wakes, starts;
+  wakes.reserve(50);
+  starts.reserve(50);
+  scheduler.set_wake_hook([](void* out) { static_cast<std::vector<std::int64_t>*>(out)->push_back(FrameProfiler::now_ns()); }, &wakes);
+  scheduler.run(0, 50, [&](std::uint64_t) {
+    starts.push_back(FrameProfiler::now_ns());
+    return true;
+  });
+  // Tick 0 starts at once; every later one waited, and the hook ran during that wait.
+  ASSERT_EQ(wakes.size(), 49u);
+  for (std::size_t k = 1; k < starts.size(); ++k) {
+    EXPECT_GT(wakes[k - 1], starts[k - 1]) << k;
+    EXPECT_LE(wakes[k - 1], starts[k]) << k;
+  }
+}
+
 TEST(FixedStepScheduler, FarBehindReanchorsInsteadOfBursting) {
   SchedulerConfig config;
   config.realtime = true;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <mutex>
+#include <string>
 #include <vector>
 
 #include "rtcore/core/simulation.h"
@@ -67,6 +68,29 @@ TEST(Simulation, TheCollisionThreadChangesNothingButWhereTheSearchRuns) {
   const auto b = run_hashes(inline_search, 2 * 960);
   ASSERT_EQ(a.size(), 120u);
   EXPECT_EQ(a, b);
+}
+
+TEST(Simulation, ThePhysicsHelperChangesNoBit) {
+  // The physics step's loops shared with a helper thread give the lone thread's state at every
+  // collision step, through contact and cuts (input_at presses the pedal from 1.5 s), with the search
+  // inline (the helper shares every tick) and on the collision thread (only ticks without its job).
+  for (const bool collision_thread : {false, true}) {
+    SimulationConfig alone = small_config(), shared = small_config();
+    alone.collision_thread = shared.collision_thread = collision_thread;
+    shared.physics_threads = 2;
+    const auto a = run_hashes(alone, 2 * 960);
+    const auto b = run_hashes(shared, 2 * 960);
+    ASSERT_EQ(a.size(), 120u);
+    EXPECT_EQ(a, b) << (collision_thread ? "collision thread" : "inline search");
+  }
+  SimulationConfig shared = small_config();
+  shared.collision_thread = false;
+  shared.physics_threads = 2;
+  auto sim = Simulation::create(shared);
+  ASSERT_TRUE(sim) << sim.error();
+  for (std::uint64_t tick = 0; tick < 960; ++tick) (*sim)->step(input_at(tick, shared.tick_s()), {});
+  ASSERT_NE((*sim)->physics_helper(), nullptr);
+  EXPECT_GT((*sim)->physics_helper()->chunks_helped(), 0u) << "the helper never ran a chunk: the comparison above proved nothing";
 }
 
 TEST(Simulation, ClearanceCertificatesGiveTheBruteForceState) {
@@ -200,8 +224,12 @@ TEST(Simulation, ACommandChangesTheStateFromItsTickOn) {
   EXPECT_NE(plain.back(), changed.back());
 }
 
-TEST(Simulation, SteadyStateTickAllocatesNothingAndTakesNoLock) {
-  auto sim = Simulation::create(small_config());
+class SteadyState : public ::testing::TestWithParam<int> {};
+
+TEST_P(SteadyState, TickAllocatesNothingAndTakesNoLock) {
+  SimulationConfig config = small_config();
+  config.physics_threads = GetParam();
+  auto sim = Simulation::create(config);
   ASSERT_TRUE(sim) << sim.error();
   const double h = (*sim)->config().tick_s();
   FrameProfiler profiler(default_stage_budgets_us((*sim)->config()), 1 << 14);
@@ -227,6 +255,10 @@ TEST(Simulation, SteadyStateTickAllocatesNothingAndTakesNoLock) {
   EXPECT_GT((*sim)->metrics().contact_time_s, 0.0);  // the ticks counted did real contact work
 }
 
+INSTANTIATE_TEST_SUITE_P(PhysicsThreads, SteadyState, ::testing::Values(1, 2), [](const ::testing::TestParamInfo<int>& info) {
+  return info.param == 1 ? std::string("Alone") : std::string("WithTheHelper");
+});
+
 TEST(RealtimeProbe, SeesAnAllocationAndALock) {
   // The probe itself must be able to fail: a heap allocation and a mutex are counted.
   std::mutex mutex;
@@ -244,6 +276,11 @@ TEST(Simulation, RejectsImpossibleRates) {
   auto sim = Simulation::create(config);
   ASSERT_FALSE(sim);
   EXPECT_NE(sim.error().find("physics substeps 0"), std::string::npos);
+  config = small_config();
+  config.physics_threads = 3;
+  auto three = Simulation::create(config);
+  ASSERT_FALSE(three);
+  EXPECT_NE(three.error().find("physics threads 3"), std::string::npos);
 }
 
 }  // namespace

@@ -1,0 +1,168 @@
+// LoopHelper: a second thread that shares the physics step's data-parallel loops with the core.
+// A loop is cut into a fixed number of chunks; the core and the helper claim chunks one at a time
+// until none is left, and each chunk writes only its own slice of the output. Which thread ran a
+// chunk therefore never changes a bit of the result, and a helper that is late, descheduled or
+// absent only means the core runs more chunks itself: it never waits for the helper to arrive, only
+// for a chunk the helper has already claimed.
+//
+// The helper sleeps on a futex between ticks and is called in for the loops of one step (it then
+// spins, so a chunk starts within a fraction of a microsecond). No mutex, no allocation after
+// construction: the loop's body is passed as a function pointer and a context pointer.
+#pragma once
+
+#include <immintrin.h>
+#include <linux/futex.h>
+#include <sched.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdint>
+#include <thread>
+
+namespace resecto {
+
+class LoopHelper {
+ public:
+  /// The most chunks one loop may have.
+  static constexpr std::uint32_t kMaxChunks = 0xffff;
+
+  LoopHelper() : thread_([this] { run(); }) {}
+  ~LoopHelper() {
+    stopping_.store(true, std::memory_order_relaxed);
+    on_call_.store(1, std::memory_order_release);
+    wake(on_call_);
+    thread_.join();
+  }
+  LoopHelper(const LoopHelper&) = delete;
+  LoopHelper& operator=(const LoopHelper&) = delete;
+
+  /// Owner: wakes the helper to take part in the loops that follow, until send_home().
+  void call_in() {
+    if (on_call_.exchange(1, std::memory_order_release) == 0) wake(on_call_);
+  }
+  /// Owner: the helper goes back to sleep once it sees this (no loop is running: for_each_chunk has
+  /// returned).
+  void send_home() { on_call_.store(0, std::memory_order_relaxed); }
+
+  /// Owner: body(chunk) for every chunk in [0, chunks), chunks <= kMaxChunks, run by this thread and
+  /// the helper (if it is on call); returns once all have run, with their writes visible.
+  template <class Body>
+  void for_each_chunk(std::uint32_t chunks, Body& body) {
+    if (chunks == 0) return;
+    offered_ += chunks;
+    body_.store(&call_body<Body>, std::memory_order_relaxed);
+    context_.store(&body, std::memory_order_relaxed);
+    finished_.store(0, std::memory_order_relaxed);
+    ++generation_;
+    const std::uint64_t loop = (static_cast<std::uint64_t>(generation_) << 32) | (static_cast<std::uint64_t>(chunks) << 16);
+    work_.store(loop, std::memory_order_release);
+    std::uint32_t ran = 0;
+    for (std::uint32_t chunk = 0; claim(generation_, true, chunk);) {
+      body(chunk);
+      ++ran;
+    }
+    // Only chunks the helper claimed are outstanding; it is running them now.
+    std::uint32_t done = finished_.fetch_add(ran, std::memory_order_acq_rel) + ran;
+    for (std::uint32_t spins = 0; done != chunks; done = finished_.load(std::memory_order_acquire)) {
+      // Should the helper share this CPU (an affinity mask, a migration), let it run.
+      if (++spins > (1u << 16)) sched_yield();
+      _mm_pause();
+    }
+  }
+
+  /// The helper's OS thread, e.g. to give it a real-time priority.
+  std::thread::native_handle_type native_handle() { return thread_.native_handle(); }
+  /// How many chunks the helper has run since it started (for reports and tests).
+  std::uint64_t chunks_helped() const { return helped_.load(std::memory_order_relaxed); }
+  /// Owner: how many chunks its loops have had in all.
+  std::uint64_t chunks_offered() const { return offered_; }
+
+ private:
+  // work_: generation (32 bits) | end of the unclaimed chunks (16) | start of the unclaimed chunks (16).
+  static std::uint32_t generation_of(std::uint64_t w) { return static_cast<std::uint32_t>(w >> 32); }
+  static std::uint32_t back_of(std::uint64_t w) { return static_cast<std::uint32_t>(w >> 16) & 0xffff; }
+  static std::uint32_t front_of(std::uint64_t w) { return static_cast<std::uint32_t>(w) & 0xffff; }
+
+  // Claims the first unclaimed chunk (the owner) or the last (the helper) of loop `generation`; false
+  // once none is left or another loop began. Taking them from opposite ends gives each thread about
+  // the same half of the data every step, which then stays in its own core's cache. The bounds
+  // travel in the same word as the claim, so a claim never pairs one loop with another's size.
+  bool claim(std::uint32_t generation, bool from_front, std::uint32_t& chunk) {
+    std::uint64_t w = work_.load(std::memory_order_acquire);
+    for (;;) {
+      if (generation_of(w) != generation || front_of(w) >= back_of(w)) return false;
+      const std::uint64_t claimed = from_front ? w + 1 : w - (std::uint64_t{1} << 16);
+      if (work_.compare_exchange_weak(w, claimed, std::memory_order_acq_rel, std::memory_order_acquire)) {
+        chunk = from_front ? front_of(w) : back_of(w) - 1;
+        return true;
+      }
+    }
+  }
+
+  template <class Body>
+  static void call_body(void* context, std::uint32_t chunk) {
+    (*static_cast<Body*>(context))(chunk);
+  }
+
+  void run() {
+    std::uint32_t seen = 0;
+    for (;;) {
+      while (on_call_.load(std::memory_order_acquire) == 0) sleep_while_zero(on_call_);
+      if (stopping_.load(std::memory_order_relaxed)) return;
+      const std::uint64_t w = work_.load(std::memory_order_acquire);
+      const std::uint32_t generation = generation_of(w);
+      if (generation == seen) {
+        _mm_pause();
+        continue;
+      }
+      seen = generation;
+      std::uint32_t ran = 0;
+      for (std::uint32_t chunk = 0; claim(generation, false, chunk);) {
+        // A claimed chunk holds its loop open, so the body read here is that loop's.
+        body_.load(std::memory_order_relaxed)(context_.load(std::memory_order_relaxed), chunk);
+        ++ran;
+      }
+      if (ran > 0) {
+        helped_.fetch_add(ran, std::memory_order_relaxed);
+        finished_.fetch_add(ran, std::memory_order_release);
+      }
+    }
+  }
+
+  static void sleep_while_zero(std::atomic<std::uint32_t>& word) {
+    syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAIT_PRIVATE, 0, nullptr, nullptr, 0);
+  }
+  static void wake(std::atomic<std::uint32_t>& word) {
+    syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAKE_PRIVATE, 1, nullptr, nullptr, 0);
+  }
+
+  std::uint32_t generation_ = 0;  // owner only
+  std::uint64_t offered_ = 0;     // owner only
+  alignas(64) std::atomic<std::uint64_t> work_{0};
+  std::atomic<void (*)(void*, std::uint32_t)> body_{nullptr};
+  std::atomic<void*> context_{nullptr};
+  alignas(64) std::atomic<std::uint32_t> finished_{0};
+  alignas(64) std::atomic<std::uint32_t> on_call_{0};
+  std::atomic<bool> stopping_{false};
+  std::atomic<std::uint64_t> helped_{0};
+  std::thread thread_;  // last: starts once the rest exists
+};
+
+/// body(chunk) for every chunk in [0, chunks): shared with `helper` where there is one, else in order on
+/// this thread. Either way each chunk runs once, so the result is the same.
+template <class Body>
+void for_each_chunk(LoopHelper* helper, std::uint32_t chunks, Body& body) {
+  if (helper != nullptr) {
+    helper->for_each_chunk(chunks, body);
+  } else {
+    for (std::uint32_t chunk = 0; chunk < chunks; ++chunk) body(chunk);
+  }
+}
+
+/// How many chunks of `per_chunk` items cover `count` items.
+constexpr std::uint32_t chunks_covering(std::size_t count, std::size_t per_chunk) {
+  return static_cast<std::uint32_t>((count + per_chunk - 1) / per_chunk);
+}
+
+}  // namespace resecto
