@@ -1,6 +1,6 @@
 // LoopHelper: a second thread that shares the physics step's data-parallel loops with the core.
-// A loop is cut into a fixed number of chunks; the core and the helper claim chunks one at a time
-// until none is left, and each chunk writes only its own slice of the output. Which thread ran a
+// A loop is cut into a fixed number of chunks; the core claims them one at a time from the front and
+// the helper from the back until none is left, and each chunk writes only its own slice of the output. Which thread ran a
 // chunk therefore never changes a bit of the result, and a helper that is late, descheduled or
 // absent only means the core runs more chunks itself: it never waits for the helper to arrive, only
 // for a chunk the helper has already claimed.
@@ -10,7 +10,6 @@
 // construction: the loop's body is passed as a function pointer and a context pointer.
 #pragma once
 
-#include <immintrin.h>
 #include <linux/futex.h>
 #include <sched.h>
 #include <sys/syscall.h>
@@ -21,6 +20,13 @@
 #include <thread>
 
 namespace resecto {
+
+/// One turn of a spin-wait: tells the core (and a hypervisor) that this is a spin.
+inline void spin_pause() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#endif
+}
 
 class LoopHelper {
  public:
@@ -45,11 +51,16 @@ class LoopHelper {
   /// returned).
   void send_home() { on_call_.store(0, std::memory_order_relaxed); }
 
-  /// Owner: body(chunk) for every chunk in [0, chunks), chunks <= kMaxChunks, run by this thread and
-  /// the helper (if it is on call); returns once all have run, with their writes visible.
+  /// Owner: body(chunk) for every chunk in [0, chunks), run by this thread and the helper (if it is on
+  /// call); returns once all have run, with their writes visible. A loop of more than kMaxChunks
+  /// chunks runs on this thread alone.
   template <class Body>
   void for_each_chunk(std::uint32_t chunks, Body& body) {
     if (chunks == 0) return;
+    if (chunks > kMaxChunks) {
+      for (std::uint32_t chunk = 0; chunk < chunks; ++chunk) body(chunk);
+      return;
+    }
     offered_ += chunks;
     body_.store(&call_body<Body>, std::memory_order_relaxed);
     context_.store(&body, std::memory_order_relaxed);
@@ -67,7 +78,7 @@ class LoopHelper {
     for (std::uint32_t spins = 0; done != chunks; done = finished_.load(std::memory_order_acquire)) {
       // Should the helper share this CPU (an affinity mask, a migration), let it run.
       if (++spins > (1u << 16)) sched_yield();
-      _mm_pause();
+      spin_pause();
     }
   }
 
@@ -113,7 +124,7 @@ class LoopHelper {
       const std::uint64_t w = work_.load(std::memory_order_acquire);
       const std::uint32_t generation = generation_of(w);
       if (generation == seen) {
-        _mm_pause();
+        spin_pause();
         continue;
       }
       seen = generation;

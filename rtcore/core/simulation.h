@@ -17,6 +17,7 @@
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/base/result.h"
 #include "rtcore/concurrency/job_thread.h"
+#include "rtcore/concurrency/loop_helper.h"
 #include "rtcore/core/joint_filter.h"
 #include "rtcore/core/profiler.h"
 #include "rtcore/core/tick_input.h"

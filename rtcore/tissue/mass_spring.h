@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rtcore/collision/sphere_tree.h"
+#include "rtcore/concurrency/loop_helper.h"
 #include "rtcore/tissue/spring_forces.h"
 #include "rtcore/tissue/springs.h"
 #include "rtcore/tissue/tissue_edit_log.h"

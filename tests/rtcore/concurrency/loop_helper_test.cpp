@@ -4,6 +4,7 @@
 // or sent home between loops never loses or doubles a chunk.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <thread>
 #include <vector>
@@ -77,6 +78,18 @@ TEST(LoopHelper, WithoutAHelperTheChunksRunInOrderOnTheCaller) {
   EXPECT_EQ(chunks_covering(0, 512), 0u);
   EXPECT_EQ(chunks_covering(512, 512), 1u);
   EXPECT_EQ(chunks_covering(513, 512), 2u);
+}
+
+TEST(LoopHelper, ALoopOfMoreChunksThanItCanCountRunsOnTheCaller) {
+  LoopHelper helper;
+  helper.call_in();
+  const std::uint32_t chunks = LoopHelper::kMaxChunks + 3;
+  std::vector<std::uint8_t> runs(chunks, 0);
+  auto body = [&](std::uint32_t chunk) { ++runs[chunk]; };
+  helper.for_each_chunk(chunks, body);
+  helper.send_home();
+  EXPECT_EQ(std::count(runs.begin(), runs.end(), 1), static_cast<std::ptrdiff_t>(chunks));
+  EXPECT_EQ(helper.chunks_helped(), 0u);
 }
 
 TEST(LoopHelper, DestructionJoinsWhetherAsleepOrOnCall) {
