@@ -182,7 +182,10 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
     if (core_priority->raised() && recorder) recorder_raised = raise_to_fifo(recorder->native_handle(), kRecorderFifoPriority);
   }
   const auto wall_start = std::chrono::steady_clock::now();
-  scheduler.set_wake_hook([](void* simulation) { static_cast<Simulation*>(simulation)->prepare_for_tick(); }, &sim);
+  if (options.realtime) {
+    sim.set_paced();
+    scheduler.set_wake_hook([](void* simulation) { static_cast<Simulation*>(simulation)->prepare_for_tick(); }, &sim);
+  }
   scheduler.run(0, ticks, [&](std::uint64_t tick) {
     const std::int64_t tick_begin_ns = FrameProfiler::now_ns();
     TickInput input;

@@ -104,6 +104,7 @@ void CoreSession::run_core() {
     priority_held_.store(priority->raised(), std::memory_order_release);
   }
   const double period_ns = static_cast<double>(schedule_for(options_).period_ns);
+  sim_->set_paced();
   scheduler_.set_wake_hook([](void* simulation) { static_cast<Simulation*>(simulation)->prepare_for_tick(); }, sim_.get());
   scheduler_.run(0, UINT64_MAX / 2, [&](std::uint64_t) {
     if (stop_requested_.load(std::memory_order_acquire)) return false;

@@ -128,6 +128,7 @@ RaisedThreads raise_simulation_threads(Simulation& sim) {
 }
 
 void Simulation::prepare_for_tick() {
+  waited_ = true;
   if (physics_helper_free()) physics_helper_->call_in();
 }
 
@@ -193,6 +194,8 @@ void Simulation::step(const TickInput& input, std::span<const ParameterCommand> 
     // Who runs a loop's chunks changes no bit of the state.
     if (physics_helper_) {
       const bool helped = physics_helper_free();
+      waited_ticks_ = (waited_ticks_ << 1) | (waited_ ? 1u : 0u);
+      waited_ = false;
       tissue_->share_loops_with(helped ? physics_helper_.get() : nullptr);
       if (!helped) physics_helper_->send_home();  // called in by prepare_for_tick(), not needed after all
     }

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -203,8 +204,13 @@ class Simulation {
   JobThread* collision_thread() { return collision_thread_.get(); }
   /// Real time, about a spin ahead of each tick: calls in the physics helper if the coming tick's
   /// physics will share its loops with it, so the helper is running when they begin (a sleeping
-  /// helper on an idle virtual CPU takes tens of microseconds to wake). Changes no state.
+  /// helper on an idle virtual CPU takes tens of microseconds to wake). Changes no state. Called
+  /// only when the core waits for a tick: a paced core that waits for fewer than half of its ticks
+  /// is overloaded, and gives up the helper until it keeps time again.
   void prepare_for_tick();
+  /// The ticks are paced in real time (prepare_for_tick() is called whenever the core waits for one),
+  /// so the helper's use can follow whether the core keeps time. Changes no state.
+  void set_paced() { paced_ = true; }
   /// The physics step's helper thread (physics_threads = 2), else nullptr.
   LoopHelper* physics_helper() { return physics_helper_.get(); }
 
@@ -293,7 +299,16 @@ class Simulation {
   double contact_force_sum_n_ = 0.0;
   ProcedureMetrics metrics_;
   /// Whether the next physics step may share its loops with the helper (see prepare_for_tick()).
-  bool physics_helper_free() const { return physics_helper_ && (!collision_thread_ || collision_thread_->idle()); }
+  bool physics_helper_free() const {
+    return physics_helper_ && (!collision_thread_ || collision_thread_->idle()) && !(paced_ && std::popcount(waited_ticks_) < 16);
+  }
+  // A paced (real-time) core that waited before fewer than half of its last 32 ticks is overloaded:
+  // the model is too large for the machine (a catch-up after a stall is a few ticks). It then runs
+  // without the helper, which would otherwise hold the second processor too and starve every other
+  // thread (the console drew one frame a second at 34560 triangles), until it keeps time again.
+  bool paced_ = false;                    // set_paced(): the ticks are paced in real time
+  bool waited_ = false;                   // ... and was, before the coming tick
+  std::uint32_t waited_ticks_ = ~0u;      // one bit per recent tick: whether the core waited for it
   std::unique_ptr<LoopHelper> physics_helper_;
   std::unique_ptr<JobThread> collision_thread_;  // last: stops before what its job uses goes
 };

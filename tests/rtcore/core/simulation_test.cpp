@@ -93,6 +93,40 @@ TEST(Simulation, ThePhysicsHelperChangesNoBit) {
   EXPECT_GT((*sim)->physics_helper()->chunks_helped(), 0u) << "the helper never ran a chunk: the comparison above proved nothing";
 }
 
+TEST(Simulation, APacedCoreThatStopsWaitingGivesUpTheHelper) {
+  // Batch ticks (never paced) always share; once paced, a core that waited before fewer than half of
+  // its last 32 ticks runs alone, until it keeps time again.
+  SimulationConfig config = small_config();
+  config.collision_thread = false;
+  config.physics_threads = 2;
+  auto sim = Simulation::create(config);
+  ASSERT_TRUE(sim) << sim.error();
+  LoopHelper& helper = *(*sim)->physics_helper();
+  std::uint64_t tick = 0;
+  auto run = [&](int ticks, bool waiting) {
+    for (int k = 0; k < ticks; ++k, ++tick) {
+      if (waiting) (*sim)->prepare_for_tick();
+      (*sim)->step(input_at(tick, config.tick_s()), {});
+    }
+  };
+  run(40, false);
+  EXPECT_GT(helper.chunks_offered(), 0u) << "batch ticks share their loops";
+  (*sim)->set_paced();
+  run(20, true);
+  const std::uint64_t on_time = helper.chunks_offered();
+  run(1, false);
+  EXPECT_GT(helper.chunks_offered(), on_time) << "one tick behind is a catch-up, not an overload";
+  run(20, false);  // now behind for 21 of the last 32
+  const std::uint64_t overloaded = helper.chunks_offered(), helped = helper.chunks_helped();
+  run(20, false);
+  EXPECT_EQ(helper.chunks_offered(), overloaded) << "overloaded: no loop is offered to the helper";
+  EXPECT_EQ(helper.chunks_helped(), helped);
+  run(32, true);
+  const std::uint64_t recovered = helper.chunks_offered();
+  run(1, true);
+  EXPECT_GT(helper.chunks_offered(), recovered) << "keeping time again, the core shares again";
+}
+
 TEST(Simulation, ClearanceCertificatesGiveTheBruteForceState) {
   // Both tool parts, rolling, inserting and swinging into a lobe: skipping the points proven clear
   // of the tool changes no bit of the state.
