@@ -1,20 +1,17 @@
 // JobThread: a thread that runs one fixed job each time its owner launches it, and lets the owner wait
 // for that run to finish. The core launches the collision refit and search at one tick and waits for
 // it at a fixed later tick, so how long the job takes never changes what the core computes, only how
-// long the wait is. The handoff is two atomic counters and Linux futexes called directly: no mutex,
-// no allocation after construction. (Not std::atomic::wait: GCC 12's libstdc++ skips the wake when
-// its waiter count looks zero, and a test caught it losing a wake-up and deadlocking both threads.)
+// long the wait is. The handoff is two atomic counters and futexes (futex.h): no mutex, no allocation
+// after construction.
 #pragma once
-
-#include <linux/futex.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 
 #include <atomic>
 #include <cstdint>
 #include <functional>
 #include <thread>
 #include <utility>
+
+#include "rtcore/concurrency/futex.h"
 
 namespace resecto {
 
@@ -26,7 +23,7 @@ class JobThread {
     wait();
     stopping_.store(true, std::memory_order_relaxed);
     launched_.fetch_add(1, std::memory_order_release);
-    wake(launched_);
+    futex_wake_one(launched_);
     thread_.join();
   }
   JobThread(const JobThread&) = delete;
@@ -36,7 +33,7 @@ class JobThread {
   /// call is visible to the job.
   void launch() {
     launched_.fetch_add(1, std::memory_order_release);
-    wake(launched_);
+    futex_wake_one(launched_);
   }
 
   /// Owner only: returns once the last launched run has finished (at once if it has); what the job
@@ -46,7 +43,7 @@ class JobThread {
     std::uint32_t done = finished_.load(std::memory_order_acquire);
     if (done == target) return false;
     while (done != target) {
-      sleep_while_equal(finished_, done);
+      futex_sleep_while_equal(finished_, done);
       done = finished_.load(std::memory_order_acquire);
     }
     return true;
@@ -62,26 +59,17 @@ class JobThread {
   void run() {
     std::uint32_t seen = 0;
     for (;;) {
-      while (launched_.load(std::memory_order_acquire) == seen) sleep_while_equal(launched_, seen);
+      while (launched_.load(std::memory_order_acquire) == seen) futex_sleep_while_equal(launched_, seen);
       seen = launched_.load(std::memory_order_acquire);
       if (stopping_.load(std::memory_order_relaxed)) return;
       job_();
       finished_.store(seen, std::memory_order_release);
-      wake(finished_);
+      futex_wake_one(finished_);
     }
   }
 
-  // The kernel compares the word with `value` and sleeps in one step, so a wake between the caller's
-  // check and the sleep is never lost; spurious returns are fine, callers re-check.
-  static void sleep_while_equal(std::atomic<std::uint32_t>& word, std::uint32_t value) {
-    syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAIT_PRIVATE, value, nullptr, nullptr, 0);
-  }
-  static void wake(std::atomic<std::uint32_t>& word) {
-    syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAKE_PRIVATE, 1, nullptr, nullptr, 0);
-  }
 
   std::function<void()> job_;
-  static_assert(sizeof(std::atomic<std::uint32_t>) == sizeof(std::uint32_t) && std::atomic<std::uint32_t>::is_always_lock_free);
   std::atomic<std::uint32_t> launched_{0};
   std::atomic<std::uint32_t> finished_{0};
   std::atomic<bool> stopping_{false};

@@ -10,23 +10,16 @@
 // construction: the loop's body is passed as a function pointer and a context pointer.
 #pragma once
 
-#include <linux/futex.h>
 #include <sched.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 
 #include <atomic>
 #include <cstdint>
 #include <thread>
 
-namespace resecto {
+#include "rtcore/concurrency/futex.h"
+#include "rtcore/concurrency/spin_pause.h"
 
-/// One turn of a spin-wait: tells the core (and a hypervisor) that this is a spin.
-inline void spin_pause() {
-#if defined(__x86_64__) || defined(__i386__)
-  __builtin_ia32_pause();
-#endif
-}
+namespace resecto {
 
 class LoopHelper {
  public:
@@ -37,7 +30,7 @@ class LoopHelper {
   ~LoopHelper() {
     stopping_.store(true, std::memory_order_relaxed);
     on_call_.store(1, std::memory_order_release);
-    wake(on_call_);
+    futex_wake_one(on_call_);
     thread_.join();
   }
   LoopHelper(const LoopHelper&) = delete;
@@ -45,7 +38,7 @@ class LoopHelper {
 
   /// Owner: wakes the helper to take part in the loops that follow, until send_home().
   void call_in() {
-    if (on_call_.exchange(1, std::memory_order_release) == 0) wake(on_call_);
+    if (on_call_.exchange(1, std::memory_order_release) == 0) futex_wake_one(on_call_);
   }
   /// Owner: the helper goes back to sleep once it sees this (no loop is running: for_each_chunk has
   /// returned).
@@ -119,7 +112,7 @@ class LoopHelper {
   void run() {
     std::uint32_t seen = 0;
     for (;;) {
-      while (on_call_.load(std::memory_order_acquire) == 0) sleep_while_zero(on_call_);
+      while (on_call_.load(std::memory_order_acquire) == 0) futex_sleep_while_equal(on_call_, 0);
       if (stopping_.load(std::memory_order_relaxed)) return;
       const std::uint64_t w = work_.load(std::memory_order_acquire);
       const std::uint32_t generation = generation_of(w);
@@ -141,12 +134,6 @@ class LoopHelper {
     }
   }
 
-  static void sleep_while_zero(std::atomic<std::uint32_t>& word) {
-    syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAIT_PRIVATE, 0, nullptr, nullptr, 0);
-  }
-  static void wake(std::atomic<std::uint32_t>& word) {
-    syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAKE_PRIVATE, 1, nullptr, nullptr, 0);
-  }
 
   std::uint32_t generation_ = 0;  // owner only
   std::uint64_t offered_ = 0;     // owner only

@@ -5,6 +5,8 @@
 
 #include <cerrno>
 
+#include "rtcore/concurrency/spin_pause.h"
+
 namespace resecto {
 
 void FixedStepScheduler::sleep_until(std::int64_t deadline_ns) {
@@ -34,11 +36,7 @@ void FixedStepScheduler::wait_until(std::int64_t deadline_ns) {
   if (wake_hook_ != nullptr) wake_hook_(wake_context_);
   // The spin is running time: the next cycle counts it from here.
   awake_since_ns_ = FrameProfiler::now_ns();
-  while (FrameProfiler::now_ns() < deadline_ns) {
-#if defined(__x86_64__) || defined(__i386__)
-    __builtin_ia32_pause();  // tells the core (and a hypervisor) this is a spin
-#endif
-  }
+  while (FrameProfiler::now_ns() < deadline_ns) spin_pause();
 }
 
 }  // namespace resecto

@@ -143,12 +143,4 @@ void add_spring_sums(const SpringIncidence& incidence, const SpringForce* f, Vec
   }
 }
 
-std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v) {
-  return spring_forces(springs, x, v, 0, springs.i.size(), springs.compressed.data());
-}
-
-void add_spring_sums(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t node_count) {
-  add_spring_sums(incidence, f, force, 0, node_count);
-}
-
 }  // namespace resecto

@@ -64,9 +64,4 @@ std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v, s
 /// The fastest node sums this processor runs, over nodes [begin, end).
 void add_spring_sums(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t begin, std::size_t end);
 
-/// The fastest kernels this processor runs, over all springs (listing the compressed ones in
-/// springs.compressed) and all nodes.
-std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v);
-void add_spring_sums(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t node_count);
-
 }  // namespace resecto

@@ -40,12 +40,17 @@ TEST(FixedStepScheduler, RealTimeTakesTheScheduledTimeAndCountsAnOverrun) {
   EXPECT_GE(scheduler.report().max_late_us, 2000.0);
 }
 
-TEST(FixedStepScheduler, SpinningTheLastStretchNeverStartsATickEarly) {
+/// Real time at 1 ms ticks, the last 300 us before each spun.
+SchedulerConfig spinning_schedule() {
   SchedulerConfig config;
   config.realtime = true;
   config.period_ns = 1'000'000;
   config.spin_ns = 300'000;
-  FixedStepScheduler scheduler(config);
+  return config;
+}
+
+TEST(FixedStepScheduler, SpinningTheLastStretchNeverStartsATickEarly) {
+  FixedStepScheduler scheduler(spinning_schedule());
   std::vector<std::int64_t> starts;
   starts.reserve(50);
   scheduler.run(0, 50, [&](std::uint64_t) {
@@ -58,11 +63,7 @@ TEST(FixedStepScheduler, SpinningTheLastStretchNeverStartsATickEarly) {
 }
 
 TEST(FixedStepScheduler, TheWakeHookRunsOnceBeforeEachWaitedTickAndAheadOfIt) {
-  SchedulerConfig config;
-  config.realtime = true;
-  config.period_ns = 1'000'000;
-  config.spin_ns = 300'000;
-  FixedStepScheduler scheduler(config);
+  FixedStepScheduler scheduler(spinning_schedule());
   std::vector<std::int64_t> wakes, starts;
   wakes.reserve(50);
   starts.reserve(50);
