@@ -94,6 +94,13 @@ void CoreSession::stop() {
   if (live_) live_->link().stop();
 }
 
+void CoreSession::prepare_for_tick() {
+  // Only for a tick that steps: called in for a paused or slowed tick, the helper would spin on call
+  // through it (until it went home by itself) and again at every such tick, a processor held for
+  // nothing while the console waits. A batch step while paused runs without it.
+  if (!status_.paused && speed_credit_ + status_.speed >= 1.0) sim_->prepare_for_tick();
+}
+
 void CoreSession::run_core() {
   // The core first, the collision thread next, as in the headless real-time run; the console's own
   // thread stays at normal priority, so a slow frame can never hold a tick back.
@@ -105,7 +112,7 @@ void CoreSession::run_core() {
   }
   const double period_ns = static_cast<double>(schedule_for(options_).period_ns);
   sim_->set_paced();
-  scheduler_.set_wake_hook([](void* simulation) { static_cast<Simulation*>(simulation)->prepare_for_tick(); }, sim_.get());
+  scheduler_.set_wake_hook([](void* session) { static_cast<CoreSession*>(session)->prepare_for_tick(); }, this);
   scheduler_.run(0, UINT64_MAX / 2, [&](std::uint64_t) {
     if (stop_requested_.load(std::memory_order_acquire)) return false;
     const std::int64_t begin_ns = FrameProfiler::now_ns();

@@ -138,6 +138,8 @@ class CoreSession {
  private:
   CoreSession(const CoreSessionOptions& options, std::unique_ptr<Simulation> sim);
   void run_core();
+  /// The scheduler's wake hook: readies the physics helper for the coming tick if it will step.
+  void prepare_for_tick();
   void take_controls();
   void step_once();
   void publish();

@@ -6,13 +6,18 @@
 // for a chunk the helper has already claimed.
 //
 // The helper sleeps on a futex between ticks and is called in for the loops of one step (it then
-// spins, so a chunk starts within a fraction of a microsecond). No mutex, no allocation after
-// construction: the loop's body is passed as a function pointer and a context pointer.
+// spins, so a chunk starts within a fraction of a microsecond). Called in for loops that do not come
+// (the owner stopped or paused between call_in() and its step), it goes home by itself after
+// kIdleOnCall: spinning at a real-time priority it would hold a processor from every lower thread,
+// the owner's own collision job among them, and two such processes on two processors then wait on
+// each other for ever. No mutex, no allocation after construction: the loop's body is passed as a
+// function pointer and a context pointer.
 #pragma once
 
 #include <sched.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <thread>
 
@@ -25,6 +30,9 @@ class LoopHelper {
  public:
   /// The most chunks one loop may have.
   static constexpr std::uint32_t kMaxChunks = 0xffff;
+  /// How long the helper stays on call with no new loop before it goes home by itself: far longer
+  /// than any gap between one step's loops (its serial parts) at a size that runs in real time.
+  static constexpr std::chrono::milliseconds kIdleOnCall{5};
 
   LoopHelper() : thread_([this] { run(); }) {}
   ~LoopHelper() {
@@ -43,6 +51,8 @@ class LoopHelper {
   /// Owner: the helper goes back to sleep once it sees this (no loop is running: for_each_chunk has
   /// returned).
   void send_home() { on_call_.store(0, std::memory_order_relaxed); }
+  /// Whether the helper is on call (called in, and not yet sent or gone home).
+  bool on_call() const { return on_call_.load(std::memory_order_relaxed) != 0; }
 
   /// Owner: body(chunk) for every chunk in [0, chunks), run by this thread and the helper (if it is on
   /// call); returns once all have run, with their writes visible. A loop of more than kMaxChunks
@@ -81,6 +91,8 @@ class LoopHelper {
   std::uint64_t chunks_helped() const { return helped_.load(std::memory_order_relaxed); }
   /// Owner: how many chunks its loops have had in all.
   std::uint64_t chunks_offered() const { return offered_; }
+  /// How many times the helper went home by itself, called in for loops that did not come.
+  std::uint64_t times_gone_home() const { return gone_home_.load(std::memory_order_relaxed); }
 
  private:
   // work_: generation (32 bits) | end of the unclaimed chunks (16) | start of the unclaimed chunks (16).
@@ -111,15 +123,31 @@ class LoopHelper {
 
   void run() {
     std::uint32_t seen = 0;
+    std::uint32_t idle_spins = 0;
+    std::chrono::steady_clock::time_point idle_since{};
     for (;;) {
-      while (on_call_.load(std::memory_order_acquire) == 0) futex_sleep_while_equal(on_call_, 0);
+      if (on_call_.load(std::memory_order_acquire) == 0) {
+        while (on_call_.load(std::memory_order_acquire) == 0) futex_sleep_while_equal(on_call_, 0);
+        idle_spins = 0;
+      }
       if (stopping_.load(std::memory_order_relaxed)) return;
       const std::uint64_t w = work_.load(std::memory_order_acquire);
       const std::uint32_t generation = generation_of(w);
       if (generation == seen) {
+        // The clock only now and then: a pause lasts tens of cycles on one processor, over a hundred
+        // on another. Going home is always safe: the owner never waits for the helper to arrive.
+        if (idle_spins++ % 1024 == 0) {
+          const auto now = std::chrono::steady_clock::now();
+          if (idle_spins == 1) idle_since = now;
+          if (now - idle_since > kIdleOnCall) {
+            std::uint32_t called = 1;
+            if (on_call_.compare_exchange_strong(called, 0, std::memory_order_relaxed)) gone_home_.fetch_add(1, std::memory_order_relaxed);
+          }
+        }
         spin_pause();
         continue;
       }
+      idle_spins = 0;
       seen = generation;
       std::uint32_t ran = 0;
       for (std::uint32_t chunk = 0; claim(generation, false, chunk);) {
@@ -144,6 +172,7 @@ class LoopHelper {
   alignas(64) std::atomic<std::uint32_t> on_call_{0};
   std::atomic<bool> stopping_{false};
   std::atomic<std::uint64_t> helped_{0};
+  std::atomic<std::uint64_t> gone_home_{0};
   std::thread thread_;  // last: starts once the rest exists
 };
 

@@ -118,6 +118,10 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const SimulationConfig& c
   return sim;
 }
 
+Simulation::~Simulation() {
+  if (physics_helper_) physics_helper_->send_home();
+}
+
 int default_physics_threads() { return std::thread::hardware_concurrency() >= 2 ? 2 : 1; }
 
 RaisedThreads raise_simulation_threads(Simulation& sim) {

@@ -164,6 +164,9 @@ class Simulation {
  public:
   /// Builds the gland, its tetrahedral model, the tissue and the tool. Allocates everything here.
   static Result<std::unique_ptr<Simulation>> create(const SimulationConfig& config);
+  /// Sends the physics helper home first: called in by prepare_for_tick() for a tick that never
+  /// came, it would spin at the core's priority while the collision thread waits to be joined.
+  ~Simulation();
 
   /// Runs tick `tick()`: applies the commands stamped for it, places the tool; on collision ticks
   /// takes in the previous collision step (its edited copy of the tissue becomes the front, its
@@ -213,6 +216,7 @@ class Simulation {
   void set_paced() { paced_ = true; }
   /// The physics step's helper thread (physics_threads = 2), else nullptr.
   LoopHelper* physics_helper() { return physics_helper_.get(); }
+  const LoopHelper* physics_helper() const { return physics_helper_.get(); }
 
   /// Copies the publishable state into `snapshot` (whose surface array is sized by make_snapshot()).
   void fill_snapshot(SimulationSnapshot& snapshot) const;

@@ -66,6 +66,32 @@ TEST(CoreSession, PauseHoldsAndStepsRunExactlyTheTicksAsked) {
   EXPECT_EQ(session.simulation().tick(), paused.next_tick + 1000);
 }
 
+TEST(CoreSession, APausedCoreLeavesThePhysicsHelperAsleep) {
+  // The scheduler wakes the physics helper ahead of every tick; for a tick that will not step it
+  // must not, or the helper spins through it at the core's priority (once it outlived the run and,
+  // with two consoles on two processors, held the collision thread from ever being joined).
+  CoreSessionOptions options = lockstep_demo();
+  options.simulation.physics_threads = 2;
+  Result<std::unique_ptr<CoreSession>> created = CoreSession::create(options);
+  ASSERT_TRUE(created);
+  CoreSession& session = **created;
+  const LoopHelper* helper = session.simulation().physics_helper();
+  ASSERT_NE(helper, nullptr);
+  session.start();
+  wait_for(session, [](const CoreStatus& s) { return s.next_tick > 200; });
+  ASSERT_TRUE(session.send({CoreControlKind::kPause, {}, 0, 0, 1.0, {}}));
+  wait_for(session, [](const CoreStatus& s) { return s.paused; });
+  // The tick the pause arrived in may have called it in already: it goes home by itself.
+  std::this_thread::sleep_for(2 * LoopHelper::kIdleOnCall + std::chrono::milliseconds(10));
+  const std::uint64_t gone_home = helper->times_gone_home();
+  for (int look = 0; look < 20; ++look) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    EXPECT_FALSE(helper->on_call()) << "look " << look;
+  }
+  EXPECT_EQ(helper->times_gone_home(), gone_home) << "called in again while paused";
+  session.stop();
+}
+
 TEST(CoreSession, LockstepRunIsTheHeadlessRunAndAStampedChangeAppliesAtItsTick) {
   Result<std::unique_ptr<CoreSession>> created = CoreSession::create(lockstep_demo());
   ASSERT_TRUE(created);

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <thread>
 #include <vector>
@@ -90,6 +92,35 @@ TEST(LoopHelper, ALoopOfMoreChunksThanItCanCountRunsOnTheCaller) {
   helper.send_home();
   EXPECT_EQ(std::count(runs.begin(), runs.end(), 1), static_cast<std::ptrdiff_t>(chunks));
   EXPECT_EQ(helper.chunks_helped(), 0u);
+}
+
+TEST(LoopHelper, CalledInForLoopsThatDoNotComeItGoesHomeByItself) {
+  // A core stopped or paused between call_in() and its step must not leave the helper spinning (at
+  // a real-time priority that holds a processor from every lower thread for as long as it lasts).
+  LoopHelper helper;
+  helper.call_in();
+  const auto called = std::chrono::steady_clock::now();
+  while (helper.on_call() && std::chrono::steady_clock::now() - called < std::chrono::seconds(10)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_FALSE(helper.on_call());
+  EXPECT_GE(std::chrono::steady_clock::now() - called, LoopHelper::kIdleOnCall);
+  EXPECT_EQ(helper.times_gone_home(), 1u);
+  // Called in again, it takes part as before, and every chunk still runs exactly once.
+  std::vector<std::atomic<int>> runs(64);
+  auto body = [&](std::uint32_t chunk) {
+    runs[chunk].fetch_add(1, std::memory_order_relaxed);
+    std::this_thread::sleep_for(std::chrono::microseconds(20));
+  };
+  int loops = 0;
+  for (; loops < 200 && helper.chunks_helped() == 0; ++loops) {
+    helper.call_in();
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    helper.for_each_chunk(64, body);
+    helper.send_home();
+  }
+  EXPECT_GT(helper.chunks_helped(), 0u);
+  for (std::size_t chunk = 0; chunk < runs.size(); ++chunk) EXPECT_EQ(runs[chunk].load(), loops) << "chunk " << chunk;
 }
 
 TEST(LoopHelper, DestructionJoinsWhetherAsleepOrOnCall) {
