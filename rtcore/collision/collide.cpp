@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rtcore/base/state_hash.h"
 #include "rtcore/geometry/triangle_triangle.h"
 
 namespace resecto {
@@ -72,14 +73,39 @@ void Collider::reserve_tissue_nodes(std::int32_t max_nodes) {
   stack_.reserve(1024);  // the descent needs about the tree's height
 }
 
+namespace {
+
+std::uint64_t fingerprint(const TriangleMesh& mesh) {
+  StateHasher hasher;
+  hasher.add(std::span<const Vec3>(mesh.positions));
+  hasher.add(std::span<const Triangle>(mesh.triangles));
+  return hasher.value() | 1u;  // never 0, which means no tool
+}
+
+}  // namespace
+
+void Collider::prepare_tool(const TriangleMesh& tool) {
+  field_.build(tool);
+  field_tool_ = fingerprint(tool);
+}
+
 void Collider::prepare(const SphereTree& tissue_tree, const SphereTree& tool_tree, const TriangleMesh& tool) {
   // resize() allocates only when a tree has grown past every size seen before.
   const auto tissue_nodes = static_cast<std::size_t>(tissue_tree.node_capacity());
   const auto tool_nodes = static_cast<std::size_t>(tool_tree.node_capacity());
-  tool_spheres_.resize(tool_nodes);
-  tool_slabs_.resize(tool_nodes);
   tool_vertices_.resize(tool.vertex_count());
   tool_boxes_.resize(tool.triangle_count());
+  l1_stamp_.resize(tissue_nodes, 0);
+  l1_.resize(tissue_nodes);
+  if (method_ == CollisionMethod::kToolField) {
+    if (field_tool_ != fingerprint(tool)) prepare_tool(tool);
+    // Depth-first over one tree: each step pushes at most two nodes, so the height bounds the stack.
+    node_stack_.resize(static_cast<std::size_t>(tissue_tree.links()[tissue_tree.root()].height) + 2);
+    stack_.resize(static_cast<std::size_t>(tool_tree.links()[tool_tree.root()].height) + 2);
+    return;
+  }
+  tool_spheres_.resize(tool_nodes);
+  tool_slabs_.resize(tool_nodes);
   tool_chain_begin_.resize(tool.triangle_count() + 1);
   tool_chain_.resize(static_cast<std::size_t>(tool_tree.leaf_count()));
   tool_leaf_rank_.resize(tool_nodes);
@@ -93,8 +119,6 @@ void Collider::prepare(const SphereTree& tissue_tree, const SphereTree& tool_tre
     }
   }
   tool_chain_begin_[tool.triangle_count()] = at;
-  l1_stamp_.resize(tissue_nodes, 0);
-  l1_.resize(tissue_nodes);
   l2_stamp_.resize(tool_nodes, 0);
   l2_.resize(tool_nodes);
   const std::int32_t heights = tissue_tree.links()[tissue_tree.root()].height + tool_tree.links()[tool_tree.root()].height;
@@ -138,6 +162,10 @@ void Collider::test_triangles(const TriangleMesh& tissue, std::uint32_t a, std::
       std::max({p0.z, p1.z, p2.z}) < box.min.z || box.max.z < std::min({p0.z, p1.z, p2.z})) {
     return;
   }
+  exact_test(a, p0, p1, p2, b);
+}
+
+void Collider::exact_test(std::uint32_t a, const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t b) {
   ++stats_.triangle_tests;
   const Triangle& tb = tool_mesh_->triangles[b];
   if (!triangles_intersect(p0, p1, p2, tool_vertices_[tb[0]], tool_vertices_[tb[1]], tool_vertices_[tb[2]])) return;
@@ -214,8 +242,10 @@ bool Collider::begin_query(const SphereTree& tissue_tree, const SphereTree& tool
   tool_mesh_ = &tool;
   // Place the tool once: its tree and mesh are small next to the work of the descent.
   const std::vector<Sphere>& tool_rest = tool_tree.spheres();
-  for (std::size_t n = 0; n < tool_rest.size(); ++n) {
-    tool_spheres_[n] = {pose_.apply_point(tool_rest[n].center), tool_rest[n].radius * radius_scale_};
+  if (method_ == CollisionMethod::kDualDescent) {
+    for (std::size_t n = 0; n < tool_rest.size(); ++n) {
+      tool_spheres_[n] = {pose_.apply_point(tool_rest[n].center), tool_rest[n].radius * radius_scale_};
+    }
   }
   for (std::size_t v = 0; v < tool_vertices_.size(); ++v) tool_vertices_[v] = pose_.apply_point(tool.positions[v]);
   for (std::size_t u = 0; u < tool_boxes_.size(); ++u) {
@@ -232,6 +262,15 @@ bool Collider::begin_query(const SphereTree& tissue_tree, const SphereTree& tool
                            max_abs(tissue_tree.spheres()[tissue_tree.root()].center) +
                            tissue_tree.spheres()[tissue_tree.root()].radius;
   slack_ = 1e-12 * magnitude;
+  if (method_ == CollisionMethod::kToolField) {
+    // Tissue points go to the tool's frame; a stretch of the inverse is allowed for in the radii.
+    inverse_rotation_ = glm::inverse(tool_pose.rotation);
+    RigidPose inverse_only;
+    inverse_only.rotation = inverse_rotation_;
+    inverse_scale_ = stretch_bound(inverse_only);
+    slabs_ = false;
+    return true;
+  }
   // A slab keeps its meaning under a rotation only: the pose's deviation from one (R^T R - I) is
   // measured, and beyond rounding the query falls back to the spheres, which allow any stretch.
   const auto& r = tool_pose.rotation;
@@ -412,6 +451,122 @@ void Collider::descend(NodePair start) {
   stats_.sphere_tests += tests;
 }
 
+// ---- The field method --------------------------------------------------------------------------
+
+double Collider::field_gap(std::int32_t tissue_node) const {
+  const Sphere& s = tissue_tree_->spheres()[static_cast<std::size_t>(tissue_node)];
+  // A gap in the tool's frame is at least inverse_scale_ times the gap in the world.
+  return field_.clearance().ball_clearance(to_tool(s.center), s.radius * inverse_scale_ + slack_) / inverse_scale_;
+}
+
+void Collider::visit_field_leaf(std::int32_t leaf, const Vec3& centre, double radius) {
+  if (l1_stamp_[static_cast<std::size_t>(leaf)] != stamp_) {
+    l1_stamp_[static_cast<std::size_t>(leaf)] = stamp_;
+    l1_[l1_count_++] = leaf;
+  }
+  if (!pairs_wanted_) return;
+  const LeafPiece& a = tissue_tree_->pieces()[static_cast<std::size_t>(leaf)];
+  // A triangle of several leaves can reach a tool triangle through each: the table decides.
+  const bool sliced = a.slices > 1;
+  std::span<const std::uint32_t> near;
+  if (field_.near(centre, radius, near)) {
+    stats_.leaf_pairs += static_cast<std::int64_t>(near.size());
+    const TriangleMesh& tissue = *tissue_mesh_;
+    const Triangle& ta = tissue.triangles[a.triangle];
+    const Vec3& p0 = tissue.positions[ta[0]];
+    const Vec3& p1 = tissue.positions[ta[1]];
+    const Vec3& p2 = tissue.positions[ta[2]];
+    const Aabb box{glm::min(p0, glm::min(p1, p2)), glm::max(p0, glm::max(p1, p2))};
+    // The tissue triangle in the tool's frame, its box grown by the slack for the transform's rounding.
+    const Vec3 t0 = to_tool(p0), t1 = to_tool(p1), t2 = to_tool(p2);
+    const Aabb local{glm::min(t0, glm::min(t1, t2)) - Vec3(slack_), glm::max(t0, glm::max(t1, t2)) + Vec3(slack_)};
+    for (std::uint32_t b : near) {
+      // The tissue triangle clear of the tool triangle's box or of its plane (in the tool's frame,
+      // where the sheath's long triangles have thin boxes), then the boxes in the world (exact on
+      // the coordinates, as brute force's): none can lose a pair.
+      const ToolPlane& plane = field_.plane(b);
+      if (local.max.x < plane.box.min.x || plane.box.max.x < local.min.x || local.max.y < plane.box.min.y ||
+          plane.box.max.y < local.min.y || local.max.z < plane.box.min.z || plane.box.max.z < local.min.z) {
+        continue;
+      }
+      const double d0 = dot(plane.normal, t0) - plane.offset;
+      const double d1 = dot(plane.normal, t1) - plane.offset;
+      const double d2 = dot(plane.normal, t2) - plane.offset;
+      const double apart = plane.thickness + slack_;
+      if (std::min({d0, d1, d2}) > apart || std::max({d0, d1, d2}) < -apart) continue;
+      const Aabb& other = tool_boxes_[b];
+      if (box.max.x < other.min.x || other.max.x < box.min.x || box.max.y < other.min.y ||
+          other.max.y < box.min.y || box.max.z < other.min.z || other.max.z < box.min.z) {
+        continue;
+      }
+      if (sliced && !first_test_of(a.triangle, b)) continue;
+      exact_test(a.triangle, p0, p1, p2, b);
+    }
+    return;
+  }
+  // A leaf past the field's largest reach (a coarse tissue): the tool's own tree, in its frame.
+  const Sphere* tool_spheres = tool_tree_->spheres().data();
+  const SphereTreeLinks* tool_links = tool_tree_->links().data();
+  const Sphere ball{centre, radius};
+  NodePair* const stack = stack_.data();
+  std::size_t top = 0;
+  stack[top++] = {leaf, tool_tree_->root()};
+  while (top > 0) {
+    const std::int32_t node = stack[--top].tool;
+    ++stats_.sphere_tests;
+    if (!spheres_meet(ball, tool_spheres[node], 0.0)) continue;
+    const SphereTreeLinks& links = tool_links[node];
+    if (links.left == SphereTree::kNoNode) {
+      ++stats_.leaf_pairs;
+      test_triangles(*tissue_mesh_, a.triangle, tool_tree_->pieces()[static_cast<std::size_t>(node)].triangle, true);
+      continue;
+    }
+    stack[top++] = {leaf, links.right};
+    stack[top++] = {leaf, links.left};
+  }
+}
+
+template <bool kRecord>
+void Collider::descend_field(std::int32_t start) {
+  const Sphere* spheres = tissue_tree_->spheres().data();
+  const SphereTreeLinks* links = tissue_tree_->links().data();
+  const ToolClearanceGrid& clearance = field_.clearance();
+  std::int32_t* const stack = node_stack_.data();
+  std::size_t top = 0;
+  stack[top++] = start;
+  std::int64_t tests = 0;
+  // Each node is placed in the tool's frame and tested once against the tool's clearance: no node
+  // pairs, so the work follows the tissue's spheres near the tool, not their products with the tool's.
+  while (top > 0) {
+    const std::int32_t node = stack[--top];
+    ++tests;
+    const Sphere& s = spheres[node];
+    const Vec3 centre = to_tool(s.center);
+    const double radius = s.radius * inverse_scale_ + slack_;
+    if constexpr (kRecord) {
+      const double g = clearance.ball_clearance(centre, radius);
+      if (g > 0.0) {
+        record({node, SphereTree::kNoNode}, travel_ + g / inverse_scale_);
+        continue;
+      }
+    } else {
+      if (!clearance.ball_may_touch(centre, radius)) continue;
+    }
+    const SphereTreeLinks& l = links[node];
+    if (l.left == SphereTree::kNoNode) {
+      visit_field_leaf(node, centre, radius);
+      if constexpr (kRecord) record({node, SphereTree::kNoNode}, -1.0);  // walked again every call
+      continue;
+    }
+    // The left child is next and usually the next node in memory (depth-first numbering); the right
+    // waits on the stack, so its load is started now.
+    __builtin_prefetch(spheres + l.right);
+    stack[top++] = l.right;
+    stack[top++] = l.left;
+  }
+  stats_.sphere_tests += tests;
+}
+
 void Collider::finish_query() {
   // Sorted on the (tissue, tool) key, each once: the same output whatever the walk order.
   const auto end = pairs_.begin() + static_cast<std::ptrdiff_t>(pair_count_);
@@ -423,7 +578,11 @@ bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue
                        const TriangleMesh& tool, const RigidPose& tool_pose) {
   if (!begin_query(tissue_tree, tool_tree, tool, tool_pose)) return true;
   tissue_mesh_ = &tissue;
-  descend<false>({tissue_tree.root(), tool_tree.root()});
+  if (method_ == CollisionMethod::kToolField) {
+    descend_field<false>(tissue_tree.root());
+  } else {
+    descend<false>({tissue_tree.root(), tool_tree.root()});
+  }
   finish_query();
   return !overflowed_;
 }
@@ -441,11 +600,14 @@ bool Collider::collide_sequence(const SphereTree& tissue_tree, const TriangleMes
     return true;
   }
   tissue_mesh_ = &tissue;
+  const bool field = method_ == CollisionMethod::kToolField;
+  // The dual descent's certificates need the slabs' rigid pose; the field's hold for any pose.
+  const bool certifiable = field || slabs_;
   const bool same_trees = front_tissue_tree_ == &tissue_tree && front_tool_tree_ == &tool_tree &&
                           front_tissue_version_ == tissue_tree.structure_version() &&
                           front_tool_version_ == tool_tree.structure_version() &&
                           previous_tool_vertices_.size() == tool_vertices_.size();
-  bool fresh = !front_valid_ || !same_trees || !slabs_ || tissue_travel_m < last_tissue_travel_ ||
+  bool fresh = !front_valid_ || !same_trees || !certifiable || tissue_travel_m < last_tissue_travel_ ||
                front_count_ > 2 * fresh_front_count_ + 1024;
   if (!fresh) {
     // How far the tool moved since the last call: its largest vertex displacement (a point of a
@@ -455,39 +617,7 @@ bool Collider::collide_sequence(const SphereTree& tissue_tree, const TriangleMes
       moved2 = std::max(moved2, length_squared(tool_vertices_[v] - previous_tool_vertices_[v]));
     }
     travel_ += std::sqrt(moved2) * (1.0 + 1e-9) + slack_ + (tissue_travel_m - last_tissue_travel_) * (1.0 + 1e-9);
-    const std::size_t cached = front_count_;
-    const Sphere* tissue_spheres = tissue_tree.spheres().data();
-    const Slab* tissue_slabs = tissue_tree.slabs().data();
-    const SphereTreeLinks* tissue_links = tissue_tree.links().data();
-    constexpr std::size_t kAhead = 16;  // the cached pairs lie scattered over the tissue's arrays
-    for (std::size_t i = 0; i < cached; ++i) {
-      if (i + kAhead < cached) {
-        const NodePair ahead = front_pairs_[i + kAhead];
-        __builtin_prefetch(tissue_spheres + ahead.tissue);
-        __builtin_prefetch(tissue_slabs + ahead.tissue);
-        __builtin_prefetch(tissue_links + ahead.tissue);
-        __builtin_prefetch(tool_spheres_.data() + ahead.tool);
-        __builtin_prefetch(tool_slabs_.data() + ahead.tool);
-      }
-      if (front_expiry_[i] > travel_) continue;
-      ++stats_.front_renewed;
-      // Most renewed pairs are still apart: a new certificate in place, without a walk.
-      const NodePair pair = front_pairs_[i];
-      const bool leaves = tissue_tree.is_leaf(pair.tissue) && tool_tree.is_leaf(pair.tool);
-      if (!leaves) {
-        ++stats_.sphere_tests;
-        const double g = gap(pair.tissue, pair.tool);
-        if (g > 0.0) {
-          front_expiry_[i] = travel_ + g;
-          continue;
-        }
-      }
-      pending_slot_ = i;
-      has_pending_slot_ = true;
-      descend<true>(front_pairs_[i]);
-      has_pending_slot_ = false;
-    }
-    stats_.front_kept = static_cast<std::int64_t>(cached) - stats_.front_renewed;
+    renew_front(tissue_tree, tool_tree);
   } else {
     if (front_pairs_.empty() || front_overflowed_) {
       // Grown only here, off the steady state: a front that did not fit gets twice the room.
@@ -496,10 +626,14 @@ bool Collider::collide_sequence(const SphereTree& tissue_tree, const TriangleMes
     front_count_ = 0;
     front_overflowed_ = false;
     travel_ = 0.0;
-    descend<true>({tissue_tree.root(), tool_tree.root()});
+    if (field) {
+      descend_field<true>(tissue_tree.root());
+    } else {
+      descend<true>({tissue_tree.root(), tool_tree.root()});
+    }
     fresh_front_count_ = front_count_;
   }
-  front_valid_ = !front_overflowed_ && slabs_;
+  front_valid_ = !front_overflowed_ && certifiable;
   front_tissue_tree_ = &tissue_tree;
   front_tool_tree_ = &tool_tree;
   front_tissue_version_ = tissue_tree.structure_version();
@@ -508,6 +642,50 @@ bool Collider::collide_sequence(const SphereTree& tissue_tree, const TriangleMes
   previous_tool_vertices_.assign(tool_vertices_.begin(), tool_vertices_.end());
   finish_query();
   return !overflowed_;
+}
+
+// Every cached pair whose certificate ran out is tested again: most are still apart and get a new
+// certificate in place; the rest are walked from where the last walk stopped.
+void Collider::renew_front(const SphereTree& tissue_tree, const SphereTree& tool_tree) {
+  const bool field = method_ == CollisionMethod::kToolField;
+  const std::size_t cached = front_count_;
+  const Sphere* tissue_spheres = tissue_tree.spheres().data();
+  const Slab* tissue_slabs = tissue_tree.slabs().data();
+  const SphereTreeLinks* tissue_links = tissue_tree.links().data();
+  constexpr std::size_t kAhead = 16;  // the cached pairs lie scattered over the tissue's arrays
+  for (std::size_t i = 0; i < cached; ++i) {
+    if (i + kAhead < cached) {
+      const NodePair ahead = front_pairs_[i + kAhead];
+      __builtin_prefetch(tissue_spheres + ahead.tissue);
+      __builtin_prefetch(tissue_links + ahead.tissue);
+      if (!field) {
+        __builtin_prefetch(tissue_slabs + ahead.tissue);
+        __builtin_prefetch(tool_spheres_.data() + ahead.tool);
+        __builtin_prefetch(tool_slabs_.data() + ahead.tool);
+      }
+    }
+    if (front_expiry_[i] > travel_) continue;
+    ++stats_.front_renewed;
+    const NodePair pair = front_pairs_[i];
+    const bool leaves = tissue_tree.is_leaf(pair.tissue) && (field || tool_tree.is_leaf(pair.tool));
+    if (!leaves) {
+      ++stats_.sphere_tests;
+      const double g = field ? field_gap(pair.tissue) : gap(pair.tissue, pair.tool);
+      if (g > 0.0) {
+        front_expiry_[i] = travel_ + g;
+        continue;
+      }
+    }
+    pending_slot_ = i;
+    has_pending_slot_ = true;
+    if (field) {
+      descend_field<true>(pair.tissue);
+    } else {
+      descend<true>(pair);
+    }
+    has_pending_slot_ = false;
+  }
+  stats_.front_kept = static_cast<std::int64_t>(cached) - stats_.front_renewed;
 }
 
 std::vector<TrianglePair> collide_brute_force(const TriangleMesh& tissue, const TriangleMesh& tool,

@@ -1,6 +1,9 @@
-// The paper's dual descent (section 3.2, Figure 11): two sphere trees walked together to find every
-// intersecting triangle pair between the tissue and a rigid tool, and the colliding leaf lists L1 and
-// L2 the penalty response reads. Runs in the 60 Hz core step, so a query allocates nothing.
+// Every intersecting triangle pair between the tissue and a rigid tool. Two ways, same pairs: the
+// tissue's sphere tree descended alone against the tool's precomputed field (the default: a rigid
+// tool's proximity is worked out once in its own frame, so each tissue sphere is tested once rather
+// than against each tool sphere), or the paper's dual descent (section 3.2, Figure 11), two sphere
+// trees walked together, which also gives the colliding leaf lists L1 and L2 its penalty response
+// reads. Runs in the 60 Hz core step, so a query allocates nothing.
 #pragma once
 
 #include <cstdint>
@@ -8,6 +11,7 @@
 #include <vector>
 
 #include "rtcore/collision/sphere_tree.h"
+#include "rtcore/collision/tool_field.h"
 #include "rtcore/geometry/rigid_pose.h"
 
 namespace resecto {
@@ -20,12 +24,18 @@ struct TrianglePair {
   friend auto operator<=>(const TrianglePair&, const TrianglePair&) = default;
 };
 
+/// How a query finds the pairs (the pairs are the same either way).
+enum class CollisionMethod {
+  kToolField,    ///< the tissue's tree alone against the tool's ToolField
+  kDualDescent,  ///< the paper's: the tissue's and the tool's trees together
+};
+
 /// Work counters of the last query.
 struct CollisionStats {
-  std::int64_t sphere_tests = 0;    ///< node-pair bound tests (sphere, then the slabs)
-  std::int64_t front_kept = 0;      ///< sequence: cached node pairs whose certificate still held
-  std::int64_t front_renewed = 0;   ///< sequence: cached node pairs walked again
-  std::int64_t leaf_pairs = 0;      ///< leaf pairs whose spheres met
+  std::int64_t sphere_tests = 0;    ///< bound tests: node pairs (dual descent) or tissue nodes (field)
+  std::int64_t front_kept = 0;      ///< sequence: cached nodes or node pairs whose certificate still held
+  std::int64_t front_renewed = 0;   ///< sequence: cached nodes or node pairs walked again
+  std::int64_t leaf_pairs = 0;      ///< leaf pairs whose spheres met (field: tissue leaf, near tool triangle)
   std::int64_t triangle_tests = 0;  ///< exact triangle tests (after the box prefilter)
 };
 
@@ -41,6 +51,16 @@ class Collider {
   /// Room for tissue trees of up to `max_nodes` nodes (a tree that resection grows), so a query on
   /// one allocates nothing.
   void reserve_tissue_nodes(std::int32_t max_nodes);
+
+  /// Which way queries go (kToolField unless changed).
+  void set_method(CollisionMethod method) { method_ = method; front_valid_ = false; }
+  CollisionMethod method() const { return method_; }
+
+  /// Builds the tool's field for the field method, off the query path. A query checks the tool's
+  /// fingerprint (a hash of its vertices and triangles, about a microsecond for the resectoscope)
+  /// and builds the field first for a tool it has not seen.
+  void prepare_tool(const TriangleMesh& tool);
+  const ToolField& tool_field() const { return field_; }
 
   /// Finds every pair of intersecting closed triangles between the tissue and the tool placed at
   /// `tool_pose` (the tool tree is in tool coordinates; its spheres move with the pose, never
@@ -72,9 +92,11 @@ class Collider {
   /// the contact response needs: that skips every exact triangle test.
   void set_pairs_wanted(bool wanted) { pairs_wanted_ = wanted; }
   std::span<const TrianglePair> pairs() const { return {pairs_.data(), pair_count_}; }
-  /// L1: the tissue leaves whose spheres met a tool leaf sphere, each once, in the order found.
+  /// L1: the tissue leaves whose spheres met a tool leaf sphere (the field method: came within
+  /// reach of the tool's surface), each once, in the order found.
   std::span<const std::int32_t> tissue_leaves() const { return {l1_.data(), l1_count_}; }
-  /// L2: the tool leaves whose spheres met a tissue leaf sphere, each once, in the order found.
+  /// L2: the tool leaves whose spheres met a tissue leaf sphere, each once, in the order found. The
+  /// dual descent's only: the field method finds the tool's triangles without its leaves.
   std::span<const std::int32_t> tool_leaves() const { return {l2_.data(), l2_count_}; }
   bool overflowed() const { return overflowed_; }
   const CollisionStats& stats() const { return stats_; }
@@ -97,13 +119,28 @@ class Collider {
   template <bool kRecord>
   void descend(NodePair start);
   void visit_leaves(const NodePair& pair);
+  // The field method: the tissue's tree alone, in the tool's frame.
+  Vec3 to_tool(const Vec3& world) const { return inverse_rotation_ * (world - pose_.translation); }
+  double field_gap(std::int32_t tissue_node) const;
+  template <bool kRecord>
+  void descend_field(std::int32_t start);
+  void visit_field_leaf(std::int32_t leaf, const Vec3& centre, double radius);
+  void renew_front(const SphereTree& tissue_tree, const SphereTree& tool_tree);
   void record(const NodePair& pair, double expiry);
   void finish_query();
   bool first_test_of(std::uint32_t tissue_triangle, std::uint32_t tool_triangle);
   void test_triangles(const TriangleMesh& tissue, std::uint32_t a, std::uint32_t b, bool may_repeat);
+  /// The exact test of tissue triangle a (corners p0, p1, p2) against tool triangle b, as brute force's.
+  void exact_test(std::uint32_t a, const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t b);
   void next_stamp();
 
   RigidPose pose_;
+  CollisionMethod method_ = CollisionMethod::kToolField;
+  ToolField field_;
+  std::uint64_t field_tool_ = 0;  // the fingerprint of the tool the field was built for (0: none)
+  glm::dmat3 inverse_rotation_{1.0};  // the field method: world to the tool's frame (with the translation)
+  double inverse_scale_ = 1.0;        // bounds how much inverse_rotation_ can stretch a tissue sphere
+  std::vector<std::int32_t> node_stack_;  // the field method's descent
   // The trees and meshes of the running query.
   const SphereTree* tissue_tree_ = nullptr;
   const SphereTree* tool_tree_ = nullptr;

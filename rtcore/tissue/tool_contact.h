@@ -12,7 +12,7 @@
 #include "rtcore/collision/sphere_tree.h"
 #include "rtcore/geometry/rigid_pose.h"
 #include "rtcore/mesh/triangle_mesh.h"
-#include "rtcore/tissue/tool_proximity_grid.h"
+#include "rtcore/collision/tool_proximity_grid.h"
 
 namespace resecto {
 

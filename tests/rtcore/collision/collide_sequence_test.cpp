@@ -27,9 +27,14 @@ struct Scene {
   }
 };
 
+constexpr CollisionMethod kMethods[] = {CollisionMethod::kToolField, CollisionMethod::kDualDescent};
+
 TEST(CollideSequence, EveryFrameEqualsAFreshQueryAndBruteForce) {
   Scene scene(2816);
+  for (const CollisionMethod method : kMethods) {
   Collider fresh, sequence;
+  fresh.set_method(method);
+  sequence.set_method(method);
   std::int64_t kept = 0, pairs = 0;
   for (int run = 0; run < 3; ++run) {
     sequence.reset_sequence();
@@ -46,12 +51,15 @@ TEST(CollideSequence, EveryFrameEqualsAFreshQueryAndBruteForce) {
   }
   EXPECT_GT(pairs, 1000) << "the sweep must press into the wall";
   EXPECT_GT(kept, 0) << "no certificate was ever reused";
+  }
 }
 
 // Large jumps expire the certificates; standing still keeps them; exact either way.
 TEST(CollideSequence, JumpsAndStandstillsStayExact) {
   Scene scene(1296);
+  for (const CollisionMethod method : kMethods) {
   Collider sequence;
+  sequence.set_method(method);
   std::mt19937_64 rng(3);
   for (int i = 0; i < 60; ++i) {
     const RigidPose pose = (i % 3 == 2) ? random_channel_pose(rng) : channel_sweep_pose(i, 0.4);
@@ -66,6 +74,7 @@ TEST(CollideSequence, JumpsAndStandstillsStayExact) {
       }
     }
   }
+  }
 }
 
 // The tissue deforms between frames (its travel passed in) and loses and regains triangles (the
@@ -74,7 +83,8 @@ TEST(CollideSequence, FollowsDeformationAndCutting) {
   Scene scene(2816);
   TriangleMesh& surface = scene.prostate.surface;
   const std::vector<Vec3> rest = surface.positions;
-  Collider sequence;
+  Collider sequence, dual;
+  dual.set_method(CollisionMethod::kDualDescent);
   double travel = 0.0;
   std::vector<Vec3> previous = rest;
   std::vector<std::uint32_t> removed;
@@ -103,19 +113,24 @@ TEST(CollideSequence, FollowsDeformationAndCutting) {
     }
     const RigidPose pose = channel_sweep_pose(f, 2.5);
     ASSERT_TRUE(sequence.collide_sequence(scene.tissue_tree, surface, scene.tool_tree, scene.tool, pose, travel));
+    ASSERT_TRUE(dual.collide_sequence(scene.tissue_tree, surface, scene.tool_tree, scene.tool, pose, travel));
     auto expected = collide_brute_force(surface, scene.tool, pose);
     std::erase_if(expected, [&](const TrianglePair& p) {
       return scene.tissue_tree.first_leaf_of_triangle(p.tissue) == SphereTree::kNoNode;
     });
-    ASSERT_EQ(pairs_of(sequence), expected) << "frame " << f;
+    ASSERT_EQ(pairs_of(sequence), expected) << "frame " << f << " (field)";
+    ASSERT_EQ(pairs_of(dual), expected) << "frame " << f << " (dual descent)";
   }
   testing::expect_slabs_cover(scene.tissue_tree, surface);
 }
 
-// Slabs on and off give the same pairs; the slab leaf lists are a subset of the spheres' lists.
+// Slabs on and off give the dual descent the same pairs; the slab leaf lists are a subset of the
+// spheres' lists.
 TEST(CollideSequence, SlabsChangeTheWorkNotThePairs) {
   Scene scene(1296);
   Collider with, without;
+  with.set_method(CollisionMethod::kDualDescent);
+  without.set_method(CollisionMethod::kDualDescent);
   without.set_slabs(false);
   std::mt19937_64 rng(8);
   std::int64_t with_tests = 0, without_tests = 0;
@@ -156,7 +171,10 @@ TEST(CollideSequence, TreesWithoutSlabsUseTheSpheres) {
   EXPECT_FALSE(tissue_tree.has_slabs());
   EXPECT_TRUE(tool_tree.has_slabs());
   const std::vector<Vec3> rest = surface.positions;
+  for (const CollisionMethod method : kMethods) {
   Collider fresh, sequence;
+  fresh.set_method(method);
+  sequence.set_method(method);
   for (int f = 0; f < 40; ++f) {
     for (std::size_t v = 0; v < rest.size(); ++v) {
       const Vec3& p = rest[v];
@@ -169,6 +187,7 @@ TEST(CollideSequence, TreesWithoutSlabsUseTheSpheres) {
     ASSERT_TRUE(sequence.collide_sequence(tissue_tree, surface, tool_tree, tool, pose, 0.0004 * f));
     ASSERT_EQ(pairs_of(fresh), expected) << "frame " << f;
     ASSERT_EQ(pairs_of(sequence), expected) << "frame " << f;
+  }
   }
   testing::expect_tree_invariants(tissue_tree);
 }

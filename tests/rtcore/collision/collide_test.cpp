@@ -1,5 +1,6 @@
-// The dual descent against brute force: the procedural gland and resectoscope over random poses in
-// the channel, random triangle soups full of touching and coplanar faces, and a deformed gland.
+// Both query methods (the tool field and the paper's dual descent) against brute force: the
+// procedural gland and resectoscope over random poses in the channel, random triangle soups full of
+// touching and coplanar faces, and a deformed gland.
 #include "rtcore/collision/collide.h"
 
 #include <gtest/gtest.h>
@@ -18,7 +19,16 @@ std::vector<TrianglePair> pairs_of(const Collider& collider) {
   return {collider.pairs().begin(), collider.pairs().end()};
 }
 
-// L1 and L2 hold each leaf once, and every pair's triangles have a leaf in them.
+constexpr CollisionMethod kMethods[] = {CollisionMethod::kToolField, CollisionMethod::kDualDescent};
+
+Collider collider_using(CollisionMethod method) {
+  Collider collider;
+  collider.set_method(method);
+  return collider;
+}
+
+// L1 and L2 hold each leaf once, and every pair's triangles have a leaf in them (the tool's in L2
+// only for the dual descent; the field method lists no tool leaf).
 void expect_leaf_lists(const Collider& collider, const SphereTree& tissue_tree, const SphereTree& tool_tree) {
   std::set<std::int32_t> l1(collider.tissue_leaves().begin(), collider.tissue_leaves().end());
   std::set<std::int32_t> l2(collider.tool_leaves().begin(), collider.tool_leaves().end());
@@ -34,9 +44,15 @@ void expect_leaf_lists(const Collider& collider, const SphereTree& tissue_tree, 
     ASSERT_TRUE(tool_tree.is_leaf(n));
     l2_triangles.insert(tool_tree.pieces()[n].triangle);
   }
+  const bool dual = collider.method() == CollisionMethod::kDualDescent;
+  if (!dual) {
+    ASSERT_TRUE(l2.empty());
+  }
   for (const TrianglePair& p : collider.pairs()) {
     ASSERT_TRUE(l1_triangles.count(p.tissue)) << "tissue triangle " << p.tissue << " has no leaf in L1";
-    ASSERT_TRUE(l2_triangles.count(p.tool)) << "tool triangle " << p.tool << " has no leaf in L2";
+    if (dual) {
+      ASSERT_TRUE(l2_triangles.count(p.tool)) << "tool triangle " << p.tool << " has no leaf in L2";
+    }
   }
 }
 
@@ -57,29 +73,38 @@ struct ProstateScene {
 
 // `poses` random channel poses: pairs equal brute force; the leaf lists checked every few poses.
 void expect_brute_force_over_poses(const ProstateScene& scene, std::uint64_t seed, int poses, int list_every) {
-  Collider collider;
-  std::mt19937_64 rng(seed);
-  for (int i = 0; i < poses; ++i) {
-    const RigidPose pose = random_channel_pose(rng);
-    ASSERT_TRUE(collider.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
-    ASSERT_EQ(pairs_of(collider), collide_brute_force(scene.prostate.surface, scene.tool, pose)) << "pose " << i;
-    if (i % list_every == 0) expect_leaf_lists(collider, scene.tissue_tree, scene.tool_tree);
+  for (const CollisionMethod method : kMethods) {
+    Collider collider = collider_using(method);
+    std::mt19937_64 rng(seed);
+    for (int i = 0; i < poses; ++i) {
+      const RigidPose pose = random_channel_pose(rng);
+      ASSERT_TRUE(collider.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
+      ASSERT_EQ(pairs_of(collider), collide_brute_force(scene.prostate.surface, scene.tool, pose))
+          << "pose " << i << (method == CollisionMethod::kToolField ? " (field)" : " (dual descent)");
+      if (i % list_every == 0) expect_leaf_lists(collider, scene.tissue_tree, scene.tool_tree);
+    }
   }
 }
 
 TEST(Collide, EqualsBruteForceOnTheGlandOverThousandsOfPoses) {
   ProstateScene scene(1296);
-  Collider collider;
+  Collider field = collider_using(CollisionMethod::kToolField);
+  Collider dual = collider_using(CollisionMethod::kDualDescent);
   std::mt19937_64 rng(7);
   std::int64_t total_pairs = 0;
   int poses_with_pairs = 0;
   const int poses = 2000;
   for (int i = 0; i < poses; ++i) {
     const RigidPose pose = random_channel_pose(rng);
-    ASSERT_TRUE(collider.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
+    ASSERT_TRUE(field.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
+    ASSERT_TRUE(dual.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
     const auto expected = collide_brute_force(scene.prostate.surface, scene.tool, pose);
-    ASSERT_EQ(pairs_of(collider), expected) << "pose " << i;
-    if (i % 50 == 0) expect_leaf_lists(collider, scene.tissue_tree, scene.tool_tree);
+    ASSERT_EQ(pairs_of(field), expected) << "pose " << i << " (field)";
+    ASSERT_EQ(pairs_of(dual), expected) << "pose " << i << " (dual descent)";
+    if (i % 50 == 0) {
+      expect_leaf_lists(field, scene.tissue_tree, scene.tool_tree);
+      expect_leaf_lists(dual, scene.tissue_tree, scene.tool_tree);
+    }
     total_pairs += static_cast<std::int64_t>(expected.size());
     poses_with_pairs += expected.empty() ? 0 : 1;
   }
@@ -92,18 +117,20 @@ TEST(Collide, LeafListsAloneAreTheSameListsWithoutTheTriangleTests) {
   // The contact response reads only L1 and L2: without the pairs the walk lists the same leaves in
   // the same order and tests no triangle.
   ProstateScene scene(1296);
-  Collider with_pairs, lists_only;
-  lists_only.set_pairs_wanted(false);
-  std::mt19937_64 rng(11);
-  for (int i = 0; i < 300; ++i) {
-    const RigidPose pose = random_channel_pose(rng);
-    ASSERT_TRUE(with_pairs.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
-    ASSERT_TRUE(lists_only.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
-    const auto l1 = with_pairs.tissue_leaves(), l2 = with_pairs.tool_leaves();
-    ASSERT_TRUE(std::equal(l1.begin(), l1.end(), lists_only.tissue_leaves().begin(), lists_only.tissue_leaves().end())) << "pose " << i;
-    ASSERT_TRUE(std::equal(l2.begin(), l2.end(), lists_only.tool_leaves().begin(), lists_only.tool_leaves().end())) << "pose " << i;
-    EXPECT_TRUE(lists_only.pairs().empty());
-    EXPECT_EQ(lists_only.stats().triangle_tests, 0);
+  for (const CollisionMethod method : kMethods) {
+    Collider with_pairs = collider_using(method), lists_only = collider_using(method);
+    lists_only.set_pairs_wanted(false);
+    std::mt19937_64 rng(11);
+    for (int i = 0; i < 300; ++i) {
+      const RigidPose pose = random_channel_pose(rng);
+      ASSERT_TRUE(with_pairs.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
+      ASSERT_TRUE(lists_only.collide(scene.tissue_tree, scene.prostate.surface, scene.tool_tree, scene.tool, pose));
+      const auto l1 = with_pairs.tissue_leaves(), l2 = with_pairs.tool_leaves();
+      ASSERT_TRUE(std::equal(l1.begin(), l1.end(), lists_only.tissue_leaves().begin(), lists_only.tissue_leaves().end())) << "pose " << i;
+      ASSERT_TRUE(std::equal(l2.begin(), l2.end(), lists_only.tool_leaves().begin(), lists_only.tool_leaves().end())) << "pose " << i;
+      EXPECT_TRUE(lists_only.pairs().empty());
+      EXPECT_EQ(lists_only.stats().triangle_tests, 0);
+    }
   }
 }
 
@@ -125,7 +152,8 @@ TEST(Collide, EqualsBruteForceOnALargerGlandWithTheLoopPressedIn) {
 TEST(Collide, EqualsBruteForceOnTouchingAndCoplanarSoups) {
   std::mt19937_64 rng(3);
   std::uniform_int_distribution<int> grid(0, 6);
-  Collider collider;
+  Collider field = collider_using(CollisionMethod::kToolField);
+  Collider dual = collider_using(CollisionMethod::kDualDescent);
   std::int64_t total = 0;
   for (int trial = 0; trial < 300; ++trial) {
     const auto soup = [&](int triangles) {
@@ -160,10 +188,12 @@ TEST(Collide, EqualsBruteForceOnTouchingAndCoplanarSoups) {
     pose.rotation[0] = Vec3(c, s, 0.0);  // columns
     pose.rotation[1] = Vec3(-s, c, 0.0);
     pose.translation = Vec3(grid(rng) - 3, grid(rng) - 3, trial % 3 == 0 ? 0 : grid(rng) - 3);
-    ASSERT_TRUE(collider.collide(tissue_tree, tissue, tool_tree, tool, pose));
     const auto expected = collide_brute_force(tissue, tool, pose);
-    ASSERT_EQ(pairs_of(collider), expected) << "trial " << trial;
-    expect_leaf_lists(collider, tissue_tree, tool_tree);
+    for (Collider* collider : {&field, &dual}) {
+      ASSERT_TRUE(collider->collide(tissue_tree, tissue, tool_tree, tool, pose));
+      ASSERT_EQ(pairs_of(*collider), expected) << "trial " << trial << (collider == &field ? " (field)" : " (dual descent)");
+      expect_leaf_lists(*collider, tissue_tree, tool_tree);
+    }
     total += static_cast<std::int64_t>(expected.size());
   }
   EXPECT_GT(total, 1000);
@@ -175,7 +205,8 @@ TEST(Collide, EqualsBruteForceAfterDeformationAndRefit) {
   ProstateScene scene(2816);
   TriangleMesh& surface = scene.prostate.surface;
   const std::vector<Vec3> rest = surface.positions;
-  Collider collider;
+  Collider field = collider_using(CollisionMethod::kToolField);
+  Collider dual = collider_using(CollisionMethod::kDualDescent);
   std::mt19937_64 rng(5);
   for (int step = 1; step <= 8; ++step) {
     const double amplitude = 0.00025 * step;  // up to 2 mm
@@ -188,8 +219,11 @@ TEST(Collide, EqualsBruteForceAfterDeformationAndRefit) {
     testing::expect_tree_invariants(scene.tissue_tree);
     for (int i = 0; i < 40; ++i) {
       const RigidPose pose = random_channel_pose(rng);
-      ASSERT_TRUE(collider.collide(scene.tissue_tree, surface, scene.tool_tree, scene.tool, pose));
-      ASSERT_EQ(pairs_of(collider), collide_brute_force(surface, scene.tool, pose)) << "step " << step << " pose " << i;
+      const auto expected = collide_brute_force(surface, scene.tool, pose);
+      for (Collider* collider : {&field, &dual}) {
+        ASSERT_TRUE(collider->collide(scene.tissue_tree, surface, scene.tool_tree, scene.tool, pose));
+        ASSERT_EQ(pairs_of(*collider), expected) << "step " << step << " pose " << i;
+      }
     }
   }
 }

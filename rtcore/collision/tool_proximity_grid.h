@@ -29,7 +29,7 @@ class ToolProximityGrid {
     if (!(at.x >= 0.0 && at.y >= 0.0 && at.z >= 0.0)) return {};
     const auto ix = static_cast<std::size_t>(at.x), iy = static_cast<std::size_t>(at.y), iz = static_cast<std::size_t>(at.z);
     if (ix >= dims_[0] || iy >= dims_[1] || iz >= dims_[2]) return {};
-    const std::size_t cell = (iz * dims_[1] + iy) * dims_[0] + ix;
+    const std::size_t cell = storage_index(ix, iy, iz);
     return {triangles_.data() + first_[cell], triangles_.data() + first_[cell + 1]};
   }
 
@@ -43,7 +43,17 @@ class ToolProximityGrid {
   std::size_t entry_count() const { return triangles_.size(); }
 
  private:
+  // Cells are numbered brick by brick (4 x 4 x 4), and their lists stored in that order: the
+  // lookups of neighbouring points share cache lines.
+  static constexpr std::size_t kBrick = 4;
+  std::size_t storage_index(std::size_t x, std::size_t y, std::size_t z) const {
+    const std::size_t brick = ((z / kBrick) * bricks_[1] + y / kBrick) * bricks_[0] + x / kBrick;
+    return brick * kBrick * kBrick * kBrick + ((z % kBrick) * kBrick + y % kBrick) * kBrick + x % kBrick;
+  }
+  std::size_t storage_count() const { return bricks_[0] * bricks_[1] * bricks_[2] * kBrick * kBrick * kBrick; }
+
   Vec3 lower_{0.0}, upper_{0.0};
+  std::array<std::size_t, 3> bricks_{0, 0, 0};
   double cell_m_ = 0.0, inverse_cell_ = 0.0;
   std::array<std::size_t, 3> dims_{0, 0, 0};
   std::vector<std::uint32_t> first_{0};  // cell c's triangles: triangles_[first_[c], first_[c + 1])

@@ -1,4 +1,4 @@
-#include "rtcore/tissue/tool_proximity_grid.h"
+#include "rtcore/collision/tool_proximity_grid.h"
 
 #include <algorithm>
 #include <cmath>
@@ -29,6 +29,7 @@ void ToolProximityGrid::build(const TriangleMesh& mesh, double reach_m, std::siz
   inverse_cell_ = 1.0 / cell_m_;
   // One more cell than the extent needs on each axis, so the box's upper faces are inside.
   for (int a = 0; a < 3; ++a) dims_[static_cast<std::size_t>(a)] = static_cast<std::size_t>(extent[a] * inverse_cell_) + 1;
+  for (std::size_t a = 0; a < 3; ++a) bricks_[a] = (dims_[a] + kBrick - 1) / kBrick;
 
   // Any point of a cell is within half its diagonal of the centre, so a triangle within the reach
   // of such a point is within reach + half diagonal of the centre: the test below keeps it.
@@ -53,15 +54,15 @@ void ToolProximityGrid::build(const TriangleMesh& mesh, double reach_m, std::siz
           const Vec3 centre = lower_ + (Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)) + 0.5) * cell_m_;
           const Vec3 q = closest_point_on_triangle(centre, a, b, c);
           if (glm::dot(centre - q, centre - q) > keep * keep) continue;
-          entries.emplace_back(static_cast<std::uint32_t>((z * dims_[1] + y) * dims_[0] + x), t);
+          entries.emplace_back(static_cast<std::uint32_t>(storage_index(x, y, z)), t);
         }
       }
     }
   }
   // Counting sort by cell; stable, so each cell's triangles stay ascending.
-  first_.assign(cell_count() + 1, 0);
+  first_.assign(storage_count() + 1, 0);
   for (const auto& [cell, t] : entries) ++first_[cell + 1];
-  for (std::size_t c = 0; c < cell_count(); ++c) first_[c + 1] += first_[c];
+  for (std::size_t c = 0; c < storage_count(); ++c) first_[c + 1] += first_[c];
   triangles_.resize(entries.size());
   std::vector<std::uint32_t> fill(first_.begin(), first_.end() - 1);
   for (const auto& [cell, t] : entries) triangles_[fill[cell]++] = t;

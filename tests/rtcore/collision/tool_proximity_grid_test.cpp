@@ -7,7 +7,7 @@
 
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/geometry/closest_point.h"
-#include "rtcore/tissue/tool_proximity_grid.h"
+#include "rtcore/collision/tool_proximity_grid.h"
 
 namespace resecto {
 namespace {

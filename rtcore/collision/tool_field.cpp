@@ -1,0 +1,48 @@
+#include "rtcore/collision/tool_field.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/common.hpp>
+
+namespace resecto {
+
+void ToolField::build(const TriangleMesh& mesh) {
+  clearance_.build(mesh);
+  planes_.resize(mesh.triangle_count());
+  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+    const Vec3& a = mesh.positions[mesh.triangles[t][0]];
+    const Vec3& b = mesh.positions[mesh.triangles[t][1]];
+    const Vec3& c = mesh.positions[mesh.triangles[t][2]];
+    const Vec3 n = cross(b - a, c - a);
+    const double n_length = length(n);
+    ToolPlane& plane = planes_[t];
+    plane.normal = n_length > 0.0 ? n / n_length : Vec3(0.0);
+    plane.offset = dot(plane.normal, a);
+    // However rough the computed normal of a sliver, the thickness measured from it bounds the
+    // triangle: every point is an affine mix of the corners.
+    double spread = 0.0, magnitude = 0.0;
+    for (const Vec3* v : {&a, &b, &c}) {
+      spread = std::max(spread, std::abs(dot(plane.normal, *v) - plane.offset));
+      magnitude = std::max({magnitude, std::abs(v->x), std::abs(v->y), std::abs(v->z)});
+    }
+    plane.thickness = spread + 1e-12 * magnitude;
+    plane.box = {glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
+  }
+  // Reaches of 1, 2, 4, 8 and 16 clearance cells: a leaf takes the smallest that holds its sphere, so
+  // its list is not much longer than what is truly near it.
+  double reach = clearance_.cell_m();
+  for (int k = 0; k < kReaches; ++k, reach *= 2.0) {
+    // The small reaches get fine cells too, or their lists would be the cells' size, not theirs.
+    near_[static_cast<std::size_t>(k)].build(mesh, reach, std::size_t{1} << (k < 2 ? 20 : 18));
+    usable_reach_[static_cast<std::size_t>(k)] = mesh.triangle_count() == 0 ? -1.0 : reach * (1.0 - 1e-6);
+  }
+}
+
+std::size_t ToolField::entry_count() const {
+  std::size_t entries = 0;
+  for (const ToolProximityGrid& grid : near_) entries += grid.entry_count();
+  return entries;
+}
+
+}  // namespace resecto

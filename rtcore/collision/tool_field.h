@@ -1,0 +1,65 @@
+// ToolField: what the collision query precomputes about a rigid tool, once, in the tool's own frame:
+// a lower bound on the distance to its surface anywhere (to prune the tissue's spheres that cannot
+// reach it), and which of its triangles lie near any point, at a few reaches (to find the triangles
+// a tissue leaf can meet without a tree of the tool's own).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "rtcore/collision/tool_clearance_grid.h"
+#include "rtcore/collision/tool_proximity_grid.h"
+#include "rtcore/mesh/triangle_mesh.h"
+
+namespace resecto {
+
+/// A tool triangle's plane in the tool's frame: every point x of the triangle has
+/// |normal . x - offset| <= thickness (its vertices' spread off the computed plane, plus rounding).
+/// Its box too, in the same frame (where a long triangle of the sheath is thin along two axes).
+struct ToolPlane {
+  Vec3 normal{0.0};
+  double offset = 0.0;
+  double thickness = 0.0;
+  Aabb box;
+};
+
+class ToolField {
+ public:
+  static constexpr int kReaches = 5;
+
+  /// Builds over `mesh` in its own frame. Costs tens of milliseconds for the resectoscope: a
+  /// tool's, like its tree's, is built once.
+  void build(const TriangleMesh& mesh);
+  bool empty() const { return clearance_.empty(); }
+
+  const ToolClearanceGrid& clearance() const { return clearance_; }
+
+  /// Sets `triangles` to the tool's triangles that may lie within `radius` of `p` (every one that
+  /// does, in ascending order, and some that do not). False, leaving it alone, when the radius is
+  /// past the largest reach.
+  bool near(const Vec3& p, double radius, std::span<const std::uint32_t>& triangles) const {
+    for (int k = 0; k < kReaches; ++k) {
+      if (radius <= usable_reach_[static_cast<std::size_t>(k)]) {
+        triangles = near_[static_cast<std::size_t>(k)].candidates(p);
+        return true;
+      }
+    }
+    return false;
+  }
+  double largest_reach() const { return usable_reach_[kReaches - 1]; }
+  /// Per tool triangle, its plane: a ball that stays off it by more than the thickness cannot meet
+  /// the triangle (the cheap test ahead of the box and exact tests).
+  const ToolPlane& plane(std::uint32_t triangle) const { return planes_[triangle]; }
+  /// Triangle entries over every reach's lists.
+  std::size_t entry_count() const;
+
+ private:
+  ToolClearanceGrid clearance_;
+  std::array<ToolProximityGrid, kReaches> near_;
+  std::array<double, kReaches> usable_reach_{};  // each list's reach, less a margin for rounding
+  std::vector<ToolPlane> planes_;
+};
+
+}  // namespace resecto
