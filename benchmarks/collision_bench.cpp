@@ -43,10 +43,21 @@ struct Clock {
 // --tool-slice-aspect X: the same for the tool's tree alone.
 double g_slice_aspect = 0.0;
 double g_tool_slice_aspect = 0.0;
+// --dual-descent: the tables use the paper's dual descent instead of the tool field.
+CollisionMethod g_method = CollisionMethod::kToolField;
 
 void configure(SphereTree& tree, bool tool = false) {
   if (g_slice_aspect > 0.0) tree.set_slice_aspect(g_slice_aspect);
   if (tool && g_tool_slice_aspect > 0.0) tree.set_slice_aspect(g_tool_slice_aspect);
+  // The field method reads only the tissue's spheres: a tree without slabs refits in about half the time.
+  if (!tool) tree.set_slabs(g_method == CollisionMethod::kDualDescent);
+}
+
+Collider collider_for(const TriangleMesh& tool) {
+  Collider collider;
+  collider.set_method(g_method);
+  collider.prepare_tool(tool);  // built once per tool, as its tree is
+  return collider;
 }
 
 // The resectoscope and its tree, as every table uses them.
@@ -167,7 +178,7 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
   SphereTree tissue_tree;
   configure(tissue_tree);
   tissue_tree.build(tissue);
-  Collider collider;
+  Collider collider = collider_for(tool);
   collider.reserve(1 << 16, 1 << 16);
 
   // Our query and FCL OBBRSS (all contacts), every pose `repetitions` times, alternated pose by pose
@@ -310,7 +321,7 @@ SequenceRow measure_sequence(int target_triangles, const TriangleMesh& tool, con
   SphereTree tissue_tree;
   configure(tissue_tree);
   tissue_tree.build(tissue);
-  Collider fresh, sequence;
+  Collider fresh = collider_for(tool), sequence = collider_for(tool);
   fresh.reserve(1 << 16, 1 << 16);
   sequence.reserve(1 << 16, 1 << 16);
   fcl::CollisionObjectd fcl_tissue(fcl_model<fcl::OBBRSSd>(tissue));
@@ -435,14 +446,16 @@ int run_table(int repetitions, int only_size) {
 
 // ---- Google Benchmark cases (--gbench) ----------------------------------------------------------
 
-void query_case(benchmark::State& state, bool slabs) {
+void query_case(benchmark::State& state, CollisionMethod method, bool slabs) {
   const ProstateModel gland = generate_prostate(static_cast<int>(state.range(0)));
   const TriangleMesh tool = combined_resectoscope_mesh(generate_resectoscope());
   SphereTree tissue_tree, tool_tree;
+  tissue_tree.set_slabs(method == CollisionMethod::kDualDescent);
   tissue_tree.build(gland.surface);
   tool_tree.build(tool);
   const auto poses = pressing_poses();
   Collider collider;
+  collider.set_method(method);
   collider.set_slabs(slabs);
   collider.prepare_tool(tool);  // built once per tool, as its tree is
   std::size_t p = 0;
@@ -460,10 +473,13 @@ void query_case(benchmark::State& state, bool slabs) {
   state.counters["leaf_pairs"] = per_query(work.leaf_pairs);
   state.counters["triangle_tests"] = per_query(work.triangle_tests);
 }
-void BM_Query(benchmark::State& state) { query_case(state, true); }
-// The paper's test alone (spheres, no slabs): what the slabs save.
-void BM_QuerySpheresOnly(benchmark::State& state) { query_case(state, false); }
-BENCHMARK(BM_QuerySpheresOnly)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
+// The tool field (the default method).
+void BM_Query(benchmark::State& state) { query_case(state, CollisionMethod::kToolField, false); }
+// The paper's dual descent with the slabs beside the spheres, and with the spheres alone (the paper's test).
+void BM_QueryDualDescent(benchmark::State& state) { query_case(state, CollisionMethod::kDualDescent, true); }
+void BM_QueryPaperSpheres(benchmark::State& state) { query_case(state, CollisionMethod::kDualDescent, false); }
+BENCHMARK(BM_QueryPaperSpheres)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_QueryDualDescent)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Query)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
 
 // The 60 Hz trajectory as a sequence (collide_sequence), frame after frame, looping.
@@ -471,10 +487,10 @@ void BM_Sequence8640(benchmark::State& state) {
   const ProstateModel gland = generate_prostate(8640);
   const BenchTool tool = make_bench_tool();
   SphereTree tissue_tree;
+  configure(tissue_tree);
   tissue_tree.build(gland.surface);
   const auto frames = pressing_trajectory();
-  Collider collider;
-  collider.prepare_tool(tool.mesh);
+  Collider collider = collider_for(tool.mesh);
   std::size_t f = 0;
   for (auto _ : state) {
     if (f % frames.size() == 0) collider.reset_sequence();
@@ -484,11 +500,13 @@ void BM_Sequence8640(benchmark::State& state) {
 }
 BENCHMARK(BM_Sequence8640);
 
-// The refit after a deformation (spheres and slabs of every node), ours and FCL's AABB tree.
-void BM_Refit(benchmark::State& state) {
+// The refit after a deformation, ours and FCL's AABB tree: the spheres alone (what the tool field
+// reads) and with the slabs (what the dual descent reads).
+void refit_case(benchmark::State& state, bool slabs) {
   ProstateModel gland = generate_prostate(static_cast<int>(state.range(0)));
   TriangleMesh& mesh = gland.surface;
   SphereTree tree;
+  tree.set_slabs(slabs);
   tree.build(mesh);
   const std::vector<Vec3> rest = mesh.positions;
   deform(rest, mesh.positions, 0.7);
@@ -497,6 +515,9 @@ void BM_Refit(benchmark::State& state) {
     benchmark::DoNotOptimize(tree.spheres().data());
   }
 }
+void BM_Refit(benchmark::State& state) { refit_case(state, false); }
+void BM_RefitWithSlabs(benchmark::State& state) { refit_case(state, true); }
+BENCHMARK(BM_RefitWithSlabs)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Refit)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
 
 void BM_FclAabbRefit(benchmark::State& state) {
@@ -533,6 +554,7 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--size") == 0 && i + 1 < argc) only_size = std::atoi(argv[++i]);
     if (std::strcmp(argv[i], "--repetitions") == 0 && i + 1 < argc) repetitions = std::max(1, std::atoi(argv[++i]));
     if (std::strcmp(argv[i], "--sequence-only") == 0) sequence_only = true;
+    if (std::strcmp(argv[i], "--dual-descent") == 0) g_method = CollisionMethod::kDualDescent;
     if (std::strcmp(argv[i], "--write-poses") == 0 && i + 1 < argc) {
       // The bench's poses for `resecto collide`: PREFIX-independent.txt and PREFIX-trajectory.txt (mm).
       const std::string prefix = argv[++i];

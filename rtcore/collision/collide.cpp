@@ -101,6 +101,8 @@ void Collider::prepare(const SphereTree& tissue_tree, const SphereTree& tool_tre
     if (field_tool_ != fingerprint(tool)) prepare_tool(tool);
     // Depth-first over one tree: each step pushes at most two nodes, so the height bounds the stack.
     node_stack_.resize(static_cast<std::size_t>(tissue_tree.links()[tissue_tree.root()].height) + 2);
+    near_leaves_.resize(tissue_nodes);  // each leaf is set aside at most once a query
+    near_leaf_count_ = 0;
     stack_.resize(static_cast<std::size_t>(tool_tree.links()[tool_tree.root()].height) + 2);
     return;
   }
@@ -526,6 +528,25 @@ void Collider::visit_field_leaf(std::int32_t leaf, const Vec3& centre, double ra
   }
 }
 
+void Collider::visit_field_leaves() {
+  const LeafPiece* pieces = tissue_tree_->pieces().data();
+  const Triangle* triangles = tissue_mesh_->triangles.data();
+  // Each leaf's data lies scattered (its piece, its triangle's corners, its cell's list): loaded
+  // ahead in two steps, the piece and the list's bounds four leaves ahead, the triangle two ahead.
+  constexpr std::size_t kFar = 4, kNear = 2;
+  for (std::size_t i = 0; i < near_leaf_count_; ++i) {
+    if (i + kFar < near_leaf_count_) {
+      const NearLeaf& far = near_leaves_[i + kFar];
+      __builtin_prefetch(pieces + far.leaf);
+      field_.prefetch_near(far.centre, far.radius);
+    }
+    if (i + kNear < near_leaf_count_) __builtin_prefetch(triangles + pieces[near_leaves_[i + kNear].leaf].triangle);
+    const NearLeaf& leaf = near_leaves_[i];
+    visit_field_leaf(leaf.leaf, leaf.centre, leaf.radius);
+  }
+  near_leaf_count_ = 0;
+}
+
 template <bool kRecord>
 void Collider::descend_field(std::int32_t start) {
   const Sphere* spheres = tissue_tree_->spheres().data();
@@ -554,13 +575,14 @@ void Collider::descend_field(std::int32_t start) {
     }
     const SphereTreeLinks& l = links[node];
     if (l.left == SphereTree::kNoNode) {
-      visit_field_leaf(node, centre, radius);
+      near_leaves_[near_leaf_count_++] = {centre, radius, node};
       if constexpr (kRecord) record({node, SphereTree::kNoNode}, -1.0);  // walked again every call
       continue;
     }
     // The left child is next and usually the next node in memory (depth-first numbering); the right
-    // waits on the stack, so its load is started now.
+    // waits on the stack, so its loads are started now.
     __builtin_prefetch(spheres + l.right);
+    __builtin_prefetch(links + l.right);
     stack[top++] = l.right;
     stack[top++] = l.left;
   }
@@ -580,6 +602,7 @@ bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue
   tissue_mesh_ = &tissue;
   if (method_ == CollisionMethod::kToolField) {
     descend_field<false>(tissue_tree.root());
+    visit_field_leaves();
   } else {
     descend<false>({tissue_tree.root(), tool_tree.root()});
   }
@@ -633,6 +656,7 @@ bool Collider::collide_sequence(const SphereTree& tissue_tree, const TriangleMes
     }
     fresh_front_count_ = front_count_;
   }
+  if (field) visit_field_leaves();
   front_valid_ = !front_overflowed_ && certifiable;
   front_tissue_tree_ = &tissue_tree;
   front_tool_tree_ = &tool_tree;

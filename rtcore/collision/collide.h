@@ -125,6 +125,8 @@ class Collider {
   template <bool kRecord>
   void descend_field(std::int32_t start);
   void visit_field_leaf(std::int32_t leaf, const Vec3& centre, double radius);
+  /// Visits the leaves the descents set aside, loading each one's data a few leaves ahead.
+  void visit_field_leaves();
   void renew_front(const SphereTree& tissue_tree, const SphereTree& tool_tree);
   void record(const NodePair& pair, double expiry);
   void finish_query();
@@ -141,6 +143,13 @@ class Collider {
   glm::dmat3 inverse_rotation_{1.0};  // the field method: world to the tool's frame (with the translation)
   double inverse_scale_ = 1.0;        // bounds how much inverse_rotation_ can stretch a tissue sphere
   std::vector<std::int32_t> node_stack_;  // the field method's descent
+  struct NearLeaf {
+    Vec3 centre;  // in the tool's frame
+    double radius;
+    std::int32_t leaf;
+  };
+  std::vector<NearLeaf> near_leaves_;  // the leaves within reach of the tool, visited after the descent
+  std::size_t near_leaf_count_ = 0;
   // The trees and meshes of the running query.
   const SphereTree* tissue_tree_ = nullptr;
   const SphereTree* tool_tree_ = nullptr;

@@ -474,11 +474,18 @@ void SphereTree::update_refit_order() {
     const std::int32_t h = links_[n].height;
     if (h > 0) refit_internal_[static_cast<std::size_t>(stack_[static_cast<std::size_t>(h)]++)] = n;
   }
-  // The backward sweep needs every child numbered after its parent (true after a build; an
-  // insertion or removal may reuse a lower slot).
-  preorder_ = true;
-  for (std::int32_t n = 0; n < node_capacity() && preorder_; ++n) {
-    if (links_[n].height > 0) preorder_ = links_[n].left > n && links_[n].right > n;
+  // With every child numbered after its parent (true after a build; an insertion or removal may
+  // reuse a lower slot), the internal nodes backwards are also children first, and read memory in
+  // order: on a large tree that beats the order by height.
+  bool preorder = true;
+  for (std::int32_t n = 0; n < node_capacity() && preorder; ++n) {
+    if (links_[n].height > 0) preorder = links_[n].left > n && links_[n].right > n;
+  }
+  if (preorder) {
+    refit_internal_.clear();
+    for (std::int32_t n = node_capacity() - 1; n >= 0; --n) {
+      if (links_[n].height > 0) refit_internal_.push_back(n);
+    }
   }
   order_dirty_ = false;
 }
@@ -543,23 +550,45 @@ void SphereTree::refit_internal(const TriangleMesh& mesh, std::int32_t node) {
 
 void SphereTree::refit(const TriangleMesh& mesh) {
   if (order_dirty_) update_refit_order();
-  if (preorder_) {
-    // Depth-first numbering puts every child after its parent: one backward sweep over the arrays
-    // meets children first, reading memory in order.
-    for (std::int32_t n = node_capacity() - 1; n >= 0; --n) {
-      const std::int32_t height = links_[n].height;
-      if (height == 0) {
-        refit_leaf(mesh, n);
-      } else if (height > 0) {
-        refit_internal(mesh, n);
-      }
-    }
+  // Leaves from their triangles' corners, then one pass of O(1) merges, children before parents:
+  // each internal bound holds its two children's, so every leaf below stays covered. Two loops
+  // without a branch on the kind of node, each reading its arrays in order.
+  if (slabs_kept_) {
+    for (const std::int32_t leaf : refit_leaves_) refit_leaf(mesh, leaf);
+    for (const std::int32_t node : refit_internal_) refit_internal(mesh, node);
     return;
   }
-  // Leaves from their triangles' corners, then one bottom-up pass of O(1) merges by height: each
-  // internal bound holds its two children's, so every leaf below stays covered.
-  for (const std::int32_t leaf : refit_leaves_) refit_leaf(mesh, leaf);
-  for (const std::int32_t node : refit_internal_) refit_internal(mesh, node);
+  // Spheres alone: the same bounds as refit_leaf and refit_internal give, through raw pointers, so
+  // nothing is reloaded per node (a store to a sphere could otherwise alias every vector's data).
+  const Vec3* positions = mesh.positions.data();
+  const Triangle* triangles = mesh.triangles.data();
+  const LeafPiece* pieces = pieces_.data();
+  const SphereTreeLinks* links = links_.data();
+  Sphere* spheres = spheres_.data();
+  const std::int32_t* leaves = refit_leaves_.data();
+  const std::size_t leaf_count = refit_leaves_.size();
+  // A leaf's corners lie three loads deep (piece, triangle, positions), scattered over large
+  // arrays: each is started a few leaves ahead, one level at a time.
+  constexpr std::size_t kPieceAhead = 12, kTriangleAhead = 8, kCornersAhead = 4;
+  for (std::size_t i = 0; i < leaf_count; ++i) {
+    if (i + kPieceAhead < leaf_count) __builtin_prefetch(pieces + leaves[i + kPieceAhead]);
+    if (i + kTriangleAhead < leaf_count) __builtin_prefetch(triangles + pieces[leaves[i + kTriangleAhead]].triangle);
+    if (i + kCornersAhead < leaf_count) {
+      const Triangle& ahead = triangles[pieces[leaves[i + kCornersAhead]].triangle];
+      __builtin_prefetch(positions + ahead[0]);
+      __builtin_prefetch(positions + ahead[1]);
+      __builtin_prefetch(positions + ahead[2]);
+    }
+    const std::int32_t leaf = leaves[i];
+    const LeafPiece& piece = pieces[leaf];
+    if (piece.slices != 1) {
+      spheres[leaf] = piece_sphere(mesh, piece);
+      continue;
+    }
+    const Triangle& tri = triangles[piece.triangle];
+    spheres[leaf] = centroid_sphere(positions[tri[0]], positions[tri[1]], positions[tri[2]]);
+  }
+  for (const std::int32_t node : refit_internal_) spheres[node] = merge(spheres[links[node].left], spheres[links[node].right]);
 }
 
 // ---- Insert and remove ------------------------------------------------------------------------

@@ -210,7 +210,6 @@ class SphereTree {
   bool order_dirty_ = true;
   bool slabs_wanted_ = true;
   bool slabs_kept_ = false;
-  bool preorder_ = false;  // every child's index is above its parent's: refit sweeps the array backwards
   std::uint64_t structure_version_ = 0;
   double slice_aspect_ = kSliceAspect;
   double built_mean_internal_radius_ = 0.0;

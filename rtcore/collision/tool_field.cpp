@@ -8,7 +8,11 @@
 namespace resecto {
 
 void ToolField::build(const TriangleMesh& mesh) {
-  clearance_.build(mesh);
+  // Cells grow with the tool's triangles, up to about a million (the resectoscope's 488 reach it): a
+  // small tool, whose few triangles each cross many cells, gets a small field built in milliseconds.
+  const std::size_t triangles = mesh.triangle_count();
+  const std::size_t cells = std::clamp<std::size_t>(8 * triangles * triangles, 4096, std::size_t{1} << 20);
+  clearance_.build(mesh, cells);
   planes_.resize(mesh.triangle_count());
   for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
     const Vec3& a = mesh.positions[mesh.triangles[t][0]];
@@ -34,7 +38,7 @@ void ToolField::build(const TriangleMesh& mesh) {
   double reach = clearance_.cell_m();
   for (int k = 0; k < kReaches; ++k, reach *= 2.0) {
     // The small reaches get fine cells too, or their lists would be the cells' size, not theirs.
-    near_[static_cast<std::size_t>(k)].build(mesh, reach, std::size_t{1} << (k < 2 ? 20 : 18));
+    near_[static_cast<std::size_t>(k)].build(mesh, reach, k < 2 ? cells : cells / 4);
     usable_reach_[static_cast<std::size_t>(k)] = mesh.triangle_count() == 0 ? -1.0 : reach * (1.0 - 1e-6);
   }
 }

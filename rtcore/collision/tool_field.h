@@ -49,6 +49,15 @@ class ToolField {
     return false;
   }
   double largest_reach() const { return usable_reach_[kReaches - 1]; }
+  /// Starts loading what near(p, radius) will read.
+  void prefetch_near(const Vec3& p, double radius) const {
+    for (int k = 0; k < kReaches; ++k) {
+      if (radius <= usable_reach_[static_cast<std::size_t>(k)]) {
+        near_[static_cast<std::size_t>(k)].prefetch(p);
+        return;
+      }
+    }
+  }
   /// Per tool triangle, its plane: a ball that stays off it by more than the thickness cannot meet
   /// the triangle (the cheap test ahead of the box and exact tests).
   const ToolPlane& plane(std::uint32_t triangle) const { return planes_[triangle]; }

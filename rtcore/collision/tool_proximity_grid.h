@@ -33,6 +33,16 @@ class ToolProximityGrid {
     return {triangles_.data() + first_[cell], triangles_.data() + first_[cell + 1]};
   }
 
+  /// Starts loading the list candidates(p) will read.
+  void prefetch(const Vec3& p) const {
+    const Vec3 at = (p - lower_) * inverse_cell_;
+    if (!(at.x >= 0.0 && at.y >= 0.0 && at.z >= 0.0)) return;
+    const auto ix = static_cast<std::size_t>(at.x), iy = static_cast<std::size_t>(at.y), iz = static_cast<std::size_t>(at.z);
+    if (ix >= dims_[0] || iy >= dims_[1] || iz >= dims_[2]) return;
+    const std::size_t cell = storage_index(ix, iy, iz);
+    __builtin_prefetch(first_.data() + cell);
+  }
+
   /// The box the cells cover: the mesh's bounding box grown by the reach. Nothing outside it is
   /// within the reach of the mesh.
   const Vec3& lower() const { return lower_; }
