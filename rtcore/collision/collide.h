@@ -69,8 +69,9 @@ class Collider {
                const TriangleMesh& tool, const RigidPose& tool_pose);
 
   /// The same pairs as collide() for consecutive poses of one tool against one tissue tree, reusing
-  /// the previous call's work (temporal coherence). Every node pair where the last descent stopped
-  /// is kept with a certificate: the pair's bounds were `gap` apart, so its triangles cannot meet
+  /// the previous call's work (temporal coherence). Every node pair (the field method: every tissue
+  /// node) where the last descent stopped is kept with a certificate: the bounds were `gap` apart
+  /// (the field method: the node's sphere was `gap` clear of the tool's surface), so nothing can meet
   /// until the tool and the tissue together have moved `gap`. The tool's motion is bounded exactly
   /// (its vertices' largest displacement between calls, summed), the tissue's by `tissue_travel_m`,
   /// a running bound on how far any tissue point has moved (0 for a static tissue); only pairs whose
@@ -84,8 +85,9 @@ class Collider {
   /// Room for this many cached node pairs (a sequence that needs more starts afresh each call).
   void reserve_front(std::int32_t max_front);
 
-  /// Whether the descent also tests each node's slab (the default), or spheres alone as the paper
-  /// does. The pairs are the same either way; the leaf lists are shorter with the slabs.
+  /// Whether the dual descent also tests each node's slab (the default), or spheres alone as the
+  /// paper does. The pairs are the same either way; the leaf lists are shorter with the slabs. The
+  /// field method reads the tissue's spheres only.
   void set_slabs(bool enabled) { slabs_wanted_ = enabled; }
 
   /// Whether queries find the intersecting triangle pairs (the default) or only the leaf lists, as
