@@ -158,12 +158,7 @@ void Collider::test_triangles(const TriangleMesh& tissue, std::uint32_t a, std::
   const Vec3& p2 = tissue.positions[ta[2]];
   // Closed boxes that do not meet hold closed triangles that do not meet: exact on coordinates,
   // the same prefilter brute force uses.
-  const Aabb& box = tool_boxes_[b];
-  if (std::max({p0.x, p1.x, p2.x}) < box.min.x || box.max.x < std::min({p0.x, p1.x, p2.x}) ||
-      std::max({p0.y, p1.y, p2.y}) < box.min.y || box.max.y < std::min({p0.y, p1.y, p2.y}) ||
-      std::max({p0.z, p1.z, p2.z}) < box.min.z || box.max.z < std::min({p0.z, p1.z, p2.z})) {
-    return;
-  }
+  if (!boxes_overlap(triangle_box(p0, p1, p2), tool_boxes_[b])) return;
   exact_test(a, p0, p1, p2, b);
 }
 
@@ -255,7 +250,7 @@ bool Collider::begin_query(const SphereTree& tissue_tree, const SphereTree& tool
     const Vec3& a = tool_vertices_[t[0]];
     const Vec3& b = tool_vertices_[t[1]];
     const Vec3& c = tool_vertices_[t[2]];
-    tool_boxes_[u] = {glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
+    tool_boxes_[u] = triangle_box(a, b, c);
   }
   // Rounding of transformed centres and of distances is far below this slack; it only ever lets
   // a few more pairs through to the exact test.
@@ -478,29 +473,24 @@ void Collider::visit_field_leaf(std::int32_t leaf, const Vec3& centre, double ra
     const Vec3& p0 = tissue.positions[ta[0]];
     const Vec3& p1 = tissue.positions[ta[1]];
     const Vec3& p2 = tissue.positions[ta[2]];
-    const Aabb box{glm::min(p0, glm::min(p1, p2)), glm::max(p0, glm::max(p1, p2))};
+    const Aabb box = triangle_box(p0, p1, p2);
     // The tissue triangle in the tool's frame, its box grown by the slack for the transform's rounding.
     const Vec3 t0 = to_tool(p0), t1 = to_tool(p1), t2 = to_tool(p2);
-    const Aabb local{glm::min(t0, glm::min(t1, t2)) - Vec3(slack_), glm::max(t0, glm::max(t1, t2)) + Vec3(slack_)};
+    Aabb local = triangle_box(t0, t1, t2);
+    local.min -= Vec3(slack_);
+    local.max += Vec3(slack_);
     for (std::uint32_t b : near) {
       // The tissue triangle clear of the tool triangle's box or of its plane (in the tool's frame,
       // where the sheath's long triangles have thin boxes), then the boxes in the world (exact on
       // the coordinates, as brute force's): none can lose a pair.
       const ToolPlane& plane = field_.plane(b);
-      if (local.max.x < plane.box.min.x || plane.box.max.x < local.min.x || local.max.y < plane.box.min.y ||
-          plane.box.max.y < local.min.y || local.max.z < plane.box.min.z || plane.box.max.z < local.min.z) {
-        continue;
-      }
+      if (!boxes_overlap(local, plane.box)) continue;
       const double d0 = dot(plane.normal, t0) - plane.offset;
       const double d1 = dot(plane.normal, t1) - plane.offset;
       const double d2 = dot(plane.normal, t2) - plane.offset;
       const double apart = plane.thickness + slack_;
       if (std::min({d0, d1, d2}) > apart || std::max({d0, d1, d2}) < -apart) continue;
-      const Aabb& other = tool_boxes_[b];
-      if (box.max.x < other.min.x || other.max.x < box.min.x || box.max.y < other.min.y ||
-          other.max.y < box.min.y || box.max.z < other.min.z || other.max.z < box.min.z) {
-        continue;
-      }
+      if (!boxes_overlap(box, tool_boxes_[b])) continue;
       if (sliced && !first_test_of(a.triangle, b)) continue;
       exact_test(a.triangle, p0, p1, p2, b);
     }
@@ -716,13 +706,10 @@ std::vector<TrianglePair> collide_brute_force(const TriangleMesh& tissue, const 
                                               const RigidPose& tool_pose) {
   std::vector<Vec3> world(tool.vertex_count());
   for (std::size_t v = 0; v < world.size(); ++v) world[v] = tool_pose.apply_point(tool.positions[v]);
-  const auto box_of = [](const Vec3& a, const Vec3& b, const Vec3& c) {
-    return Aabb{glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
-  };
   std::vector<Aabb> tool_boxes(tool.triangle_count());
   for (std::size_t u = 0; u < tool_boxes.size(); ++u) {
     const Triangle& t = tool.triangles[u];
-    tool_boxes[u] = box_of(world[t[0]], world[t[1]], world[t[2]]);
+    tool_boxes[u] = triangle_box(world[t[0]], world[t[1]], world[t[2]]);
   }
   std::vector<TrianglePair> pairs;
   // Tissue-major, then tool: the output is sorted by construction.
@@ -731,14 +718,10 @@ std::vector<TrianglePair> collide_brute_force(const TriangleMesh& tissue, const 
     const Vec3& p0 = tissue.positions[ta[0]];
     const Vec3& p1 = tissue.positions[ta[1]];
     const Vec3& p2 = tissue.positions[ta[2]];
-    const Aabb box = box_of(p0, p1, p2);
+    const Aabb box = triangle_box(p0, p1, p2);
     for (std::uint32_t b = 0; b < tool.triangle_count(); ++b) {
-      const Aabb& other = tool_boxes[b];
       // Closed boxes that do not meet hold closed triangles that do not meet: exact on coordinates.
-      if (box.max.x < other.min.x || other.max.x < box.min.x || box.max.y < other.min.y ||
-          other.max.y < box.min.y || box.max.z < other.min.z || other.max.z < box.min.z) {
-        continue;
-      }
+      if (!boxes_overlap(box, tool_boxes[b])) continue;
       const Triangle& tb = tool.triangles[b];
       if (triangles_intersect(p0, p1, p2, world[tb[0]], world[tb[1]], world[tb[2]])) pairs.push_back({a, b});
     }

@@ -60,7 +60,6 @@ class Collider {
   /// fingerprint (a hash of its vertices and triangles, about a microsecond for the resectoscope)
   /// and builds the field first for a tool it has not seen.
   void prepare_tool(const TriangleMesh& tool);
-  const ToolField& tool_field() const { return field_; }
 
   /// Finds every pair of intersecting closed triangles between the tissue and the tool placed at
   /// `tool_pose` (the tool tree is in tool coordinates; its spheres move with the pose, never

@@ -32,7 +32,7 @@ void ToolClearanceGrid::build(const TriangleMesh& mesh, std::size_t max_cells) {
     const Vec3& a = mesh.positions[mesh.triangles[t][0]];
     const Vec3& b = mesh.positions[mesh.triangles[t][1]];
     const Vec3& c = mesh.positions[mesh.triangles[t][2]];
-    boxes[t] = {glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
+    boxes[t] = triangle_box(a, b, c);
     all = {glm::min(all.min, boxes[t].min), glm::max(all.max, boxes[t].max)};
   }
   // A flat or thin tool still gets cells of a sensible size: no side counts as less than 1/64 of
@@ -40,17 +40,11 @@ void ToolClearanceGrid::build(const TriangleMesh& mesh, std::size_t max_cells) {
   const Vec3 extent = all.size();
   const double longest = std::max({extent.x, extent.y, extent.z, 1e-300});
   const Vec3 sized = glm::max(extent, Vec3(longest / 64.0));
-  cell_m_ = std::cbrt(sized.x * sized.y * sized.z / static_cast<double>(std::max<std::size_t>(max_cells, 64)));
-  inverse_cell_ = 1.0 / cell_m_;
-  band_m_ = kBandCells * cell_m_;
-  lower_ = all.min - Vec3(band_m_);
-  for (int a = 0; a < 3; ++a) {
-    dims_[static_cast<std::size_t>(a)] = static_cast<std::size_t>((extent[a] + 2.0 * band_m_) * inverse_cell_) + 1;
-  }
-  upper_ = lower_ + Vec3(static_cast<double>(dims_[0]), static_cast<double>(dims_[1]), static_cast<double>(dims_[2])) * cell_m_;
-  for (std::size_t a = 0; a < 3; ++a) bricks_[a] = (dims_[a] + kBrick - 1) / kBrick;
+  const double cell_m = std::cbrt(sized.x * sized.y * sized.z / static_cast<double>(std::max<std::size_t>(max_cells, 64)));
+  band_m_ = kBandCells * cell_m;
+  cells_ = BrickGrid(all.min - Vec3(band_m_), extent + Vec3(2.0 * band_m_), cell_m);
   step_m_ = band_m_ / 255.0;
-  values_.assign(bricks_[0] * bricks_[1] * bricks_[2] * kBrick * kBrick * kBrick, 255);
+  values_.assign(cells_.storage_count(), 255);
   // A stored distance never exceeds the true one: the double's own rounding is allowed for, and
   // the steps are counted down.
   const auto steps_below = [&](double distance) {
@@ -58,17 +52,16 @@ void ToolClearanceGrid::build(const TriangleMesh& mesh, std::size_t max_cells) {
     return static_cast<std::uint8_t>(std::clamp(steps, 0.0, 255.0));
   };
 
-  const double half_diagonal = 0.5 * std::sqrt(3.0) * cell_m_;
+  const double half_diagonal = 0.5 * std::sqrt(3.0) * cell_m;
   const double block_half_diagonal = static_cast<double>(kBlock) * half_diagonal;
   // Every cell centre of a block is within the block's half diagonal of its centre.
   const double reach = (band_m_ + block_half_diagonal) * (1.0 + 1e-9);
   std::vector<std::pair<double, std::uint32_t>> near;  // (distance of the box from the block's centre, triangle)
-  for (std::size_t bz = 0; bz < dims_[2]; bz += kBlock) {
-    for (std::size_t by = 0; by < dims_[1]; by += kBlock) {
-      for (std::size_t bx = 0; bx < dims_[0]; bx += kBlock) {
-        const Vec3 block_centre =
-            lower_ + Vec3(static_cast<double>(bx), static_cast<double>(by), static_cast<double>(bz)) * cell_m_ +
-            Vec3(0.5 * static_cast<double>(kBlock) * cell_m_);
+  for (std::size_t bz = 0; bz < cells_.dim(2); bz += kBlock) {
+    for (std::size_t by = 0; by < cells_.dim(1); by += kBlock) {
+      for (std::size_t bx = 0; bx < cells_.dim(0); bx += kBlock) {
+        const Vec3 block_centre = cells_.lower() + Vec3(static_cast<double>(bx), static_cast<double>(by), static_cast<double>(bz)) * cell_m +
+                                  Vec3(0.5 * static_cast<double>(kBlock) * cell_m);
         near.clear();
         for (std::uint32_t t = 0; t < boxes.size(); ++t) {
           const double d2 = box_distance2(block_centre, boxes[t]);
@@ -78,10 +71,10 @@ void ToolClearanceGrid::build(const TriangleMesh& mesh, std::size_t max_cells) {
         // Nearest boxes first: a cell stops at the first box that, even moved by the cell's offset
         // from the block's centre, is farther than the nearest triangle found.
         std::sort(near.begin(), near.end());
-        for (std::size_t z = bz; z < std::min(bz + kBlock, dims_[2]); ++z) {
-          for (std::size_t y = by; y < std::min(by + kBlock, dims_[1]); ++y) {
-            for (std::size_t x = bx; x < std::min(bx + kBlock, dims_[0]); ++x) {
-              const Vec3 centre = lower_ + (Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)) + 0.5) * cell_m_;
+        for (std::size_t z = bz; z < std::min(bz + kBlock, cells_.dim(2)); ++z) {
+          for (std::size_t y = by; y < std::min(by + kBlock, cells_.dim(1)); ++y) {
+            for (std::size_t x = bx; x < std::min(bx + kBlock, cells_.dim(0)); ++x) {
+              const Vec3 centre = cells_.centre(x, y, z);
               const double offset = length(centre - block_centre) * (1.0 + 1e-9) + 1e-12 * reach;
               double best2 = band_m_ * band_m_;
               for (const auto& [box_distance, t] : near) {
@@ -92,7 +85,7 @@ void ToolClearanceGrid::build(const TriangleMesh& mesh, std::size_t max_cells) {
                 const Vec3 q = closest_point_on_triangle(centre, mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]]);
                 best2 = std::min(best2, length_squared(centre - q));
               }
-              values_[storage_index(x, y, z)] = steps_below(std::sqrt(best2));
+              values_[cells_.storage_index(x, y, z)] = steps_below(std::sqrt(best2));
             }
           }
         }

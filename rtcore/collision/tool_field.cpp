@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <glm/common.hpp>
-
 namespace resecto {
 
 void ToolField::build(const TriangleMesh& mesh) {
@@ -31,22 +29,16 @@ void ToolField::build(const TriangleMesh& mesh) {
       magnitude = std::max({magnitude, std::abs(v->x), std::abs(v->y), std::abs(v->z)});
     }
     plane.thickness = spread + 1e-12 * magnitude;
-    plane.box = {glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
+    plane.box = triangle_box(a, b, c);
   }
   // Reaches of 1, 2, 4, 8 and 16 clearance cells: a leaf takes the smallest that holds its sphere, so
   // its list is not much longer than what is truly near it.
   double reach = clearance_.cell_m();
-  for (int k = 0; k < kReaches; ++k, reach *= 2.0) {
+  for (std::size_t k = 0; k < kReaches; ++k, reach *= 2.0) {
     // The small reaches get fine cells too, or their lists would be the cells' size, not theirs.
-    near_[static_cast<std::size_t>(k)].build(mesh, reach, k < 2 ? cells : cells / 4);
-    usable_reach_[static_cast<std::size_t>(k)] = mesh.triangle_count() == 0 ? -1.0 : reach * (1.0 - 1e-6);
+    near_[k].build(mesh, reach, k < 2 ? cells : cells / 4);
+    usable_reach_[k] = mesh.triangle_count() == 0 ? -1.0 : reach * (1.0 - 1e-6);
   }
-}
-
-std::size_t ToolField::entry_count() const {
-  std::size_t entries = 0;
-  for (const ToolProximityGrid& grid : near_) entries += grid.entry_count();
-  return entries;
 }
 
 }  // namespace resecto

@@ -27,7 +27,7 @@ struct ToolPlane {
 
 class ToolField {
  public:
-  static constexpr int kReaches = 5;
+  static constexpr std::size_t kReaches = 5;
 
   /// Builds over `mesh` in its own frame. Costs tens of milliseconds for the resectoscope: a
   /// tool's, like its tree's, is built once.
@@ -40,31 +40,28 @@ class ToolField {
   /// does, in ascending order, and some that do not). False, leaving it alone, when the radius is
   /// past the largest reach.
   bool near(const Vec3& p, double radius, std::span<const std::uint32_t>& triangles) const {
-    for (int k = 0; k < kReaches; ++k) {
-      if (radius <= usable_reach_[static_cast<std::size_t>(k)]) {
-        triangles = near_[static_cast<std::size_t>(k)].candidates(p);
-        return true;
-      }
-    }
-    return false;
+    const ToolProximityGrid* grid = lists_for(radius);
+    if (grid == nullptr) return false;
+    triangles = grid->candidates(p);
+    return true;
   }
-  double largest_reach() const { return usable_reach_[kReaches - 1]; }
   /// Starts loading what near(p, radius) will read.
   void prefetch_near(const Vec3& p, double radius) const {
-    for (int k = 0; k < kReaches; ++k) {
-      if (radius <= usable_reach_[static_cast<std::size_t>(k)]) {
-        near_[static_cast<std::size_t>(k)].prefetch(p);
-        return;
-      }
-    }
+    if (const ToolProximityGrid* grid = lists_for(radius)) grid->prefetch(p);
   }
   /// Per tool triangle, its plane: a ball that stays off it by more than the thickness cannot meet
   /// the triangle (the cheap test ahead of the box and exact tests).
   const ToolPlane& plane(std::uint32_t triangle) const { return planes_[triangle]; }
-  /// Triangle entries over every reach's lists.
-  std::size_t entry_count() const;
 
  private:
+  // The lists of the smallest reach that holds a sphere of this radius; none past the largest.
+  const ToolProximityGrid* lists_for(double radius) const {
+    for (std::size_t k = 0; k < kReaches; ++k) {
+      if (radius <= usable_reach_[k]) return &near_[k];
+    }
+    return nullptr;
+  }
+
   ToolClearanceGrid clearance_;
   std::array<ToolProximityGrid, kReaches> near_;
   std::array<double, kReaches> usable_reach_{};  // each list's reach, less a margin for rounding

@@ -20,49 +20,46 @@ void ToolProximityGrid::build(const TriangleMesh& mesh, double reach_m, std::siz
       high = glm::max(high, mesh.positions[v]);
     }
   }
-  lower_ = low - Vec3(reach_m);
+  const Vec3 lower = low - Vec3(reach_m);
   upper_ = high + Vec3(reach_m);
-  const Vec3 extent = upper_ - lower_;
+  const Vec3 extent = upper_ - lower;
   // Half the reach keeps a cell's lists near the true ones (a list holds what is within the reach
   // plus half the cell's diagonal); a long part gets larger cells rather than an unbounded grid.
-  cell_m_ = std::max(0.5 * reach_m, std::cbrt(extent.x * extent.y * extent.z / static_cast<double>(max_cells)));
-  inverse_cell_ = 1.0 / cell_m_;
-  // One more cell than the extent needs on each axis, so the box's upper faces are inside.
-  for (int a = 0; a < 3; ++a) dims_[static_cast<std::size_t>(a)] = static_cast<std::size_t>(extent[a] * inverse_cell_) + 1;
-  for (std::size_t a = 0; a < 3; ++a) bricks_[a] = (dims_[a] + kBrick - 1) / kBrick;
+  cells_ = BrickGrid(lower, extent, std::max(0.5 * reach_m, std::cbrt(extent.x * extent.y * extent.z / static_cast<double>(max_cells))));
 
   // Any point of a cell is within half its diagonal of the centre, so a triangle within the reach
   // of such a point is within reach + half diagonal of the centre: the test below keeps it.
-  const double half_diagonal = 0.5 * std::sqrt(3.0) * cell_m_;
+  const double half_diagonal = 0.5 * std::sqrt(3.0) * cells_.cell_m();
   const double keep = reach_m + half_diagonal;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> entries;  // (cell, triangle), triangles ascending
   const auto cell_of = [&](double coordinate, int axis) {
-    const double at = std::floor((coordinate - lower_[axis]) * inverse_cell_);
-    return static_cast<std::size_t>(std::clamp(at, 0.0, static_cast<double>(dims_[static_cast<std::size_t>(axis)] - 1)));
+    const double at = std::floor((coordinate - lower[axis]) * cells_.inverse_cell());
+    return static_cast<std::size_t>(std::clamp(at, 0.0, static_cast<double>(cells_.dim(static_cast<std::size_t>(axis)) - 1)));
   };
   for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
     const Vec3& a = mesh.positions[mesh.triangles[t][0]];
     const Vec3& b = mesh.positions[mesh.triangles[t][1]];
     const Vec3& c = mesh.positions[mesh.triangles[t][2]];
-    const Vec3 box_low = glm::min(a, glm::min(b, c)) - Vec3(keep), box_high = glm::max(a, glm::max(b, c)) + Vec3(keep);
+    const Aabb box = triangle_box(a, b, c);
+    const Vec3 box_low = box.min - Vec3(keep), box_high = box.max + Vec3(keep);
     const std::size_t x0 = cell_of(box_low.x, 0), x1 = cell_of(box_high.x, 0);
     const std::size_t y0 = cell_of(box_low.y, 1), y1 = cell_of(box_high.y, 1);
     const std::size_t z0 = cell_of(box_low.z, 2), z1 = cell_of(box_high.z, 2);
     for (std::size_t z = z0; z <= z1; ++z) {
       for (std::size_t y = y0; y <= y1; ++y) {
         for (std::size_t x = x0; x <= x1; ++x) {
-          const Vec3 centre = lower_ + (Vec3(static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)) + 0.5) * cell_m_;
+          const Vec3 centre = cells_.centre(x, y, z);
           const Vec3 q = closest_point_on_triangle(centre, a, b, c);
           if (glm::dot(centre - q, centre - q) > keep * keep) continue;
-          entries.emplace_back(static_cast<std::uint32_t>(storage_index(x, y, z)), t);
+          entries.emplace_back(static_cast<std::uint32_t>(cells_.storage_index(x, y, z)), t);
         }
       }
     }
   }
   // Counting sort by cell; stable, so each cell's triangles stay ascending.
-  first_.assign(storage_count() + 1, 0);
+  first_.assign(cells_.storage_count() + 1, 0);
   for (const auto& [cell, t] : entries) ++first_[cell + 1];
-  for (std::size_t c = 0; c < storage_count(); ++c) first_[c + 1] += first_[c];
+  for (std::size_t c = 0; c < cells_.storage_count(); ++c) first_[c + 1] += first_[c];
   triangles_.resize(entries.size());
   std::vector<std::uint32_t> fill(first_.begin(), first_.end() - 1);
   for (const auto& [cell, t] : entries) triangles_[fill[cell]++] = t;

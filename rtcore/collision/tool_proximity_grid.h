@@ -11,6 +11,7 @@
 #include <span>
 #include <vector>
 
+#include "rtcore/collision/brick_grid.h"
 #include "rtcore/geometry/vec3.h"
 #include "rtcore/mesh/triangle_mesh.h"
 
@@ -25,47 +26,31 @@ class ToolProximityGrid {
   /// Triangles (ascending index) that may lie within the reach of `p`: every one that does, and
   /// some that do not (those near the cell but not near `p`). Empty when nothing is in reach.
   std::span<const std::uint32_t> candidates(const Vec3& p) const {
-    const Vec3 at = (p - lower_) * inverse_cell_;
-    if (!(at.x >= 0.0 && at.y >= 0.0 && at.z >= 0.0)) return {};
-    const auto ix = static_cast<std::size_t>(at.x), iy = static_cast<std::size_t>(at.y), iz = static_cast<std::size_t>(at.z);
-    if (ix >= dims_[0] || iy >= dims_[1] || iz >= dims_[2]) return {};
-    const std::size_t cell = storage_index(ix, iy, iz);
+    std::size_t cell;
+    if (!cells_.locate(p, cell)) return {};
     return {triangles_.data() + first_[cell], triangles_.data() + first_[cell + 1]};
   }
 
   /// Starts loading the list candidates(p) will read.
   void prefetch(const Vec3& p) const {
-    const Vec3 at = (p - lower_) * inverse_cell_;
-    if (!(at.x >= 0.0 && at.y >= 0.0 && at.z >= 0.0)) return;
-    const auto ix = static_cast<std::size_t>(at.x), iy = static_cast<std::size_t>(at.y), iz = static_cast<std::size_t>(at.z);
-    if (ix >= dims_[0] || iy >= dims_[1] || iz >= dims_[2]) return;
-    const std::size_t cell = storage_index(ix, iy, iz);
-    __builtin_prefetch(first_.data() + cell);
+    std::size_t cell;
+    if (cells_.locate(p, cell)) __builtin_prefetch(first_.data() + cell);
   }
 
   /// The box the cells cover: the mesh's bounding box grown by the reach. Nothing outside it is
   /// within the reach of the mesh.
-  const Vec3& lower() const { return lower_; }
+  const Vec3& lower() const { return cells_.lower(); }
   const Vec3& upper() const { return upper_; }
-  double cell_m() const { return cell_m_; }
-  std::size_t cell_count() const { return dims_[0] * dims_[1] * dims_[2]; }
+  double cell_m() const { return cells_.cell_m(); }
+  std::size_t cell_count() const { return cells_.cell_count(); }
   /// Triangle entries over all cells: the grid's size.
   std::size_t entry_count() const { return triangles_.size(); }
 
  private:
-  // Cells are numbered brick by brick (4 x 4 x 4), and their lists stored in that order: the
-  // lookups of neighbouring points share cache lines.
-  static constexpr std::size_t kBrick = 4;
-  std::size_t storage_index(std::size_t x, std::size_t y, std::size_t z) const {
-    const std::size_t brick = ((z / kBrick) * bricks_[1] + y / kBrick) * bricks_[0] + x / kBrick;
-    return brick * kBrick * kBrick * kBrick + ((z % kBrick) * kBrick + y % kBrick) * kBrick + x % kBrick;
-  }
-  std::size_t storage_count() const { return bricks_[0] * bricks_[1] * bricks_[2] * kBrick * kBrick * kBrick; }
-
-  Vec3 lower_{0.0}, upper_{0.0};
-  std::array<std::size_t, 3> bricks_{0, 0, 0};
-  double cell_m_ = 0.0, inverse_cell_ = 0.0;
-  std::array<std::size_t, 3> dims_{0, 0, 0};
+  // The lists are stored in the cells' brick order: the lookups of neighbouring points share
+  // cache lines.
+  BrickGrid cells_;
+  Vec3 upper_{0.0};
   std::vector<std::uint32_t> first_{0};  // cell c's triangles: triangles_[first_[c], first_[c + 1])
   std::vector<std::uint32_t> triangles_;
 };

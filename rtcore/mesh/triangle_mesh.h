@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <glm/common.hpp>
+
 #include "rtcore/geometry/vec3.h"
 
 namespace resecto {
@@ -27,6 +29,16 @@ struct Aabb {
   Vec3 max{0.0};
   Vec3 size() const { return max - min; }
 };
+
+/// The box of a triangle's corners.
+inline Aabb triangle_box(const Vec3& a, const Vec3& b, const Vec3& c) {
+  return {glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
+}
+/// Whether two closed boxes share a point (touching counts): exact on the coordinates.
+inline bool boxes_overlap(const Aabb& a, const Aabb& b) {
+  return !(a.max.x < b.min.x || b.max.x < a.min.x || a.max.y < b.min.y || b.max.y < a.min.y || a.max.z < b.min.z ||
+           b.max.z < a.min.z);
+}
 
 /// Area-weighted (unnormalised: twice the area) normal of triangle t.
 Vec3 triangle_normal_x2(const TriangleMesh& mesh, std::size_t t);

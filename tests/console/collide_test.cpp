@@ -134,6 +134,29 @@ TEST(CollideCommand, SequenceGivesThePairsOfIndependentQueries) {
   EXPECT_EQ(read_text(sequence), expected.str());
 }
 
+// --method: the paper's dual descent and the tool field (the default) write the same pairs, and the
+// report says which ran and what the tool's field cost.
+TEST(CollideCommand, BothMethodsWriteTheSamePairs) {
+  const Files f = make_files("collide_methods");
+  const auto field = f.dir / "field.csv";
+  const auto dual = f.dir / "dual.csv";
+  const auto field_run = run_resecto(common_args(f) + " --json --pairs " + field.string());
+  ASSERT_EQ(field_run.exit_code, 0) << field_run.err;
+  const auto dual_run = run_resecto(common_args(f) + " --method dual-descent --json --pairs " + dual.string());
+  ASSERT_EQ(dual_run.exit_code, 0) << dual_run.err;
+  const auto field_report = nlohmann::json::parse(field_run.out);
+  const auto dual_report = nlohmann::json::parse(dual_run.out);
+  EXPECT_EQ(field_report["method"], "field");
+  EXPECT_EQ(dual_report["method"], "dual-descent");
+  EXPECT_GT(field_report["tool_field_ms"].get<double>(), 0.0);
+  EXPECT_EQ(dual_report["tool_field_ms"].get<double>(), 0.0);
+  EXPECT_GT(field_report["pairs"].get<std::size_t>(), 100u);
+  EXPECT_EQ(read_text(field), read_text(dual));
+  const auto unknown = run_resecto(common_args(f) + " --method fastest");
+  EXPECT_NE(unknown.exit_code, 0);
+  EXPECT_NE(unknown.err.find("--method"), std::string::npos) << unknown.err;
+}
+
 TEST(CollideCommand, MalformedPosesLineIsNamed) {
   const Files f = make_files("collide_bad_poses");
   std::ofstream(f.poses) << "# header\n1 0 0 0 0 1 0 0 0 0 1 0\n\n1 0 0 0 0 1 zero 0 0 0 1 0\n";
