@@ -179,6 +179,7 @@ ResectionStep Resection::step(const SweptVolume* sweep, bool pedal_down, bool di
     for (std::uint32_t t : candidates_) {
       if (tissue_->topology().alive(t) && sweep->contains(centroid(t))) removing_.push_back(t);
     }
+    keep_reachable_from_surface(removing_);
     if (!removing_.empty()) {
       // A removed tetrahedron with a face on the gland's outer surface opens it.
       const TetTopology& topo = tissue_->topology();
@@ -230,6 +231,39 @@ ResectionStep Resection::step(const SweptVolume* sweep, bool pedal_down, bool di
     ++stats_.spring_compactions;
   }
   return out;
+}
+
+void Resection::keep_reachable_from_surface(std::vector<std::uint32_t>& slots) {
+  // The wire cuts its way in from the tissue's surface. Through the penalty contact it can sink into
+  // the tissue with the pedal up; pressed there, a thin sweep can take the centroid of a tetrahedron
+  // whose neighbours all stay, which would leave a closed void inside the tissue (a surface
+  // component facing inwards, which no exported surface may hold). So only the tetrahedra that the
+  // surface reaches, through faces of this cut's own tetrahedra, go; the rest stay for a sweep that
+  // comes from the surface. Kept in their given order.
+  if (slots.empty()) return;
+  const TetTopology& topo = tissue_->topology();
+  if (stamp_ > 0xF0000000u) restart_stamps();  // the two stamps below must stay ordered
+  const std::uint32_t member = next_stamp();
+  const std::uint32_t reached = next_stamp();
+  for (std::uint32_t t : slots) slot_stamp_[t] = member;
+  queue_.clear();
+  for (std::uint32_t t : slots) {
+    for (int f = 0; f < 4; ++f) {
+      if (topo.neighbor(t, f) != TetTopology::kNone) continue;
+      slot_stamp_[t] = reached;
+      queue_.push_back(t);
+      break;
+    }
+  }
+  for (std::size_t i = 0; i < queue_.size(); ++i) {
+    for (int f = 0; f < 4; ++f) {
+      const std::int32_t n = topo.neighbor(queue_[i], f);
+      if (n == TetTopology::kNone || slot_stamp_[static_cast<std::uint32_t>(n)] != member) continue;
+      slot_stamp_[static_cast<std::uint32_t>(n)] = reached;
+      queue_.push_back(static_cast<std::uint32_t>(n));
+    }
+  }
+  std::erase_if(slots, [&](std::uint32_t t) { return slot_stamp_[t] != reached; });
 }
 
 void Resection::gather_candidates(const SweptVolume& sweep) {

@@ -124,6 +124,9 @@ class Resection {
   int refine_near(const SweptVolume& sweep);
   /// Cuts marked_ down to its `keep` tetrahedra nearest where the path starts.
   void keep_nearest_the_start(const SweptVolume& sweep, std::size_t keep);
+  /// Drops from `slots` (this cut's tetrahedra) those the tissue's surface does not reach through
+  /// faces of the others: a cut never leaves a closed void inside the tissue.
+  void keep_reachable_from_surface(std::vector<std::uint32_t>& slots);
   /// Removes `slots` through the tissue, accounting them; `chip` adds them to the chips' volume.
   void remove(std::vector<std::uint32_t>& slots, bool chip, ResectionStep& out);
   /// Removes tetrahedra hanging by an edge or a vertex around the nodes of `removed` until none is.

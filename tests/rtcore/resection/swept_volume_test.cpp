@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <numbers>
 
 #include <cstdio>
 
+#include "rtcore/mesh/mesh_validation.h"
 #include "rtcore/resection/resection.h"
 #include "tests/support/block_mesh.h"
 
@@ -24,8 +26,9 @@ TEST(SweptVolume, PathDistanceOfAStraightRibbon) {
   EXPECT_NEAR(sweep.bounds().max.y, 0.009, 1e-15);
 }
 
-/// Cuts a 6 mm wire moving 8 mm across itself, radius 1 mm, through the middle of a block of cubes of
-/// `cell_m`, in `steps` collision steps; returns the removed volume over the analytic one.
+/// Cuts a 6 mm wire, radius 1 mm, moving across itself right through a 16 mm block of cubes of
+/// `cell_m` (from 2 mm before its face to 2 mm past the far one, so the cut opens from the surface as
+/// the loop's does), in `steps` collision steps; returns the removed volume over the analytic one.
 double stroke_ratio(double cell_m, bool refine, int steps, std::size_t max_marked, std::int64_t* refined) {
   const int cells = static_cast<int>(std::lround(0.016 / cell_m));
   const TetMesh block = block_mesh(cells, cells, cells, cell_m);
@@ -35,7 +38,7 @@ double stroke_ratio(double cell_m, bool refine, int steps, std::size_t max_marke
   config.max_refined_per_step = max_marked;
   config.channel_origin = Vec3(-1.0);  // no channel: every boundary face is the outer surface
   Resection resection(tissue, config);
-  const double r = 0.001, span = 0.006, travel = 0.008;
+  const double r = 0.001, span = 0.006, side = 0.016, start = -0.002, travel = side + 0.004;
   // The wire along x at the block's mid-height, moving along y, sampled at 13 points.
   std::vector<Vec3> from, to;
   SweptVolume sweep(13);
@@ -44,15 +47,18 @@ double stroke_ratio(double cell_m, bool refine, int steps, std::size_t max_marke
     to.clear();
     for (int i = 0; i <= 12; ++i) {
       const double x = 0.005 + span * i / 12.0;
-      from.push_back({x, 0.004 + travel * step / steps, 0.008});
-      to.push_back({x, 0.004 + travel * (step + 1) / steps, 0.008});
+      from.push_back({x, start + travel * step / steps, 0.008});
+      to.push_back({x, start + travel * (step + 1) / steps, 0.008});
     }
     sweep.set(from, to, r);
     (void)resection.step(&sweep, true, false, 1.0 / 60.0);
   }
   *refined = resection.stats().refined_tetrahedra;
   const double removed = resection.stats().removed_m3[static_cast<std::size_t>(TissueRegion::kCapsule)];
-  return removed / SweptVolume::straight_stroke_volume(span, travel, r);
+  // Inside the block the sweep is the slab and the half-cylinders along the wire's two ends, over
+  // the block's whole depth: the rounded ends of the stroke lie outside it.
+  const double inside = 2.0 * r * span * side + std::numbers::pi * r * r * side;
+  return removed / inside;
 }
 
 TEST(SweptVolume, AStraightStrokeRemovesTheAnalyticVolumeAtTwoResolutions) {
@@ -69,6 +75,41 @@ TEST(SweptVolume, AStraightStrokeRemovesTheAnalyticVolumeAtTwoResolutions) {
     EXPECT_NEAR(on, 1.0, 0.15) << "cell " << cell;
     EXPECT_EQ(refined_off, 0);
   }
+}
+
+TEST(SweptVolume, AWireBuriedInTheTissueCutsNoVoidUntilItsCutReachesTheSurface) {
+  // The wire sunk 4 mm into a 16 mm block (the penalty contact lets it) with the pedal down: its
+  // sweep takes the centroids of tetrahedra that the surface does not reach, and none may go, or a
+  // closed void would be left inside. The next sweep, from there out through the block's face,
+  // opens the cut from the surface, and then both go.
+  const double cell = 0.001;
+  const TetMesh block = block_mesh(16, 16, 16, cell);
+  MassSpringTissue tissue(block);
+  ResectionConfig config;
+  config.channel_origin = Vec3(-1.0);  // no channel: every boundary face is the outer surface
+  Resection resection(tissue, config);
+  SweptVolume sweep(7);
+  const auto wire_at = [](double y) {
+    std::vector<Vec3> wire;
+    for (int i = 0; i <= 6; ++i) wire.push_back({0.005 + 0.006 * i / 6.0, y, 0.008});
+    return wire;
+  };
+  sweep.set(wire_at(0.005), wire_at(0.007), 0.0008);
+  const ResectionStep buried = resection.step(&sweep, true, false, 1.0 / 60.0);
+  EXPECT_EQ(buried.cut_tetrahedra, 0);
+  EXPECT_EQ(resection.stats().removed_m3[static_cast<std::size_t>(TissueRegion::kCapsule)], 0.0);
+  const TriangleMesh untouched = tissue.live_surface(true);
+  ASSERT_TRUE(validate_closed_surface(untouched));
+  EXPECT_EQ(validate_closed_surface(untouched)->components, 1);
+
+  sweep.set(wire_at(0.007), wire_at(-0.002), 0.0008);  // back out through the face at y = 0
+  const ResectionStep opened = resection.step(&sweep, true, false, 1.0 / 60.0);
+  EXPECT_GT(opened.cut_tetrahedra, 0);
+  const TriangleMesh cut = tissue.live_surface(true);
+  Result<SurfaceReport> report = validate_closed_surface(cut);
+  ASSERT_TRUE(report) << report.error();
+  EXPECT_EQ(report->components, 1);
+  EXPECT_GT(report->volume_m3, 0.0);
 }
 
 }  // namespace
