@@ -501,11 +501,14 @@ Result<ordered_json> run_console(const ConsoleOptions& options) {
   if (resolved.view_scale <= 0.0) resolved.view_scale = software ? 0.5 : 1.0;
 
   const auto wall_start = std::chrono::steady_clock::now();
-  session.start();
   Status ran = Ok{};
   ordered_json report;
   {
+    // The window first: it queues --record's start, which the core then takes before its first tick
+    // (started the other way round, a loaded machine let the core tick first, and the recording began
+    // at tick 1, which a replay refuses).
     ConsoleWindow console(window, resolved, session, **renderer, std::move(actions));
+    session.start();
     ran = console.open_initial_replay();
     if (ran) ran = console.run();
     session.stop();
