@@ -242,8 +242,7 @@ void Resection::keep_reachable_from_surface(std::vector<std::uint32_t>& slots) {
   // comes from the surface. Kept in their given order.
   if (slots.empty()) return;
   const TetTopology& topo = tissue_->topology();
-  if (stamp_ > 0xF0000000u) restart_stamps();  // the two stamps below must stay ordered
-  const std::uint32_t member = next_stamp();
+  const std::uint32_t member = next_stamp();  // only compared for equality: a wrap between the two is harmless
   const std::uint32_t reached = next_stamp();
   for (std::uint32_t t : slots) slot_stamp_[t] = member;
   queue_.clear();

@@ -26,38 +26,47 @@ TEST(SweptVolume, PathDistanceOfAStraightRibbon) {
   EXPECT_NEAR(sweep.bounds().max.y, 0.009, 1e-15);
 }
 
-/// Cuts a 6 mm wire, radius 1 mm, moving across itself right through a 16 mm block of cubes of
-/// `cell_m` (from 2 mm before its face to 2 mm past the far one, so the cut opens from the surface as
-/// the loop's does), in `steps` collision steps; returns the removed volume over the analytic one.
+/// A 16 mm block of cubes of `cell_m` (every boundary face its outer surface), its tissue and a
+/// resection of it, cut by a 6 mm wire along x at the block's mid-height.
+struct CutBlock {
+  static constexpr double kSide = 0.016, kSpan = 0.006;
+  CutBlock(double cell_m, const ResectionConfig& config)
+      : block(block_mesh(cells(cell_m), cells(cell_m), cells(cell_m), cell_m)), tissue(block), resection(tissue, no_channel(config)) {}
+  /// The wire's `samples` points at depth y.
+  static std::vector<Vec3> wire_at(double y, int samples) {
+    std::vector<Vec3> wire;
+    for (int i = 0; i < samples; ++i) wire.push_back({0.005 + kSpan * i / (samples - 1), y, 0.008});
+    return wire;
+  }
+  static int cells(double cell_m) { return static_cast<int>(std::lround(kSide / cell_m)); }
+  static ResectionConfig no_channel(ResectionConfig config) {
+    config.channel_origin = Vec3(-1.0);
+    return config;
+  }
+  TetMesh block;
+  MassSpringTissue tissue;
+  Resection resection;
+};
+
+/// Cuts the block with the wire, radius 1 mm, moving across itself right through it (from 2 mm
+/// before its face to 2 mm past the far one, so the cut opens from the surface as the loop's does),
+/// in `steps` collision steps; returns the removed volume over the analytic one.
 double stroke_ratio(double cell_m, bool refine, int steps, std::size_t max_marked, std::int64_t* refined) {
-  const int cells = static_cast<int>(std::lround(0.016 / cell_m));
-  const TetMesh block = block_mesh(cells, cells, cells, cell_m);
-  MassSpringTissue tissue(block);
   ResectionConfig config;
   config.refine = refine;
   config.max_refined_per_step = max_marked;
-  config.channel_origin = Vec3(-1.0);  // no channel: every boundary face is the outer surface
-  Resection resection(tissue, config);
-  const double r = 0.001, span = 0.006, side = 0.016, start = -0.002, travel = side + 0.004;
-  // The wire along x at the block's mid-height, moving along y, sampled at 13 points.
-  std::vector<Vec3> from, to;
+  CutBlock cut(cell_m, config);
+  const double r = 0.001, side = CutBlock::kSide, start = -0.002, travel = side + 0.004;
   SweptVolume sweep(13);
   for (int step = 0; step < steps; ++step) {
-    from.clear();
-    to.clear();
-    for (int i = 0; i <= 12; ++i) {
-      const double x = 0.005 + span * i / 12.0;
-      from.push_back({x, start + travel * step / steps, 0.008});
-      to.push_back({x, start + travel * (step + 1) / steps, 0.008});
-    }
-    sweep.set(from, to, r);
-    (void)resection.step(&sweep, true, false, 1.0 / 60.0);
+    sweep.set(CutBlock::wire_at(start + travel * step / steps, 13), CutBlock::wire_at(start + travel * (step + 1) / steps, 13), r);
+    (void)cut.resection.step(&sweep, true, false, 1.0 / 60.0);
   }
-  *refined = resection.stats().refined_tetrahedra;
-  const double removed = resection.stats().removed_m3[static_cast<std::size_t>(TissueRegion::kCapsule)];
+  *refined = cut.resection.stats().refined_tetrahedra;
+  const double removed = cut.resection.stats().removed_m3[static_cast<std::size_t>(TissueRegion::kCapsule)];
   // Inside the block the sweep is the slab and the half-cylinders along the wire's two ends, over
   // the block's whole depth: the rounded ends of the stroke lie outside it.
-  const double inside = 2.0 * r * span * side + std::numbers::pi * r * r * side;
+  const double inside = 2.0 * r * CutBlock::kSpan * side + std::numbers::pi * r * r * side;
   return removed / inside;
 }
 
@@ -82,31 +91,21 @@ TEST(SweptVolume, AWireBuriedInTheTissueCutsNoVoidUntilItsCutReachesTheSurface) 
   // sweep takes the centroids of tetrahedra that the surface does not reach, and none may go, or a
   // closed void would be left inside. The next sweep, from there out through the block's face,
   // opens the cut from the surface, and then both go.
-  const double cell = 0.001;
-  const TetMesh block = block_mesh(16, 16, 16, cell);
-  MassSpringTissue tissue(block);
-  ResectionConfig config;
-  config.channel_origin = Vec3(-1.0);  // no channel: every boundary face is the outer surface
-  Resection resection(tissue, config);
+  CutBlock cut(0.001, {});
   SweptVolume sweep(7);
-  const auto wire_at = [](double y) {
-    std::vector<Vec3> wire;
-    for (int i = 0; i <= 6; ++i) wire.push_back({0.005 + 0.006 * i / 6.0, y, 0.008});
-    return wire;
-  };
-  sweep.set(wire_at(0.005), wire_at(0.007), 0.0008);
-  const ResectionStep buried = resection.step(&sweep, true, false, 1.0 / 60.0);
+  sweep.set(CutBlock::wire_at(0.005, 7), CutBlock::wire_at(0.007, 7), 0.0008);
+  const ResectionStep buried = cut.resection.step(&sweep, true, false, 1.0 / 60.0);
   EXPECT_EQ(buried.cut_tetrahedra, 0);
-  EXPECT_EQ(resection.stats().removed_m3[static_cast<std::size_t>(TissueRegion::kCapsule)], 0.0);
-  const TriangleMesh untouched = tissue.live_surface(true);
+  EXPECT_EQ(cut.resection.stats().removed_m3[static_cast<std::size_t>(TissueRegion::kCapsule)], 0.0);
+  const TriangleMesh untouched = cut.tissue.live_surface(true);
   ASSERT_TRUE(validate_closed_surface(untouched));
   EXPECT_EQ(validate_closed_surface(untouched)->components, 1);
 
-  sweep.set(wire_at(0.007), wire_at(-0.002), 0.0008);  // back out through the face at y = 0
-  const ResectionStep opened = resection.step(&sweep, true, false, 1.0 / 60.0);
+  sweep.set(CutBlock::wire_at(0.007, 7), CutBlock::wire_at(-0.002, 7), 0.0008);  // back out through the face at y = 0
+  const ResectionStep opened = cut.resection.step(&sweep, true, false, 1.0 / 60.0);
   EXPECT_GT(opened.cut_tetrahedra, 0);
-  const TriangleMesh cut = tissue.live_surface(true);
-  Result<SurfaceReport> report = validate_closed_surface(cut);
+  const TriangleMesh after = cut.tissue.live_surface(true);
+  Result<SurfaceReport> report = validate_closed_surface(after);
   ASSERT_TRUE(report) << report.error();
   EXPECT_EQ(report->components, 1);
   EXPECT_GT(report->volume_m3, 0.0);
