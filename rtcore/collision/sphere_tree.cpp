@@ -6,26 +6,12 @@
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <span>
+
+#include "rtcore/collision/sphere_refit_kernel.h"
 
 namespace resecto {
 namespace {
-
-// Rounding in a sphere's centre and radius is a few ulps; growing every radius by far more than
-// that (relative, plus a floor tied to the coordinates' magnitude) makes the cover conservative.
-inline Sphere inflated(const Vec3& center, double radius) {
-  const double magnitude = std::max({std::abs(center.x), std::abs(center.y), std::abs(center.z), radius});
-  return {center, radius * (1.0 + 1e-12) + magnitude * 1e-15};
-}
-
-// The smallest sphere holding both spheres.
-inline Sphere merge(const Sphere& a, const Sphere& b) {
-  const Vec3 offset = b.center - a.center;
-  const double distance = length(offset);
-  if (distance + b.radius <= a.radius) return a;
-  if (distance + a.radius <= b.radius) return b;
-  const double radius = 0.5 * (distance + a.radius + b.radius);
-  return inflated(a.center + offset * ((radius - a.radius) / distance), radius);
-}
 
 // A sphere around points: the better of the box centre and the centroid.
 template <std::size_t N>
@@ -46,16 +32,7 @@ Sphere sphere_around(const std::array<Vec3, N>& points) {
     const double r = std::sqrt(r2);
     if (r < best.radius) best = {c, r};
   }
-  return inflated(best.center, best.radius);
-}
-
-// The refit's leaf sphere for a whole triangle: centred on the centroid, radius to the farthest
-// corner. One square root and no division or branch: a shade looser than triangle_sphere (equal
-// for an equilateral triangle), and cheap enough for the per-tick refit of every leaf.
-inline Sphere centroid_sphere(const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 center = (a + b + c) * (1.0 / 3.0);
-  const double r2 = std::max({length_squared(a - center), length_squared(b - center), length_squared(c - center)});
-  return inflated(center, std::sqrt(r2));
+  return inflated_sphere(best.center, best.radius);
 }
 
 // A tight sphere around a triangle, O(1): the sphere on its longest edge when that holds the third
@@ -83,7 +60,7 @@ Sphere triangle_sphere(const Vec3& a, const Vec3& b, const Vec3& c) {
     if (w2 > 0.0) center = a + (cross(w, u) * length_squared(v) + cross(v, w) * length_squared(u)) / (2.0 * w2);
   }
   const double r2 = std::max({length_squared(a - center), length_squared(b - center), length_squared(c - center)});
-  return inflated(center, std::sqrt(r2));
+  return inflated_sphere(center, std::sqrt(r2));
 }
 
 double max_abs(const Vec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
@@ -234,6 +211,9 @@ void SphereTree::reserve(std::int32_t max_nodes, std::uint32_t max_triangles) {
   next_leaf_.reserve(nodes);
   refit_leaves_.reserve(nodes);
   refit_internal_.reserve(nodes);
+  for (auto* list : {&whole_leaves_, &sliced_leaves_, &merge_order_, &block_top_, &block_pending_, &block_nodes_, &block_walk_}) list->reserve(nodes);
+  refit_blocks_.reserve(nodes);
+  merge_group_ends_.reserve(nodes);
   stack_.reserve(nodes);
   first_leaf_.reserve(max_triangles);
 }
@@ -391,8 +371,8 @@ void SphereTree::cover_leaves(std::int32_t node, const std::int32_t* first, cons
   for (const std::int32_t* n = first; n != last; ++n) {
     radius = std::max(radius, length(spheres_[*n].center - center) + spheres_[*n].radius);
   }
-  const Sphere direct = inflated(center, radius);
-  const Sphere merged = merge(spheres_[links_[node].left], spheres_[links_[node].right]);
+  const Sphere direct = inflated_sphere(center, radius);
+  const Sphere merged = enclosing_sphere(spheres_[links_[node].left], spheres_[links_[node].right]);
   spheres_[node] = direct.radius < merged.radius ? direct : merged;
   if (!slabs_kept_) return;
   // The slab likewise from the leaves' triangles directly, along their area-weighted mean normal:
@@ -440,7 +420,7 @@ void SphereTree::set_child_leans(std::int32_t node) {
 
 void SphereTree::refit_node(std::int32_t node) {
   const SphereTreeLinks& l = links_[node];
-  spheres_[node] = merge(spheres_[l.left], spheres_[l.right]);
+  spheres_[node] = enclosing_sphere(spheres_[l.left], spheres_[l.right]);
   if (slabs_kept_) {
     slabs_[node] = merge_slabs(spheres_[l.left], slabs_[l.left], spheres_[l.right], slabs_[l.right]);
     set_child_leans(node);
@@ -455,6 +435,7 @@ void SphereTree::refit_upward(std::int32_t node) {
 void SphereTree::update_refit_order() {
   refit_leaves_.clear();
   refit_internal_.clear();
+  update_sphere_refit_blocks();
   if (root_ == kNoNode) return;
   // Leaves in node order; internal nodes by height (a child is always lower than its parent), so
   // the merges of one height are independent of each other and overlap in the pipeline.
@@ -490,6 +471,72 @@ void SphereTree::update_refit_order() {
   order_dirty_ = false;
 }
 
+// The spheres-only refit's order. Its merges go four at a time, so they come in groups of one
+// height, whose nodes are never one another's children. A tree far larger than the cache would be
+// swept once per height that way, so the small subtrees go first, each whole while its spheres are
+// in cache (its leaves, then its heights in turn), and the nodes above them last, a height at a time.
+void SphereTree::update_sphere_refit_blocks() {
+  constexpr std::int32_t kBlockHeight = 8;  // up to 256 leaves: 16 KiB of spheres
+  refit_blocks_.clear();
+  whole_leaves_.clear();
+  sliced_leaves_.clear();
+  merge_order_.clear();
+  merge_group_ends_.clear();
+  block_top_.clear();
+  if (root_ == kNoNode) return;
+  const auto add_by_height = [this](std::span<const std::int32_t> nodes, std::int32_t tallest) {
+    for (std::int32_t h = 1; h <= tallest; ++h) {
+      for (const std::int32_t n : nodes) {
+        if (links_[n].height == h) merge_order_.push_back(n);
+      }
+      if (merge_group_ends_.empty() || merge_group_ends_.back() != merge_order_.size()) merge_group_ends_.push_back(merge_order_.size());
+    }
+  };
+  const auto open_block = [this] {
+    refit_blocks_.push_back({whole_leaves_.size(), sliced_leaves_.size(), merge_group_ends_.size(), 0, 0, 0});
+  };
+  const auto close_block = [this] {
+    RefitBlock& block = refit_blocks_.back();
+    block.whole_end = whole_leaves_.size();
+    block.sliced_end = sliced_leaves_.size();
+    block.groups_end = merge_group_ends_.size();
+  };
+  // Depth first from the root, left before right: the order a build numbers the nodes in.
+  std::vector<std::int32_t>& pending = block_pending_;
+  pending.assign(1, root_);
+  while (!pending.empty()) {
+    const std::int32_t n = pending.back();
+    pending.pop_back();
+    if (links_[n].height > kBlockHeight) {
+      block_top_.push_back(n);
+      pending.push_back(links_[n].right);
+      pending.push_back(links_[n].left);
+      continue;
+    }
+    open_block();
+    block_nodes_.clear();
+    block_walk_.assign(1, n);
+    while (!block_walk_.empty()) {
+      const std::int32_t m = block_walk_.back();
+      block_walk_.pop_back();
+      if (links_[m].height == 0) {
+        (pieces_[m].slices == 1 ? whole_leaves_ : sliced_leaves_).push_back(m);
+        continue;
+      }
+      block_nodes_.push_back(m);
+      block_walk_.push_back(links_[m].right);
+      block_walk_.push_back(links_[m].left);
+    }
+    add_by_height(block_nodes_, links_[n].height);
+    close_block();
+  }
+  if (!block_top_.empty()) {
+    open_block();
+    add_by_height(block_top_, links_[root_].height);
+    close_block();
+  }
+}
+
 void SphereTree::refit_leaf(const TriangleMesh& mesh, std::int32_t leaf) {
   const LeafPiece& piece = pieces_[leaf];
   const Triangle& tri = mesh.triangles[piece.triangle];
@@ -520,7 +567,7 @@ void SphereTree::refit_leaf(const TriangleMesh& mesh, std::int32_t leaf) {
 // region through its stored lean.
 void SphereTree::refit_internal(const TriangleMesh& mesh, std::int32_t node) {
   const SphereTreeLinks& l = links_[node];
-  spheres_[node] = merge(spheres_[l.left], spheres_[l.right]);
+  spheres_[node] = enclosing_sphere(spheres_[l.left], spheres_[l.right]);
   if (!slabs_kept_) return;
   const Vec3 axis = slabs_[node].normal;
   double lo = INFINITY;
@@ -558,37 +605,18 @@ void SphereTree::refit(const TriangleMesh& mesh) {
     for (const std::int32_t node : refit_internal_) refit_internal(mesh, node);
     return;
   }
-  // Spheres alone: the same bounds as refit_leaf and refit_internal give, through raw pointers, so
-  // nothing is reloaded per node (a store to a sphere could otherwise alias every vector's data).
-  const Vec3* positions = mesh.positions.data();
-  const Triangle* triangles = mesh.triangles.data();
-  const LeafPiece* pieces = pieces_.data();
-  const SphereTreeLinks* links = links_.data();
-  Sphere* spheres = spheres_.data();
-  const std::int32_t* leaves = refit_leaves_.data();
-  const std::size_t leaf_count = refit_leaves_.size();
-  // A leaf's corners lie three loads deep (piece, triangle, positions), scattered over large
-  // arrays: each is started a few leaves ahead, one level at a time.
-  constexpr std::size_t kPieceAhead = 12, kTriangleAhead = 8, kCornersAhead = 4;
-  for (std::size_t i = 0; i < leaf_count; ++i) {
-    if (i + kPieceAhead < leaf_count) __builtin_prefetch(pieces + leaves[i + kPieceAhead]);
-    if (i + kTriangleAhead < leaf_count) __builtin_prefetch(triangles + pieces[leaves[i + kTriangleAhead]].triangle);
-    if (i + kCornersAhead < leaf_count) {
-      const Triangle& ahead = triangles[pieces[leaves[i + kCornersAhead]].triangle];
-      __builtin_prefetch(positions + ahead[0]);
-      __builtin_prefetch(positions + ahead[1]);
-      __builtin_prefetch(positions + ahead[2]);
+  // Spheres alone: the same bounds as refit_leaf and refit_internal give, block by block, four at a time.
+  const std::span<const std::int32_t> whole(whole_leaves_), merges(merge_order_);
+  for (const RefitBlock& block : refit_blocks_) {
+    centroid_spheres(mesh.positions.data(), mesh.triangles.data(), pieces_.data(), whole.subspan(block.whole_begin, block.whole_end - block.whole_begin),
+                     spheres_.data());
+    for (std::size_t k = block.sliced_begin; k < block.sliced_end; ++k) spheres_[sliced_leaves_[k]] = piece_sphere(mesh, pieces_[sliced_leaves_[k]]);
+    std::size_t begin = block.groups_begin == 0 ? 0 : merge_group_ends_[block.groups_begin - 1];
+    for (std::size_t g = block.groups_begin; g < block.groups_end; ++g) {
+      merge_children(links_.data(), merges.subspan(begin, merge_group_ends_[g] - begin), spheres_.data());
+      begin = merge_group_ends_[g];
     }
-    const std::int32_t leaf = leaves[i];
-    const LeafPiece& piece = pieces[leaf];
-    if (piece.slices != 1) {
-      spheres[leaf] = piece_sphere(mesh, piece);
-      continue;
-    }
-    const Triangle& tri = triangles[piece.triangle];
-    spheres[leaf] = centroid_sphere(positions[tri[0]], positions[tri[1]], positions[tri[2]]);
   }
-  for (const std::int32_t node : refit_internal_) spheres[node] = merge(spheres[links[node].left], spheres[links[node].right]);
 }
 
 // ---- Insert and remove ------------------------------------------------------------------------

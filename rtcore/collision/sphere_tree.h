@@ -190,6 +190,7 @@ class SphereTree {
   void build_over(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles);
   void add_triangle_leaves(const TriangleMesh& mesh, std::uint32_t t, bool insert);
   void update_refit_order();
+  void update_sphere_refit_blocks();
   void renumber_depth_first();
 
   std::vector<Sphere> spheres_;         // hot: per node
@@ -201,6 +202,15 @@ class SphereTree {
   std::vector<std::int32_t> first_leaf_;  // per triangle
   std::vector<std::int32_t> refit_leaves_;    // every live leaf, in node order
   std::vector<std::int32_t> refit_internal_;  // internal nodes, children before parents
+  // The spheres-only refit's order (update_sphere_refit_blocks): blocks of leaves, whole-triangle and
+  // sliced, and of merge groups, each group of one height.
+  struct RefitBlock {
+    std::size_t whole_begin, sliced_begin, groups_begin, whole_end, sliced_end, groups_end;
+  };
+  std::vector<RefitBlock> refit_blocks_;
+  std::vector<std::int32_t> whole_leaves_, sliced_leaves_, merge_order_;
+  std::vector<std::size_t> merge_group_ends_;  // merge_order_'s end of each group
+  std::vector<std::int32_t> block_top_, block_pending_, block_nodes_, block_walk_;  // scratch
   std::vector<std::int32_t> stack_;        // scratch for update_refit_order
   std::int32_t root_ = kNoNode;
   std::int32_t free_list_ = kNoNode;

@@ -126,11 +126,6 @@ __attribute__((target("avx2"))) void add_spring_sums_avx2(const SpringIncidence&
   }
 }
 
-bool cpu_has_avx2() {
-  static const bool has = __builtin_cpu_supports("avx2");
-  return has;
-}
-
 std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end, std::uint32_t* compressed) {
   return cpu_has_avx2() ? spring_forces_avx2(springs, x, v, begin, end, compressed) : spring_forces_portable(springs, x, v, begin, end, compressed);
 }

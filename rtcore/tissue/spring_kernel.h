@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "rtcore/base/cpu_features.h"
 #include "rtcore/geometry/vec3.h"
 
 namespace resecto {
@@ -54,9 +55,6 @@ std::size_t spring_forces_avx2(SpringArrays& springs, const Vec3* x, const Vec3*
 void add_spring_sums_portable(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t begin, std::size_t end);
 /// The same a row at a time; call only where cpu_has_avx2().
 void add_spring_sums_avx2(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t begin, std::size_t end);
-
-/// Whether this processor runs the AVX2 kernels (checked once).
-bool cpu_has_avx2();
 
 /// The fastest kernel this processor runs, over springs [begin, end) (listing the compressed ones at
 /// `compressed`, room for end - begin).

@@ -1,0 +1,161 @@
+// The refit kernels. Each AVX2 loop forms every value with the same IEEE operations in the same order
+// as the inline functions of the header (dot products as (x*x + y*y) + z*z, maxima taken in the same
+// order, no contraction: the build forbids it), so the lane width cannot change a bit. Change both or
+// neither.
+#include "rtcore/collision/sphere_refit_kernel.h"
+
+#include <immintrin.h>
+
+namespace resecto {
+namespace {
+
+/// Four (x, y, z, w) rows as four columns, or back: pure moves.
+struct Columns4 {
+  __m256d x, y, z, w;
+};
+__attribute__((target("avx2"), always_inline)) inline Columns4 transpose4(__m256d r0, __m256d r1, __m256d r2, __m256d r3) {
+  const __m256d xz01 = _mm256_unpacklo_pd(r0, r1), yw01 = _mm256_unpackhi_pd(r0, r1);
+  const __m256d xz23 = _mm256_unpacklo_pd(r2, r3), yw23 = _mm256_unpackhi_pd(r2, r3);
+  return {_mm256_permute2f128_pd(xz01, xz23, 0x20), _mm256_permute2f128_pd(yw01, yw23, 0x20), _mm256_permute2f128_pd(xz01, xz23, 0x31),
+          _mm256_permute2f128_pd(yw01, yw23, 0x31)};
+}
+
+/// A corner's (x, y, z, 0): a masked load, so the last corner never reads past the array.
+__attribute__((target("avx2"), always_inline)) inline __m256d load_corner(const Vec3& p) {
+  return _mm256_maskload_pd(&p.x, _mm256_set_epi64x(0, -1, -1, -1));
+}
+
+__attribute__((target("avx2"), always_inline)) inline __m256d dot3(__m256d x, __m256d y, __m256d z) {
+  return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(x, x), _mm256_mul_pd(y, y)), _mm256_mul_pd(z, z));
+}
+
+__attribute__((target("avx2"), always_inline)) inline __m256d absolute(__m256d v) {
+  return _mm256_andnot_pd(_mm256_set1_pd(-0.0), v);
+}
+
+/// inflated_sphere()'s radius for four centres and radii.
+__attribute__((target("avx2"), always_inline)) inline __m256d inflated_radius(__m256d cx, __m256d cy, __m256d cz, __m256d radius) {
+  const __m256d magnitude = _mm256_max_pd(_mm256_max_pd(_mm256_max_pd(absolute(cx), absolute(cy)), absolute(cz)), radius);
+  return _mm256_add_pd(_mm256_mul_pd(radius, _mm256_set1_pd(1.0 + 1e-12)), _mm256_mul_pd(magnitude, _mm256_set1_pd(1e-15)));
+}
+
+/// Four spheres from columns to their rows, stored at their nodes.
+__attribute__((target("avx2"), always_inline)) inline void store_spheres(Sphere* spheres, const std::int32_t* nodes, const Columns4& c) {
+  const Columns4 rows = transpose4(c.x, c.y, c.z, c.w);
+  _mm256_storeu_pd(&spheres[nodes[0]].center.x, rows.x);
+  _mm256_storeu_pd(&spheres[nodes[1]].center.x, rows.y);
+  _mm256_storeu_pd(&spheres[nodes[2]].center.x, rows.z);
+  _mm256_storeu_pd(&spheres[nodes[3]].center.x, rows.w);
+}
+
+/// enclosing_sphere()'s choice per lane: a where it holds b, else b where it holds a, else the sphere over both.
+__attribute__((target("avx2"), always_inline)) inline __m256d pick(__m256d a_holds_b, __m256d b_holds_a, __m256d over_both, __m256d from_a,
+                                                                   __m256d from_b) {
+  return _mm256_blendv_pd(_mm256_blendv_pd(over_both, from_b, b_holds_a), from_a, a_holds_b);
+}
+
+__attribute__((target("avx2"), always_inline)) inline __m256d load_sphere(const Sphere& s) { return _mm256_loadu_pd(&s.center.x); }
+
+}  // namespace
+
+void centroid_spheres_portable(const Vec3* positions, const Triangle* triangles, const LeafPiece* pieces, std::span<const std::int32_t> leaves,
+                               Sphere* spheres) {
+  for (const std::int32_t leaf : leaves) {
+    const Triangle& t = triangles[pieces[leaf].triangle];
+    spheres[leaf] = centroid_sphere(positions[t[0]], positions[t[1]], positions[t[2]]);
+  }
+}
+
+__attribute__((target("avx2"))) void centroid_spheres_avx2(const Vec3* positions, const Triangle* triangles, const LeafPiece* pieces,
+                                                           std::span<const std::int32_t> leaves, Sphere* spheres) {
+  const std::size_t count = leaves.size();
+  const std::int32_t* leaf = leaves.data();
+  // A leaf's corners lie three loads deep (piece, triangle, positions), scattered over large arrays:
+  // each level is started some leaves ahead.
+  constexpr std::size_t kPieceAhead = 24, kTriangleAhead = 16, kCornersAhead = 8;
+  const __m256d third = _mm256_set1_pd(1.0 / 3.0);
+  std::size_t i = 0;
+  for (; i + 4 <= count; i += 4) {
+    for (std::size_t k = i; k < i + 4; ++k) {
+      if (k + kPieceAhead < count) __builtin_prefetch(pieces + leaf[k + kPieceAhead]);
+      if (k + kTriangleAhead < count) __builtin_prefetch(triangles + pieces[leaf[k + kTriangleAhead]].triangle);
+      if (k + kCornersAhead < count) {
+        const Triangle& ahead = triangles[pieces[leaf[k + kCornersAhead]].triangle];
+        __builtin_prefetch(positions + ahead[0]);
+        __builtin_prefetch(positions + ahead[1]);
+        __builtin_prefetch(positions + ahead[2]);
+      }
+    }
+    const Triangle& t0 = triangles[pieces[leaf[i]].triangle];
+    const Triangle& t1 = triangles[pieces[leaf[i + 1]].triangle];
+    const Triangle& t2 = triangles[pieces[leaf[i + 2]].triangle];
+    const Triangle& t3 = triangles[pieces[leaf[i + 3]].triangle];
+    const Columns4 a = transpose4(load_corner(positions[t0[0]]), load_corner(positions[t1[0]]), load_corner(positions[t2[0]]),
+                                  load_corner(positions[t3[0]]));
+    const Columns4 b = transpose4(load_corner(positions[t0[1]]), load_corner(positions[t1[1]]), load_corner(positions[t2[1]]),
+                                  load_corner(positions[t3[1]]));
+    const Columns4 c = transpose4(load_corner(positions[t0[2]]), load_corner(positions[t1[2]]), load_corner(positions[t2[2]]),
+                                  load_corner(positions[t3[2]]));
+    // (a + b + c) * (1/3), per coordinate.
+    const __m256d cx = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(a.x, b.x), c.x), third);
+    const __m256d cy = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(a.y, b.y), c.y), third);
+    const __m256d cz = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(a.z, b.z), c.z), third);
+    const __m256d da = dot3(_mm256_sub_pd(a.x, cx), _mm256_sub_pd(a.y, cy), _mm256_sub_pd(a.z, cz));
+    const __m256d db = dot3(_mm256_sub_pd(b.x, cx), _mm256_sub_pd(b.y, cy), _mm256_sub_pd(b.z, cz));
+    const __m256d dc = dot3(_mm256_sub_pd(c.x, cx), _mm256_sub_pd(c.y, cy), _mm256_sub_pd(c.z, cz));
+    const __m256d radius = _mm256_sqrt_pd(_mm256_max_pd(_mm256_max_pd(da, db), dc));
+    store_spheres(spheres, leaf + i, {cx, cy, cz, inflated_radius(cx, cy, cz, radius)});
+  }
+  centroid_spheres_portable(positions, triangles, pieces, leaves.subspan(i), spheres);
+}
+
+void centroid_spheres(const Vec3* positions, const Triangle* triangles, const LeafPiece* pieces, std::span<const std::int32_t> leaves,
+                      Sphere* spheres) {
+  if (cpu_has_avx2()) {
+    centroid_spheres_avx2(positions, triangles, pieces, leaves, spheres);
+  } else {
+    centroid_spheres_portable(positions, triangles, pieces, leaves, spheres);
+  }
+}
+
+void merge_children_portable(const SphereTreeLinks* links, std::span<const std::int32_t> nodes, Sphere* spheres) {
+  for (const std::int32_t node : nodes) spheres[node] = enclosing_sphere(spheres[links[node].left], spheres[links[node].right]);
+}
+
+__attribute__((target("avx2"))) void merge_children_avx2(const SphereTreeLinks* links, std::span<const std::int32_t> nodes, Sphere* spheres) {
+  const std::size_t count = nodes.size();
+  const std::int32_t* node = nodes.data();
+  std::size_t i = 0;
+  for (; i + 4 <= count; i += 4) {
+    const SphereTreeLinks &l0 = links[node[i]], &l1 = links[node[i + 1]], &l2 = links[node[i + 2]], &l3 = links[node[i + 3]];
+    const Columns4 a = transpose4(load_sphere(spheres[l0.left]), load_sphere(spheres[l1.left]), load_sphere(spheres[l2.left]),
+                                  load_sphere(spheres[l3.left]));
+    const Columns4 b = transpose4(load_sphere(spheres[l0.right]), load_sphere(spheres[l1.right]), load_sphere(spheres[l2.right]),
+                                  load_sphere(spheres[l3.right]));
+    const __m256d ox = _mm256_sub_pd(b.x, a.x), oy = _mm256_sub_pd(b.y, a.y), oz = _mm256_sub_pd(b.z, a.z);
+    const __m256d distance = _mm256_sqrt_pd(dot3(ox, oy, oz));
+    // Where one sphere holds the other, that one, as it is; else the sphere over both, inflated.
+    const __m256d a_holds_b = _mm256_cmp_pd(_mm256_add_pd(distance, b.w), a.w, _CMP_LE_OQ);
+    const __m256d b_holds_a = _mm256_cmp_pd(_mm256_add_pd(distance, a.w), b.w, _CMP_LE_OQ);
+    const __m256d radius = _mm256_mul_pd(_mm256_set1_pd(0.5), _mm256_add_pd(_mm256_add_pd(distance, a.w), b.w));
+    const __m256d step = _mm256_div_pd(_mm256_sub_pd(radius, a.w), distance);
+    const __m256d cx = _mm256_add_pd(a.x, _mm256_mul_pd(ox, step));
+    const __m256d cy = _mm256_add_pd(a.y, _mm256_mul_pd(oy, step));
+    const __m256d cz = _mm256_add_pd(a.z, _mm256_mul_pd(oz, step));
+    const __m256d cr = inflated_radius(cx, cy, cz, radius);
+    store_spheres(spheres, node + i,
+                  {pick(a_holds_b, b_holds_a, cx, a.x, b.x), pick(a_holds_b, b_holds_a, cy, a.y, b.y), pick(a_holds_b, b_holds_a, cz, a.z, b.z),
+                   pick(a_holds_b, b_holds_a, cr, a.w, b.w)});
+  }
+  merge_children_portable(links, nodes.subspan(i), spheres);
+}
+
+void merge_children(const SphereTreeLinks* links, std::span<const std::int32_t> nodes, Sphere* spheres) {
+  if (cpu_has_avx2()) {
+    merge_children_avx2(links, nodes, spheres);
+  } else {
+    merge_children_portable(links, nodes, spheres);
+  }
+}
+
+}  // namespace resecto
