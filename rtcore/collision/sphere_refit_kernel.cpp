@@ -6,28 +6,14 @@
 
 #include <immintrin.h>
 
+#include "rtcore/geometry/avx2_rows.h"
+
 namespace resecto {
 namespace {
 
-/// Four (x, y, z, w) rows as four columns, or back: pure moves.
-struct Columns4 {
-  __m256d x, y, z, w;
-};
-__attribute__((target("avx2"), always_inline)) inline Columns4 transpose4(__m256d r0, __m256d r1, __m256d r2, __m256d r3) {
-  const __m256d xz01 = _mm256_unpacklo_pd(r0, r1), yw01 = _mm256_unpackhi_pd(r0, r1);
-  const __m256d xz23 = _mm256_unpacklo_pd(r2, r3), yw23 = _mm256_unpackhi_pd(r2, r3);
-  return {_mm256_permute2f128_pd(xz01, xz23, 0x20), _mm256_permute2f128_pd(yw01, yw23, 0x20), _mm256_permute2f128_pd(xz01, xz23, 0x31),
-          _mm256_permute2f128_pd(yw01, yw23, 0x31)};
-}
-
-/// A corner's (x, y, z, 0): a masked load, so the last corner never reads past the array.
-__attribute__((target("avx2"), always_inline)) inline __m256d load_corner(const Vec3& p) {
-  return _mm256_maskload_pd(&p.x, _mm256_set_epi64x(0, -1, -1, -1));
-}
-
-__attribute__((target("avx2"), always_inline)) inline __m256d dot3(__m256d x, __m256d y, __m256d z) {
-  return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(x, x), _mm256_mul_pd(y, y)), _mm256_mul_pd(z, z));
-}
+using avx2::Columns4;
+using avx2::dot3;
+using avx2::transpose4;
 
 __attribute__((target("avx2"), always_inline)) inline __m256d absolute(__m256d v) {
   return _mm256_andnot_pd(_mm256_set1_pd(-0.0), v);
@@ -90,12 +76,12 @@ __attribute__((target("avx2"))) void centroid_spheres_avx2(const Vec3* positions
     const Triangle& t1 = triangles[pieces[leaf[i + 1]].triangle];
     const Triangle& t2 = triangles[pieces[leaf[i + 2]].triangle];
     const Triangle& t3 = triangles[pieces[leaf[i + 3]].triangle];
-    const Columns4 a = transpose4(load_corner(positions[t0[0]]), load_corner(positions[t1[0]]), load_corner(positions[t2[0]]),
-                                  load_corner(positions[t3[0]]));
-    const Columns4 b = transpose4(load_corner(positions[t0[1]]), load_corner(positions[t1[1]]), load_corner(positions[t2[1]]),
-                                  load_corner(positions[t3[1]]));
-    const Columns4 c = transpose4(load_corner(positions[t0[2]]), load_corner(positions[t1[2]]), load_corner(positions[t2[2]]),
-                                  load_corner(positions[t3[2]]));
+    const Columns4 a = transpose4(avx2::load_point(positions[t0[0]]), avx2::load_point(positions[t1[0]]), avx2::load_point(positions[t2[0]]),
+                                  avx2::load_point(positions[t3[0]]));
+    const Columns4 b = transpose4(avx2::load_point(positions[t0[1]]), avx2::load_point(positions[t1[1]]), avx2::load_point(positions[t2[1]]),
+                                  avx2::load_point(positions[t3[1]]));
+    const Columns4 c = transpose4(avx2::load_point(positions[t0[2]]), avx2::load_point(positions[t1[2]]), avx2::load_point(positions[t2[2]]),
+                                  avx2::load_point(positions[t3[2]]));
     // (a + b + c) * (1/3), per coordinate.
     const __m256d cx = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(a.x, b.x), c.x), third);
     const __m256d cy = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(a.y, b.y), c.y), third);

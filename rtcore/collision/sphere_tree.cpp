@@ -214,6 +214,7 @@ void SphereTree::reserve(std::int32_t max_nodes, std::uint32_t max_triangles) {
   for (auto* list : {&whole_leaves_, &sliced_leaves_, &merge_order_, &block_top_, &block_pending_, &block_nodes_, &block_walk_}) list->reserve(nodes);
   refit_blocks_.reserve(nodes);
   merge_group_ends_.reserve(nodes);
+  height_slots_.reserve(64);
   stack_.reserve(nodes);
   first_leaf_.reserve(max_triangles);
 }
@@ -435,7 +436,12 @@ void SphereTree::refit_upward(std::int32_t node) {
 void SphereTree::update_refit_order() {
   refit_leaves_.clear();
   refit_internal_.clear();
-  update_sphere_refit_blocks();
+  order_dirty_ = false;
+  // After every edit of a cut: each order is made only for the refit that uses it.
+  if (!slabs_kept_) {
+    update_sphere_refit_blocks();
+    return;
+  }
   if (root_ == kNoNode) return;
   // Leaves in node order; internal nodes by height (a child is always lower than its parent), so
   // the merges of one height are independent of each other and overlap in the pipeline.
@@ -468,7 +474,6 @@ void SphereTree::update_refit_order() {
       if (links_[n].height > 0) refit_internal_.push_back(n);
     }
   }
-  order_dirty_ = false;
 }
 
 // The spheres-only refit's order. Its merges go four at a time, so they come in groups of one
@@ -484,12 +489,16 @@ void SphereTree::update_sphere_refit_blocks() {
   merge_group_ends_.clear();
   block_top_.clear();
   if (root_ == kNoNode) return;
-  const auto add_by_height = [this](std::span<const std::int32_t> nodes, std::int32_t tallest) {
-    for (std::int32_t h = 1; h <= tallest; ++h) {
-      for (const std::int32_t n : nodes) {
-        if (links_[n].height == h) merge_order_.push_back(n);
-      }
-      if (merge_group_ends_.empty() || merge_group_ends_.back() != merge_order_.size()) merge_group_ends_.push_back(merge_order_.size());
+  const auto add_by_height = [this](std::span<const std::int32_t> nodes, std::int32_t tallest) {  // a counting sort
+    std::vector<std::size_t>& next = height_slots_;
+    next.assign(static_cast<std::size_t>(tallest) + 2, 0);
+    for (const std::int32_t n : nodes) ++next[static_cast<std::size_t>(links_[n].height) + 1];
+    next[0] = merge_order_.size();
+    for (std::size_t h = 1; h < next.size(); ++h) next[h] += next[h - 1];
+    merge_order_.resize(merge_order_.size() + nodes.size());
+    for (const std::int32_t n : nodes) merge_order_[next[static_cast<std::size_t>(links_[n].height)]++] = n;
+    for (std::size_t h = 1; h < next.size() - 1; ++h) {  // next[h] now ends height h
+      if (next[h] != (merge_group_ends_.empty() ? 0 : merge_group_ends_.back())) merge_group_ends_.push_back(next[h]);
     }
   };
   const auto open_block = [this] {

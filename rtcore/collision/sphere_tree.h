@@ -211,6 +211,7 @@ class SphereTree {
   std::vector<std::int32_t> whole_leaves_, sliced_leaves_, merge_order_;
   std::vector<std::size_t> merge_group_ends_;  // merge_order_'s end of each group
   std::vector<std::int32_t> block_top_, block_pending_, block_nodes_, block_walk_;  // scratch
+  std::vector<std::size_t> height_slots_;                                           // scratch
   std::vector<std::int32_t> stack_;        // scratch for update_refit_order
   std::int32_t root_ = kNoNode;
   std::int32_t free_list_ = kNoNode;

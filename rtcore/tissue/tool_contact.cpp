@@ -257,11 +257,11 @@ void ToolContacts::keep_within_margin(std::uint32_t first, const Vec3& p, const 
   std::vector<std::uint32_t>& pairs = search_.pair_triangles;
   std::vector<std::pair<double, std::uint32_t>>& kept = search_.kept;
   kept.clear();
-  for (std::size_t e = first; e < search_.pair_count; ++e) {
-    const Triangle& t = triangles[pairs[e]];
-    const Vec3 q = closest_point_on_triangle(p, positions[t[0]], positions[t[1]], positions[t[2]]);
-    const double d2 = glm::dot(p - q, p - q);
-    if (d2 <= margin_m_ * margin_m_) kept.emplace_back(d2, pairs[e]);
+  const std::size_t count = search_.pair_count - first;
+  double* d2 = search_.pair_distance.data() + first;  // scratch until the kept ones' distances are written
+  squared_distances_to_triangles(p, positions.data(), triangles.data(), &pairs[first], count, d2);
+  for (std::size_t k = 0; k < count; ++k) {
+    if (d2[k] <= margin_m_ * margin_m_) kept.emplace_back(d2[k], pairs[first + k]);
   }
   std::sort(kept.begin(), kept.end());  // by distance², ties by face index: the same order every run
   for (std::size_t k = 0; k < kept.size(); ++k) {
@@ -334,6 +334,7 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
   if (node_stamp_.size() < surface.vertex_count()) node_stamp_.assign(surface.vertex_count(), 0);
   if (tissue_triangle_stamp_.size() < surface.triangle_count()) tissue_triangle_stamp_.assign(surface.triangle_count(), 0);
   if (near_triangles_.capacity() < surface.triangle_count()) near_triangles_.reserve(surface.triangle_count());
+  if (near_boxes_.capacity() < surface.triangle_count()) near_boxes_.reserve(surface.triangle_count());
   if (stack_.capacity() < 4 * surface.triangle_count()) stack_.reserve(4 * surface.triangle_count());
   if (stamp_ > 0xfff00000u) {  // keep the stamps from wrapping
     std::fill(node_stamp_.begin(), node_stamp_.end(), 0u);
@@ -428,6 +429,12 @@ void ToolContacts::search_tool_vertices(std::uint16_t part_index, const SphereTr
     gather_triangles(tissue_tree, pose.apply_point(cluster.bound.center), cluster.bound.radius + margin_m_);
     if (near_triangles_.empty()) continue;
     ++out.stats.tool_clusters;
+    // Each face's box once for the cluster's vertices, read in order by each.
+    near_boxes_.clear();
+    for (std::uint32_t face : near_triangles_) {
+      const Triangle& t = surface.triangles[face];
+      near_boxes_.push_back({glm::min(x[t[0]], glm::min(x[t[1]], x[t[2]])), glm::max(x[t[0]], glm::max(x[t[1]], x[t[2]]))});
+    }
     for (std::uint32_t k = cluster.first; k < cluster.first + cluster.count; ++k) {
       const std::uint32_t v = part.cluster_vertices[k];
       if (out.vertex_count >= out.vertices.size()) {
@@ -436,11 +443,9 @@ void ToolContacts::search_tool_vertices(std::uint16_t part_index, const SphereTr
       }
       const auto first = static_cast<std::uint32_t>(out.pair_count);
       const Vec3 w = pose.apply_point(part.mesh.positions[v]);
-      for (std::uint32_t face : near_triangles_) {
-        const Triangle& t = surface.triangles[face];
-        const Vec3 low = glm::min(x[t[0]], glm::min(x[t[1]], x[t[2]])), high = glm::max(x[t[0]], glm::max(x[t[1]], x[t[2]]));
-        const Vec3 gap = glm::max(glm::max(low - w, w - high), Vec3(0.0));
-        if (glm::dot(gap, gap) <= margin2) push_pair(face);
+      for (std::size_t k = 0; k < near_triangles_.size(); ++k) {
+        const Vec3 gap = glm::max(glm::max(near_boxes_[k].low - w, w - near_boxes_[k].high), Vec3(0.0));
+        if (glm::dot(gap, gap) <= margin2) push_pair(near_triangles_[k]);
       }
       keep_within_margin(first, w, x, surface.triangles);
       const auto count = static_cast<std::uint32_t>(out.pair_count - first);
@@ -562,6 +567,7 @@ void ToolContacts::reserve_tissue(std::size_t max_nodes, std::size_t max_faces) 
   if (node_stamp_.size() < max_nodes) node_stamp_.assign(max_nodes, 0);
   if (tissue_triangle_stamp_.size() < max_faces) tissue_triangle_stamp_.assign(max_faces, 0);
   near_triangles_.reserve(max_faces);
+  near_boxes_.reserve(max_faces);
   // A tissue tree has about two nodes per leaf and a leaf or two per face: a depth-first stack never
   // holds more than the tree's nodes.
   stack_.reserve(4 * max_faces);

@@ -223,6 +223,10 @@ class ToolContacts {
   std::uint32_t stamp_ = 0;
   std::vector<std::int32_t> stack_;
   std::vector<std::uint32_t> near_triangles_;  // gather_triangles()'s result
+  struct Box {
+    Vec3 low, high;
+  };
+  std::vector<Box> near_boxes_;  // per face of near_triangles_, its box at the searched positions
   ToolContactStats stats_;
 };
 

@@ -1,10 +1,14 @@
 // closest_point_on_triangle against a brute-force oracle: the nearest of a dense barycentric grid
-// over the triangle, for points in every Voronoi region and for degenerate triangles.
+// over the triangle, for points in every Voronoi region and for degenerate triangles; and the
+// four-at-a-time squared distances against it bit for bit.
 #include "rtcore/geometry/closest_point.h"
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <random>
+
+#include "rtcore/base/cpu_features.h"
 
 namespace resecto {
 namespace {
@@ -66,6 +70,40 @@ TEST(ClosestPoint, DegenerateTrianglesFallBackToTheirEdges) {
   // All three corners at one point.
   const Vec3 p(3, 4, 5);
   EXPECT_EQ(closest_point_on_triangle(Vec3(0, 0, 0), p, p, p), p);
+}
+
+TEST(ClosestPoint, FourAtATimeSquaredDistancesMatchTheOneAtATimeOnesBitForBit) {
+  if (!cpu_has_avx2()) GTEST_SKIP() << "no AVX2 on this processor: only the portable path runs";
+  // Random triangles and points near them reach every region; then degenerate ones (collinear, one
+  // point, two corners equal) and a point on a corner, among ordinary ones in the same groups of four.
+  std::mt19937_64 random(29);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+  std::vector<Vec3> positions;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  const auto add = [&](const Vec3& a, const Vec3& b, const Vec3& c) {
+    const auto first = static_cast<std::uint32_t>(positions.size());
+    positions.insert(positions.end(), {a, b, c});
+    triangles.push_back({first, first + 1, first + 2});
+  };
+  const auto any = [&] { return Vec3(coordinate(random), coordinate(random), coordinate(random)); };
+  for (int t = 0; t < 2000; ++t) add(any(), any(), any());
+  add(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0));
+  add(Vec3(0.3, 0.3, 0.3), Vec3(0.3, 0.3, 0.3), Vec3(0.3, 0.3, 0.3));
+  add(Vec3(0, 0, 0), Vec3(0, 0, 0), Vec3(0, 1, 0));
+  add(Vec3(0.1, 0.2, 0.3), Vec3(0.5, -0.2, 0.1), Vec3(-0.4, 0.6, 0.2));
+  std::vector<std::uint32_t> faces(triangles.size());
+  for (std::uint32_t f = 0; f < faces.size(); ++f) faces[f] = static_cast<std::uint32_t>(faces.size()) - 1 - f;
+  std::vector<Vec3> points;
+  for (int k = 0; k < 200; ++k) points.push_back(2.0 * any());
+  points.push_back(Vec3(0.1, 0.2, 0.3));
+  for (const Vec3& p : points) {
+    for (const std::size_t count : {faces.size(), faces.size() - 3, std::size_t{2}}) {
+      std::vector<double> portable(count), simd(count);
+      squared_distances_to_triangles_portable(p, positions.data(), triangles.data(), faces.data(), count, portable.data());
+      squared_distances_to_triangles_avx2(p, positions.data(), triangles.data(), faces.data(), count, simd.data());
+      ASSERT_EQ(std::memcmp(portable.data(), simd.data(), count * sizeof(double)), 0) << "a point at " << p.x << ", " << p.y << ", " << p.z;
+    }
+  }
 }
 
 }  // namespace
