@@ -6,6 +6,9 @@
 
 #include <immintrin.h>
 
+#include <array>
+#include <cmath>
+
 #include "rtcore/geometry/avx2_rows.h"
 
 namespace resecto {
@@ -101,6 +104,83 @@ void centroid_spheres(const Vec3* positions, const Triangle* triangles, const Le
     centroid_spheres_avx2(positions, triangles, pieces, leaves, spheres);
   } else {
     centroid_spheres_portable(positions, triangles, pieces, leaves, spheres);
+  }
+}
+
+void sliced_piece_spheres_portable(const TriangleMesh& mesh, const LeafPiece* pieces, std::span<const std::int32_t> leaves, Sphere* spheres) {
+  for (const std::int32_t leaf : leaves) spheres[leaf] = SphereTree::piece_sphere(mesh, pieces[leaf]);
+}
+
+namespace {
+
+/// A column of four points (one per lane) and the column arithmetic piece_sphere's uses.
+struct Points4 {
+  __m256d x, y, z;
+};
+__attribute__((target("avx2"), always_inline)) inline Points4 corner_of(const TriangleMesh& mesh, const LeafPiece* const* piece, int offset) {
+  const auto at = [&](int lane) -> const Vec3& {
+    const Triangle& t = mesh.triangles[piece[lane]->triangle];
+    return mesh.positions[t[(piece[lane]->apex + offset) % 3]];
+  };
+  const Columns4 c = transpose4(avx2::load_point(at(0)), avx2::load_point(at(1)), avx2::load_point(at(2)), avx2::load_point(at(3)));
+  return {c.x, c.y, c.z};
+}
+/// x * (1 - t) + b * t per coordinate (glm's order).
+__attribute__((target("avx2"), always_inline)) inline Points4 lerp(const Points4& x, const Points4& b, __m256d t) {
+  const __m256d s = _mm256_sub_pd(_mm256_set1_pd(1.0), t);
+  return {_mm256_add_pd(_mm256_mul_pd(x.x, s), _mm256_mul_pd(b.x, t)), _mm256_add_pd(_mm256_mul_pd(x.y, s), _mm256_mul_pd(b.y, t)),
+          _mm256_add_pd(_mm256_mul_pd(x.z, s), _mm256_mul_pd(b.z, t))};
+}
+/// The largest squared distance from c to the four points, taken as std::max takes it from 0.
+__attribute__((target("avx2"), always_inline)) inline __m256d reach2(const std::array<Points4, 4>& points, const Points4& c) {
+  __m256d r2 = _mm256_setzero_pd();
+  for (const Points4& p : points) {
+    r2 = _mm256_max_pd(dot3(_mm256_sub_pd(p.x, c.x), _mm256_sub_pd(p.y, c.y), _mm256_sub_pd(p.z, c.z)), r2);
+  }
+  return r2;
+}
+
+}  // namespace
+
+__attribute__((target("avx2"))) void sliced_piece_spheres_avx2(const TriangleMesh& mesh, const LeafPiece* pieces, std::span<const std::int32_t> leaves,
+                                                               Sphere* spheres) {
+  const std::size_t count = leaves.size();
+  std::size_t i = 0;
+  for (; i + 4 <= count; i += 4) {
+    const LeafPiece* piece[4] = {&pieces[leaves[i]], &pieces[leaves[i + 1]], &pieces[leaves[i + 2]], &pieces[leaves[i + 3]]};
+    const Points4 b = corner_of(mesh, piece, 0), x = corner_of(mesh, piece, 1), y = corner_of(mesh, piece, 2);
+    const __m256d slice = _mm256_set_pd(piece[3]->slice, piece[2]->slice, piece[1]->slice, piece[0]->slice);
+    const __m256d slices = _mm256_set_pd(piece[3]->slices, piece[2]->slices, piece[1]->slices, piece[0]->slices);
+    const __m256d t0 = _mm256_div_pd(slice, slices), t1 = _mm256_div_pd(_mm256_add_pd(slice, _mm256_set1_pd(1.0)), slices);
+    // sphere_around() of the slab's four corners: the box centre's sphere, or the centroid's if smaller.
+    const std::array<Points4, 4> p{lerp(x, b, t0), lerp(y, b, t0), lerp(x, b, t1), lerp(y, b, t1)};
+    Points4 low = p[0], high = p[0];
+    Points4 sum{_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_setzero_pd()};
+    for (const Points4& q : p) {
+      low = {_mm256_min_pd(q.x, low.x), _mm256_min_pd(q.y, low.y), _mm256_min_pd(q.z, low.z)};
+      high = {_mm256_max_pd(q.x, high.x), _mm256_max_pd(q.y, high.y), _mm256_max_pd(q.z, high.z)};
+      sum = {_mm256_add_pd(sum.x, q.x), _mm256_add_pd(sum.y, q.y), _mm256_add_pd(sum.z, q.z)};
+    }
+    const __m256d half = _mm256_set1_pd(0.5), four = _mm256_set1_pd(4.0);
+    const Points4 box{_mm256_mul_pd(half, _mm256_add_pd(low.x, high.x)), _mm256_mul_pd(half, _mm256_add_pd(low.y, high.y)),
+                      _mm256_mul_pd(half, _mm256_add_pd(low.z, high.z))};
+    const Points4 centroid{_mm256_div_pd(sum.x, four), _mm256_div_pd(sum.y, four), _mm256_div_pd(sum.z, four)};
+    const __m256d infinity = _mm256_set1_pd(INFINITY);
+    const __m256d box_r = _mm256_sqrt_pd(reach2(p, box)), centroid_r = _mm256_sqrt_pd(reach2(p, centroid));
+    const __m256d best_r = _mm256_blendv_pd(infinity, box_r, _mm256_cmp_pd(box_r, infinity, _CMP_LT_OQ));
+    const __m256d take_centroid = _mm256_cmp_pd(centroid_r, best_r, _CMP_LT_OQ);
+    const __m256d cx = _mm256_blendv_pd(box.x, centroid.x, take_centroid), cy = _mm256_blendv_pd(box.y, centroid.y, take_centroid);
+    const __m256d cz = _mm256_blendv_pd(box.z, centroid.z, take_centroid), r = _mm256_blendv_pd(best_r, centroid_r, take_centroid);
+    store_spheres(spheres, leaves.data() + i, {cx, cy, cz, inflated_radius(cx, cy, cz, r)});
+  }
+  sliced_piece_spheres_portable(mesh, pieces, leaves.subspan(i), spheres);
+}
+
+void sliced_piece_spheres(const TriangleMesh& mesh, const LeafPiece* pieces, std::span<const std::int32_t> leaves, Sphere* spheres) {
+  if (cpu_has_avx2()) {
+    sliced_piece_spheres_avx2(mesh, pieces, leaves, spheres);
+  } else {
+    sliced_piece_spheres_portable(mesh, pieces, leaves, spheres);
   }
 }
 

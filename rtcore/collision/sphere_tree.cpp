@@ -619,7 +619,8 @@ void SphereTree::refit(const TriangleMesh& mesh) {
   for (const RefitBlock& block : refit_blocks_) {
     centroid_spheres(mesh.positions.data(), mesh.triangles.data(), pieces_.data(), whole.subspan(block.whole_begin, block.whole_end - block.whole_begin),
                      spheres_.data());
-    for (std::size_t k = block.sliced_begin; k < block.sliced_end; ++k) spheres_[sliced_leaves_[k]] = piece_sphere(mesh, pieces_[sliced_leaves_[k]]);
+    sliced_piece_spheres(mesh, pieces_.data(), std::span<const std::int32_t>(sliced_leaves_).subspan(block.sliced_begin, block.sliced_end - block.sliced_begin),
+                         spheres_.data());
     std::size_t begin = block.groups_begin == 0 ? 0 : merge_group_ends_[block.groups_begin - 1];
     for (std::size_t g = block.groups_begin; g < block.groups_end; ++g) {
       merge_children(links_.data(), merges.subspan(begin, merge_group_ends_[g] - begin), spheres_.data());

@@ -44,6 +44,28 @@ TEST(SphereRefitKernel, Avx2CentroidSpheresMatchThePortableOnesBitForBit) {
   }
 }
 
+TEST(SphereRefitKernel, Avx2SlicedPieceSpheresMatchThePortableOnesBitForBit) {
+  if (!cpu_has_avx2()) GTEST_SKIP() << "no AVX2 on this processor: only the portable path runs";
+  const TriangleMesh mesh = jittered_gland(7);
+  // Every triangle cut into 2 to 5 slices about each of its corners: every slice a leaf.
+  std::vector<LeafPiece> pieces;
+  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+    const auto slices = static_cast<std::uint16_t>(2 + t % 4);
+    for (std::uint16_t slice = 0; slice < slices; ++slice) {
+      pieces.push_back({t, slice, slices, static_cast<std::uint8_t>((t / 4 + slice) % 3)});
+    }
+  }
+  std::vector<std::int32_t> leaves(pieces.size());
+  for (std::size_t n = 0; n < leaves.size(); ++n) leaves[n] = static_cast<std::int32_t>(n);
+  for (const std::size_t count : {std::size_t{3}, std::size_t{6}, leaves.size()}) {
+    const std::span<const std::int32_t> span(leaves.data() + (count < 8 ? 9 : 0), count);
+    std::vector<Sphere> portable(leaves.size()), simd(leaves.size());
+    sliced_piece_spheres_portable(mesh, pieces.data(), span, portable.data());
+    sliced_piece_spheres_avx2(mesh, pieces.data(), span, simd.data());
+    for (std::size_t n = 0; n < leaves.size(); ++n) ASSERT_TRUE(same_bits(portable[n], simd[n])) << "piece " << n << " of a span of " << count;
+  }
+}
+
 TEST(SphereRefitKernel, Avx2MergesMatchThePortableOnesInEveryCase) {
   if (!cpu_has_avx2()) GTEST_SKIP() << "no AVX2 on this processor: only the portable path runs";
   // Pairs of random spheres: disjoint, overlapping, one inside the other either way, and equal.
