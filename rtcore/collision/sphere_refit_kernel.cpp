@@ -113,17 +113,14 @@ void sliced_piece_spheres_portable(const TriangleMesh& mesh, const LeafPiece* pi
 
 namespace {
 
-/// A column of four points (one per lane) and the column arithmetic piece_sphere's uses.
-struct Points4 {
-  __m256d x, y, z;
-};
+using avx2::Points4;
+
 __attribute__((target("avx2"), always_inline)) inline Points4 corner_of(const TriangleMesh& mesh, const LeafPiece* const* piece, int offset) {
   const auto at = [&](int lane) -> const Vec3& {
     const Triangle& t = mesh.triangles[piece[lane]->triangle];
     return mesh.positions[t[(piece[lane]->apex + offset) % 3]];
   };
-  const Columns4 c = transpose4(avx2::load_point(at(0)), avx2::load_point(at(1)), avx2::load_point(at(2)), avx2::load_point(at(3)));
-  return {c.x, c.y, c.z};
+  return avx2::points_of(transpose4(avx2::load_point(at(0)), avx2::load_point(at(1)), avx2::load_point(at(2)), avx2::load_point(at(3))));
 }
 /// x * (1 - t) + b * t per coordinate (glm's order).
 __attribute__((target("avx2"), always_inline)) inline Points4 lerp(const Points4& x, const Points4& b, __m256d t) {
@@ -135,7 +132,8 @@ __attribute__((target("avx2"), always_inline)) inline Points4 lerp(const Points4
 __attribute__((target("avx2"), always_inline)) inline __m256d reach2(const std::array<Points4, 4>& points, const Points4& c) {
   __m256d r2 = _mm256_setzero_pd();
   for (const Points4& p : points) {
-    r2 = _mm256_max_pd(dot3(_mm256_sub_pd(p.x, c.x), _mm256_sub_pd(p.y, c.y), _mm256_sub_pd(p.z, c.z)), r2);
+    const Points4 d = avx2::minus(p, c);
+    r2 = _mm256_max_pd(dot3(d.x, d.y, d.z), r2);
   }
   return r2;
 }

@@ -200,8 +200,10 @@ class SphereTree {
   std::vector<LeafPiece> pieces_;       // per node (leaves only)
   std::vector<std::int32_t> next_leaf_;   // per node: next leaf of the same triangle
   std::vector<std::int32_t> first_leaf_;  // per triangle
-  std::vector<std::int32_t> refit_leaves_;    // every live leaf, in node order
-  std::vector<std::int32_t> refit_internal_;  // internal nodes, children before parents
+  // The refit's order with slabs (update_refit_order): every live leaf in node order, and the
+  // internal nodes, children before parents.
+  std::vector<std::int32_t> refit_leaves_;
+  std::vector<std::int32_t> refit_internal_;
   // The spheres-only refit's order (update_sphere_refit_blocks): blocks of leaves, whole-triangle and
   // sliced, and of merge groups, each group of one height.
   struct RefitBlock {

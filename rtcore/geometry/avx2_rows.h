@@ -13,6 +13,10 @@ namespace resecto::avx2 {
 struct Columns4 {
   __m256d x, y, z, w;
 };
+/// Four points as three columns.
+struct Points4 {
+  __m256d x, y, z;
+};
 
 /// Four rows as four columns, or four columns back as rows.
 __attribute__((target("avx2"), always_inline)) inline Columns4 transpose4(__m256d r0, __m256d r1, __m256d r2, __m256d r3) {
@@ -25,6 +29,14 @@ __attribute__((target("avx2"), always_inline)) inline Columns4 transpose4(__m256
 /// A point's (x, y, z, 0): a masked load, so the last point of an array never reads past it.
 __attribute__((target("avx2"), always_inline)) inline __m256d load_point(const Vec3& p) {
   return _mm256_maskload_pd(&p.x, _mm256_set_epi64x(0, -1, -1, -1));
+}
+
+/// The points of four rows' (x, y, z).
+__attribute__((target("avx2"), always_inline)) inline Points4 points_of(const Columns4& c) { return {c.x, c.y, c.z}; }
+
+/// a - b per lane and coordinate.
+__attribute__((target("avx2"), always_inline)) inline Points4 minus(const Points4& a, const Points4& b) {
+  return {_mm256_sub_pd(a.x, b.x), _mm256_sub_pd(a.y, b.y), _mm256_sub_pd(a.z, b.z)};
 }
 
 /// (x*x + y*y) + z*z per lane: glm::dot's order.

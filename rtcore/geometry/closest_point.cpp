@@ -59,13 +59,11 @@ void squared_distances_to_triangles_portable(const Vec3& p, const Vec3* position
 
 namespace {
 
-using avx2::Columns4;
 using avx2::dot3;
+using avx2::minus;
+using Point4 = avx2::Points4;
 
 /// where ? then : otherwise, per lane, for three columns.
-struct Point4 {
-  __m256d x, y, z;
-};
 __attribute__((target("avx2"), always_inline)) inline Point4 choose(__m256d where, const Point4& then, const Point4& otherwise) {
   return {_mm256_blendv_pd(otherwise.x, then.x, where), _mm256_blendv_pd(otherwise.y, then.y, where), _mm256_blendv_pd(otherwise.z, then.z, where)};
 }
@@ -73,17 +71,13 @@ __attribute__((target("avx2"), always_inline)) inline Point4 choose(__m256d wher
 __attribute__((target("avx2"), always_inline)) inline Point4 along(const Point4& s, __m256d t, const Point4& d) {
   return {_mm256_add_pd(s.x, _mm256_mul_pd(t, d.x)), _mm256_add_pd(s.y, _mm256_mul_pd(t, d.y)), _mm256_add_pd(s.z, _mm256_mul_pd(t, d.z))};
 }
-__attribute__((target("avx2"), always_inline)) inline Point4 minus(const Point4& a, const Point4& b) {
-  return {_mm256_sub_pd(a.x, b.x), _mm256_sub_pd(a.y, b.y), _mm256_sub_pd(a.z, b.z)};
-}
 __attribute__((target("avx2"), always_inline)) inline __m256d dot(const Point4& a, const Point4& b) { return dot3(a.x, a.y, a.z, b.x, b.y, b.z); }
 __attribute__((target("avx2"), always_inline)) inline __m256d le(__m256d a, __m256d b) { return _mm256_cmp_pd(a, b, _CMP_LE_OQ); }
 __attribute__((target("avx2"), always_inline)) inline __m256d both(__m256d a, __m256d b) { return _mm256_and_pd(a, b); }
 
 __attribute__((target("avx2"), always_inline)) inline Point4 corners(const Vec3* positions, const std::array<std::uint32_t, 3>* const* t, int corner) {
-  const Columns4 c = avx2::transpose4(avx2::load_point(positions[(*t[0])[corner]]), avx2::load_point(positions[(*t[1])[corner]]),
-                                      avx2::load_point(positions[(*t[2])[corner]]), avx2::load_point(positions[(*t[3])[corner]]));
-  return {c.x, c.y, c.z};
+  return avx2::points_of(avx2::transpose4(avx2::load_point(positions[(*t[0])[corner]]), avx2::load_point(positions[(*t[1])[corner]]),
+                                          avx2::load_point(positions[(*t[2])[corner]]), avx2::load_point(positions[(*t[3])[corner]])));
 }
 
 }  // namespace
