@@ -16,6 +16,7 @@ namespace {
 
 using avx2::Columns4;
 using avx2::dot3;
+using avx2::Points4;
 using avx2::transpose4;
 
 __attribute__((target("avx2"), always_inline)) inline __m256d absolute(__m256d v) {
@@ -75,16 +76,9 @@ __attribute__((target("avx2"))) void centroid_spheres_avx2(const Vec3* positions
         __builtin_prefetch(positions + ahead[2]);
       }
     }
-    const Triangle& t0 = triangles[pieces[leaf[i]].triangle];
-    const Triangle& t1 = triangles[pieces[leaf[i + 1]].triangle];
-    const Triangle& t2 = triangles[pieces[leaf[i + 2]].triangle];
-    const Triangle& t3 = triangles[pieces[leaf[i + 3]].triangle];
-    const Columns4 a = transpose4(avx2::load_point(positions[t0[0]]), avx2::load_point(positions[t1[0]]), avx2::load_point(positions[t2[0]]),
-                                  avx2::load_point(positions[t3[0]]));
-    const Columns4 b = transpose4(avx2::load_point(positions[t0[1]]), avx2::load_point(positions[t1[1]]), avx2::load_point(positions[t2[1]]),
-                                  avx2::load_point(positions[t3[1]]));
-    const Columns4 c = transpose4(avx2::load_point(positions[t0[2]]), avx2::load_point(positions[t1[2]]), avx2::load_point(positions[t2[2]]),
-                                  avx2::load_point(positions[t3[2]]));
+    const Triangle* t[4] = {&triangles[pieces[leaf[i]].triangle], &triangles[pieces[leaf[i + 1]].triangle],
+                            &triangles[pieces[leaf[i + 2]].triangle], &triangles[pieces[leaf[i + 3]].triangle]};
+    const Points4 a = avx2::triangle_corners(positions, t, 0), b = avx2::triangle_corners(positions, t, 1), c = avx2::triangle_corners(positions, t, 2);
     // (a + b + c) * (1/3), per coordinate.
     const __m256d cx = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(a.x, b.x), c.x), third);
     const __m256d cy = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(a.y, b.y), c.y), third);
@@ -113,14 +107,12 @@ void sliced_piece_spheres_portable(const TriangleMesh& mesh, const LeafPiece* pi
 
 namespace {
 
-using avx2::Points4;
-
 __attribute__((target("avx2"), always_inline)) inline Points4 corner_of(const TriangleMesh& mesh, const LeafPiece* const* piece, int offset) {
   const auto at = [&](int lane) -> const Vec3& {
     const Triangle& t = mesh.triangles[piece[lane]->triangle];
     return mesh.positions[t[(piece[lane]->apex + offset) % 3]];
   };
-  return avx2::points_of(transpose4(avx2::load_point(at(0)), avx2::load_point(at(1)), avx2::load_point(at(2)), avx2::load_point(at(3))));
+  return avx2::points_of(avx2::load_point(at(0)), avx2::load_point(at(1)), avx2::load_point(at(2)), avx2::load_point(at(3)));
 }
 /// x * (1 - t) + b * t per coordinate (glm's order).
 __attribute__((target("avx2"), always_inline)) inline Points4 lerp(const Points4& x, const Points4& b, __m256d t) {

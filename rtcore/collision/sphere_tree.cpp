@@ -211,7 +211,7 @@ void SphereTree::reserve(std::int32_t max_nodes, std::uint32_t max_triangles) {
   next_leaf_.reserve(nodes);
   refit_leaves_.reserve(nodes);
   refit_internal_.reserve(nodes);
-  for (auto* list : {&whole_leaves_, &sliced_leaves_, &merge_order_, &block_top_, &block_pending_, &block_nodes_, &block_walk_}) list->reserve(nodes);
+  for (auto* list : {&whole_leaves_, &sliced_leaves_, &merge_order_, &block_top_, &block_nodes_, &block_walk_}) list->reserve(nodes);
   refit_blocks_.reserve(nodes);
   merge_group_ends_.reserve(nodes);
   height_slots_.reserve(64);
@@ -501,17 +501,9 @@ void SphereTree::update_sphere_refit_blocks() {
       if (next[h] != (merge_group_ends_.empty() ? 0 : merge_group_ends_.back())) merge_group_ends_.push_back(next[h]);
     }
   };
-  const auto open_block = [this] {
-    refit_blocks_.push_back({whole_leaves_.size(), sliced_leaves_.size(), merge_group_ends_.size(), 0, 0, 0});
-  };
-  const auto close_block = [this] {
-    RefitBlock& block = refit_blocks_.back();
-    block.whole_end = whole_leaves_.size();
-    block.sliced_end = sliced_leaves_.size();
-    block.groups_end = merge_group_ends_.size();
-  };
+  const auto end_block = [this] { refit_blocks_.push_back({whole_leaves_.size(), sliced_leaves_.size(), merge_group_ends_.size()}); };
   // Depth first from the root, left before right: the order a build numbers the nodes in.
-  std::vector<std::int32_t>& pending = block_pending_;
+  std::vector<std::int32_t>& pending = stack_;
   pending.assign(1, root_);
   while (!pending.empty()) {
     const std::int32_t n = pending.back();
@@ -522,7 +514,6 @@ void SphereTree::update_sphere_refit_blocks() {
       pending.push_back(links_[n].left);
       continue;
     }
-    open_block();
     block_nodes_.clear();
     block_walk_.assign(1, n);
     while (!block_walk_.empty()) {
@@ -537,12 +528,11 @@ void SphereTree::update_sphere_refit_blocks() {
       block_walk_.push_back(links_[m].left);
     }
     add_by_height(block_nodes_, links_[n].height);
-    close_block();
+    end_block();
   }
   if (!block_top_.empty()) {
-    open_block();
     add_by_height(block_top_, links_[root_].height);
-    close_block();
+    end_block();
   }
 }
 
@@ -615,17 +605,18 @@ void SphereTree::refit(const TriangleMesh& mesh) {
     return;
   }
   // Spheres alone: the same bounds as refit_leaf and refit_internal give, block by block, four at a time.
-  const std::span<const std::int32_t> whole(whole_leaves_), merges(merge_order_);
+  const std::span<const std::int32_t> whole(whole_leaves_), sliced(sliced_leaves_), merges(merge_order_);
+  RefitBlock begin{0, 0, 0};
+  std::size_t merged = 0;  // merge_order_'s entries done
   for (const RefitBlock& block : refit_blocks_) {
-    centroid_spheres(mesh.positions.data(), mesh.triangles.data(), pieces_.data(), whole.subspan(block.whole_begin, block.whole_end - block.whole_begin),
+    centroid_spheres(mesh.positions.data(), mesh.triangles.data(), pieces_.data(), whole.subspan(begin.whole_end, block.whole_end - begin.whole_end),
                      spheres_.data());
-    sliced_piece_spheres(mesh, pieces_.data(), std::span<const std::int32_t>(sliced_leaves_).subspan(block.sliced_begin, block.sliced_end - block.sliced_begin),
-                         spheres_.data());
-    std::size_t begin = block.groups_begin == 0 ? 0 : merge_group_ends_[block.groups_begin - 1];
-    for (std::size_t g = block.groups_begin; g < block.groups_end; ++g) {
-      merge_children(links_.data(), merges.subspan(begin, merge_group_ends_[g] - begin), spheres_.data());
-      begin = merge_group_ends_[g];
+    sliced_piece_spheres(mesh, pieces_.data(), sliced.subspan(begin.sliced_end, block.sliced_end - begin.sliced_end), spheres_.data());
+    for (std::size_t g = begin.groups_end; g < block.groups_end; ++g) {
+      merge_children(links_.data(), merges.subspan(merged, merge_group_ends_[g] - merged), spheres_.data());
+      merged = merge_group_ends_[g];
     }
+    begin = block;
   }
 }
 

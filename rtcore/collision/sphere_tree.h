@@ -205,16 +205,16 @@ class SphereTree {
   std::vector<std::int32_t> refit_leaves_;
   std::vector<std::int32_t> refit_internal_;
   // The spheres-only refit's order (update_sphere_refit_blocks): blocks of leaves, whole-triangle and
-  // sliced, and of merge groups, each group of one height.
+  // sliced, and of merge groups, each group of one height. A block begins where the one before ends.
   struct RefitBlock {
-    std::size_t whole_begin, sliced_begin, groups_begin, whole_end, sliced_end, groups_end;
+    std::size_t whole_end, sliced_end, groups_end;
   };
   std::vector<RefitBlock> refit_blocks_;
   std::vector<std::int32_t> whole_leaves_, sliced_leaves_, merge_order_;
   std::vector<std::size_t> merge_group_ends_;  // merge_order_'s end of each group
-  std::vector<std::int32_t> block_top_, block_pending_, block_nodes_, block_walk_;  // scratch
-  std::vector<std::size_t> height_slots_;                                           // scratch
-  std::vector<std::int32_t> stack_;        // scratch for update_refit_order
+  std::vector<std::int32_t> block_top_, block_nodes_, block_walk_;  // scratch
+  std::vector<std::size_t> height_slots_;                           // scratch
+  std::vector<std::int32_t> stack_;        // scratch for update_refit_order and update_sphere_refit_blocks
   std::int32_t root_ = kNoNode;
   std::int32_t free_list_ = kNoNode;
   std::int32_t leaf_count_ = 0;

@@ -6,6 +6,9 @@
 
 #include <immintrin.h>
 
+#include <array>
+#include <cstdint>
+
 #include "rtcore/geometry/vec3.h"
 
 namespace resecto::avx2 {
@@ -31,8 +34,19 @@ __attribute__((target("avx2"), always_inline)) inline __m256d load_point(const V
   return _mm256_maskload_pd(&p.x, _mm256_set_epi64x(0, -1, -1, -1));
 }
 
-/// The points of four rows' (x, y, z).
-__attribute__((target("avx2"), always_inline)) inline Points4 points_of(const Columns4& c) { return {c.x, c.y, c.z}; }
+/// Four (x, y, z, _) rows as three columns: transpose4 without the fourth column's shuffle.
+__attribute__((target("avx2"), always_inline)) inline Points4 points_of(__m256d r0, __m256d r1, __m256d r2, __m256d r3) {
+  const __m256d xz01 = _mm256_unpacklo_pd(r0, r1), y01 = _mm256_unpackhi_pd(r0, r1);
+  const __m256d xz23 = _mm256_unpacklo_pd(r2, r3), y23 = _mm256_unpackhi_pd(r2, r3);
+  return {_mm256_permute2f128_pd(xz01, xz23, 0x20), _mm256_permute2f128_pd(y01, y23, 0x20), _mm256_permute2f128_pd(xz01, xz23, 0x31)};
+}
+
+/// Corner `corner` of four triangles (corner indices into `positions`), one triangle per lane.
+__attribute__((target("avx2"), always_inline)) inline Points4 triangle_corners(const Vec3* positions, const std::array<std::uint32_t, 3>* const* t,
+                                                                               int corner) {
+  return points_of(load_point(positions[(*t[0])[corner]]), load_point(positions[(*t[1])[corner]]), load_point(positions[(*t[2])[corner]]),
+                   load_point(positions[(*t[3])[corner]]));
+}
 
 /// a - b per lane and coordinate.
 __attribute__((target("avx2"), always_inline)) inline Points4 minus(const Points4& a, const Points4& b) {

@@ -75,11 +75,6 @@ __attribute__((target("avx2"), always_inline)) inline __m256d dot(const Point4& 
 __attribute__((target("avx2"), always_inline)) inline __m256d le(__m256d a, __m256d b) { return _mm256_cmp_pd(a, b, _CMP_LE_OQ); }
 __attribute__((target("avx2"), always_inline)) inline __m256d both(__m256d a, __m256d b) { return _mm256_and_pd(a, b); }
 
-__attribute__((target("avx2"), always_inline)) inline Point4 corners(const Vec3* positions, const std::array<std::uint32_t, 3>* const* t, int corner) {
-  return avx2::points_of(avx2::transpose4(avx2::load_point(positions[(*t[0])[corner]]), avx2::load_point(positions[(*t[1])[corner]]),
-                                          avx2::load_point(positions[(*t[2])[corner]]), avx2::load_point(positions[(*t[3])[corner]])));
-}
-
 }  // namespace
 
 __attribute__((target("avx2"))) void squared_distances_to_triangles_avx2(const Vec3& p, const Vec3* positions,
@@ -90,7 +85,7 @@ __attribute__((target("avx2"))) void squared_distances_to_triangles_avx2(const V
   std::size_t k = 0;
   for (; k + 4 <= count; k += 4) {
     const std::array<std::uint32_t, 3>* t[4] = {&triangles[faces[k]], &triangles[faces[k + 1]], &triangles[faces[k + 2]], &triangles[faces[k + 3]]};
-    const Point4 a = corners(positions, t, 0), b = corners(positions, t, 1), c = corners(positions, t, 2);
+    const Point4 a = avx2::triangle_corners(positions, t, 0), b = avx2::triangle_corners(positions, t, 1), c = avx2::triangle_corners(positions, t, 2);
     // closest_point_on_triangle's quantities, every one in every lane.
     const Point4 ab = minus(b, a), ac = minus(c, a), ap = minus(point, a), bp = minus(point, b), cp = minus(point, c);
     const __m256d d1 = dot(ab, ap), d2_ = dot(ac, ap), d3 = dot(ab, bp), d4 = dot(ac, bp), d5 = dot(ab, cp), d6 = dot(ac, cp);

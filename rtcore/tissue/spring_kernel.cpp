@@ -9,30 +9,20 @@
 #include <bit>
 #include <cmath>
 
+#include "rtcore/geometry/avx2_rows.h"
+
 namespace resecto {
 namespace {
 
-/// One node's (x, y, z, 0): a masked load, so the last node's row never reads past the array.
-__attribute__((target("avx2"), always_inline)) inline __m256d load_row(const Vec3& p) {
-  return _mm256_maskload_pd(&p.x, _mm256_set_epi64x(0, -1, -1, -1));
-}
-
-/// Four (x, y, z, _) rows as three columns (x0..x3), (y0..y3), (z0..z3): pure moves, no arithmetic.
-struct Columns {
-  __m256d x, y, z;
-};
-__attribute__((target("avx2"), always_inline)) inline Columns transpose(__m256d r0, __m256d r1, __m256d r2, __m256d r3) {
-  const __m256d xz01 = _mm256_unpacklo_pd(r0, r1), y01 = _mm256_unpackhi_pd(r0, r1);
-  const __m256d xz23 = _mm256_unpacklo_pd(r2, r3), y23 = _mm256_unpackhi_pd(r2, r3);
-  return {_mm256_permute2f128_pd(xz01, xz23, 0x20), _mm256_permute2f128_pd(y01, y23, 0x20), _mm256_permute2f128_pd(xz01, xz23, 0x31)};
-}
+using Columns = avx2::Points4;
+using avx2::load_point;
 
 /// Node j's row minus node i's row of `p` for four springs, as columns: the same subtractions the
 /// portable loop does per component, done before the transpose (gathers are slow on this class of
 /// processor, and rows subtract with one instruction).
 __attribute__((target("avx2"), always_inline)) inline Columns differences(const Vec3* p, const std::uint32_t* i, const std::uint32_t* j) {
-  return transpose(_mm256_sub_pd(load_row(p[j[0]]), load_row(p[i[0]])), _mm256_sub_pd(load_row(p[j[1]]), load_row(p[i[1]])),
-                   _mm256_sub_pd(load_row(p[j[2]]), load_row(p[i[2]])), _mm256_sub_pd(load_row(p[j[3]]), load_row(p[i[3]])));
+  return avx2::points_of(_mm256_sub_pd(load_point(p[j[0]]), load_point(p[i[0]])), _mm256_sub_pd(load_point(p[j[1]]), load_point(p[i[1]])),
+                         _mm256_sub_pd(load_point(p[j[2]]), load_point(p[i[2]])), _mm256_sub_pd(load_point(p[j[3]]), load_point(p[i[3]])));
 }
 
 /// Four springs' force columns back to rows (x, y, z, 0), stored at f[0..3]: pure moves.
