@@ -46,6 +46,17 @@ __attribute__((target("avx2"), always_inline)) inline __m256d pick(__m256d a_hol
 
 __attribute__((target("avx2"), always_inline)) inline __m256d load_sphere(const Sphere& s) { return _mm256_loadu_pd(&s.center.x); }
 
+using FourIndices = std::array<std::int32_t, 4>;
+/// The last one to three entries of `items` from `begin`, the last repeated to fill four lanes. A
+/// repeated lane computes the same bits as its original and stores them to the same place, so the
+/// tail runs the four-lane path rather than the one-at-a-time one (a refit's groups are mostly
+/// small: a block's top heights hold one to three nodes).
+inline FourIndices padded_tail(std::span<const std::int32_t> items, std::size_t begin) {
+  FourIndices four{};
+  for (std::size_t k = 0; k < 4; ++k) four[k] = items[std::min(begin + k, items.size() - 1)];
+  return four;
+}
+
 }  // namespace
 
 void centroid_spheres_portable(const Vec3* positions, const Triangle* triangles, const LeafPiece* pieces, std::span<const std::int32_t> leaves,
@@ -56,6 +67,28 @@ void centroid_spheres_portable(const Vec3* positions, const Triangle* triangles,
   }
 }
 
+namespace {
+
+/// Four leaves' centroid spheres, lane by lane as centroid_sphere() makes them.
+__attribute__((target("avx2"), always_inline)) inline void centroid4(const Vec3* positions, const Triangle* triangles, const LeafPiece* pieces,
+                                                                     const std::int32_t* leaf, Sphere* spheres) {
+  const __m256d third = _mm256_set1_pd(1.0 / 3.0);
+  const Triangle* t[4] = {&triangles[pieces[leaf[0]].triangle], &triangles[pieces[leaf[1]].triangle], &triangles[pieces[leaf[2]].triangle],
+                          &triangles[pieces[leaf[3]].triangle]};
+  const Points4 a = avx2::triangle_corners(positions, t, 0), b = avx2::triangle_corners(positions, t, 1), c = avx2::triangle_corners(positions, t, 2);
+  // (a + b + c) * (1/3), per coordinate.
+  const __m256d cx = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(a.x, b.x), c.x), third);
+  const __m256d cy = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(a.y, b.y), c.y), third);
+  const __m256d cz = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(a.z, b.z), c.z), third);
+  const __m256d da = dot3(_mm256_sub_pd(a.x, cx), _mm256_sub_pd(a.y, cy), _mm256_sub_pd(a.z, cz));
+  const __m256d db = dot3(_mm256_sub_pd(b.x, cx), _mm256_sub_pd(b.y, cy), _mm256_sub_pd(b.z, cz));
+  const __m256d dc = dot3(_mm256_sub_pd(c.x, cx), _mm256_sub_pd(c.y, cy), _mm256_sub_pd(c.z, cz));
+  const __m256d radius = _mm256_sqrt_pd(_mm256_max_pd(_mm256_max_pd(da, db), dc));
+  store_spheres(spheres, leaf, {cx, cy, cz, inflated_radius(cx, cy, cz, radius)});
+}
+
+}  // namespace
+
 __attribute__((target("avx2"))) void centroid_spheres_avx2(const Vec3* positions, const Triangle* triangles, const LeafPiece* pieces,
                                                            std::span<const std::int32_t> leaves, Sphere* spheres) {
   const std::size_t count = leaves.size();
@@ -63,7 +96,6 @@ __attribute__((target("avx2"))) void centroid_spheres_avx2(const Vec3* positions
   // A leaf's corners lie three loads deep (piece, triangle, positions), scattered over large arrays:
   // each level is started some leaves ahead.
   constexpr std::size_t kPieceAhead = 24, kTriangleAhead = 16, kCornersAhead = 8;
-  const __m256d third = _mm256_set1_pd(1.0 / 3.0);
   std::size_t i = 0;
   for (; i + 4 <= count; i += 4) {
     for (std::size_t k = i; k < i + 4; ++k) {
@@ -76,20 +108,12 @@ __attribute__((target("avx2"))) void centroid_spheres_avx2(const Vec3* positions
         __builtin_prefetch(positions + ahead[2]);
       }
     }
-    const Triangle* t[4] = {&triangles[pieces[leaf[i]].triangle], &triangles[pieces[leaf[i + 1]].triangle],
-                            &triangles[pieces[leaf[i + 2]].triangle], &triangles[pieces[leaf[i + 3]].triangle]};
-    const Points4 a = avx2::triangle_corners(positions, t, 0), b = avx2::triangle_corners(positions, t, 1), c = avx2::triangle_corners(positions, t, 2);
-    // (a + b + c) * (1/3), per coordinate.
-    const __m256d cx = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(a.x, b.x), c.x), third);
-    const __m256d cy = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(a.y, b.y), c.y), third);
-    const __m256d cz = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(a.z, b.z), c.z), third);
-    const __m256d da = dot3(_mm256_sub_pd(a.x, cx), _mm256_sub_pd(a.y, cy), _mm256_sub_pd(a.z, cz));
-    const __m256d db = dot3(_mm256_sub_pd(b.x, cx), _mm256_sub_pd(b.y, cy), _mm256_sub_pd(b.z, cz));
-    const __m256d dc = dot3(_mm256_sub_pd(c.x, cx), _mm256_sub_pd(c.y, cy), _mm256_sub_pd(c.z, cz));
-    const __m256d radius = _mm256_sqrt_pd(_mm256_max_pd(_mm256_max_pd(da, db), dc));
-    store_spheres(spheres, leaf + i, {cx, cy, cz, inflated_radius(cx, cy, cz, radius)});
+    centroid4(positions, triangles, pieces, leaf + i, spheres);
   }
-  centroid_spheres_portable(positions, triangles, pieces, leaves.subspan(i), spheres);
+  if (i < count) {
+    const FourIndices tail = padded_tail(leaves, i);
+    centroid4(positions, triangles, pieces, tail.data(), spheres);
+  }
 }
 
 void centroid_spheres(const Vec3* positions, const Triangle* triangles, const LeafPiece* pieces, std::span<const std::int32_t> leaves,
@@ -130,40 +154,46 @@ __attribute__((target("avx2"), always_inline)) inline __m256d reach2(const std::
   return r2;
 }
 
+/// Four sliced pieces' spheres, lane by lane as SphereTree::piece_sphere() makes them.
+__attribute__((target("avx2"), always_inline)) inline void slice4(const TriangleMesh& mesh, const LeafPiece* pieces, const std::int32_t* leaf,
+                                                                  Sphere* spheres) {
+  const LeafPiece* piece[4] = {&pieces[leaf[0]], &pieces[leaf[1]], &pieces[leaf[2]], &pieces[leaf[3]]};
+  const Points4 b = corner_of(mesh, piece, 0), x = corner_of(mesh, piece, 1), y = corner_of(mesh, piece, 2);
+  const __m256d slice = _mm256_set_pd(piece[3]->slice, piece[2]->slice, piece[1]->slice, piece[0]->slice);
+  const __m256d slices = _mm256_set_pd(piece[3]->slices, piece[2]->slices, piece[1]->slices, piece[0]->slices);
+  const __m256d t0 = _mm256_div_pd(slice, slices), t1 = _mm256_div_pd(_mm256_add_pd(slice, _mm256_set1_pd(1.0)), slices);
+  // sphere_around() of the slab's four corners: the box centre's sphere, or the centroid's if smaller.
+  const std::array<Points4, 4> p{lerp(x, b, t0), lerp(y, b, t0), lerp(x, b, t1), lerp(y, b, t1)};
+  Points4 low = p[0], high = p[0];
+  Points4 sum{_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_setzero_pd()};
+  for (const Points4& q : p) {
+    low = {_mm256_min_pd(q.x, low.x), _mm256_min_pd(q.y, low.y), _mm256_min_pd(q.z, low.z)};
+    high = {_mm256_max_pd(q.x, high.x), _mm256_max_pd(q.y, high.y), _mm256_max_pd(q.z, high.z)};
+    sum = {_mm256_add_pd(sum.x, q.x), _mm256_add_pd(sum.y, q.y), _mm256_add_pd(sum.z, q.z)};
+  }
+  const __m256d half = _mm256_set1_pd(0.5), four = _mm256_set1_pd(4.0);
+  const Points4 box{_mm256_mul_pd(half, _mm256_add_pd(low.x, high.x)), _mm256_mul_pd(half, _mm256_add_pd(low.y, high.y)),
+                    _mm256_mul_pd(half, _mm256_add_pd(low.z, high.z))};
+  const Points4 centroid{_mm256_div_pd(sum.x, four), _mm256_div_pd(sum.y, four), _mm256_div_pd(sum.z, four)};
+  const __m256d infinity = _mm256_set1_pd(INFINITY);
+  const __m256d box_r = _mm256_sqrt_pd(reach2(p, box)), centroid_r = _mm256_sqrt_pd(reach2(p, centroid));
+  const __m256d best_r = _mm256_blendv_pd(infinity, box_r, _mm256_cmp_pd(box_r, infinity, _CMP_LT_OQ));
+  const __m256d take_centroid = _mm256_cmp_pd(centroid_r, best_r, _CMP_LT_OQ);
+  const __m256d cx = _mm256_blendv_pd(box.x, centroid.x, take_centroid), cy = _mm256_blendv_pd(box.y, centroid.y, take_centroid);
+  const __m256d cz = _mm256_blendv_pd(box.z, centroid.z, take_centroid), r = _mm256_blendv_pd(best_r, centroid_r, take_centroid);
+  store_spheres(spheres, leaf, {cx, cy, cz, inflated_radius(cx, cy, cz, r)});
+}
+
 }  // namespace
 
 __attribute__((target("avx2"))) void sliced_piece_spheres_avx2(const TriangleMesh& mesh, const LeafPiece* pieces, std::span<const std::int32_t> leaves,
                                                                Sphere* spheres) {
-  const std::size_t count = leaves.size();
   std::size_t i = 0;
-  for (; i + 4 <= count; i += 4) {
-    const LeafPiece* piece[4] = {&pieces[leaves[i]], &pieces[leaves[i + 1]], &pieces[leaves[i + 2]], &pieces[leaves[i + 3]]};
-    const Points4 b = corner_of(mesh, piece, 0), x = corner_of(mesh, piece, 1), y = corner_of(mesh, piece, 2);
-    const __m256d slice = _mm256_set_pd(piece[3]->slice, piece[2]->slice, piece[1]->slice, piece[0]->slice);
-    const __m256d slices = _mm256_set_pd(piece[3]->slices, piece[2]->slices, piece[1]->slices, piece[0]->slices);
-    const __m256d t0 = _mm256_div_pd(slice, slices), t1 = _mm256_div_pd(_mm256_add_pd(slice, _mm256_set1_pd(1.0)), slices);
-    // sphere_around() of the slab's four corners: the box centre's sphere, or the centroid's if smaller.
-    const std::array<Points4, 4> p{lerp(x, b, t0), lerp(y, b, t0), lerp(x, b, t1), lerp(y, b, t1)};
-    Points4 low = p[0], high = p[0];
-    Points4 sum{_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_setzero_pd()};
-    for (const Points4& q : p) {
-      low = {_mm256_min_pd(q.x, low.x), _mm256_min_pd(q.y, low.y), _mm256_min_pd(q.z, low.z)};
-      high = {_mm256_max_pd(q.x, high.x), _mm256_max_pd(q.y, high.y), _mm256_max_pd(q.z, high.z)};
-      sum = {_mm256_add_pd(sum.x, q.x), _mm256_add_pd(sum.y, q.y), _mm256_add_pd(sum.z, q.z)};
-    }
-    const __m256d half = _mm256_set1_pd(0.5), four = _mm256_set1_pd(4.0);
-    const Points4 box{_mm256_mul_pd(half, _mm256_add_pd(low.x, high.x)), _mm256_mul_pd(half, _mm256_add_pd(low.y, high.y)),
-                      _mm256_mul_pd(half, _mm256_add_pd(low.z, high.z))};
-    const Points4 centroid{_mm256_div_pd(sum.x, four), _mm256_div_pd(sum.y, four), _mm256_div_pd(sum.z, four)};
-    const __m256d infinity = _mm256_set1_pd(INFINITY);
-    const __m256d box_r = _mm256_sqrt_pd(reach2(p, box)), centroid_r = _mm256_sqrt_pd(reach2(p, centroid));
-    const __m256d best_r = _mm256_blendv_pd(infinity, box_r, _mm256_cmp_pd(box_r, infinity, _CMP_LT_OQ));
-    const __m256d take_centroid = _mm256_cmp_pd(centroid_r, best_r, _CMP_LT_OQ);
-    const __m256d cx = _mm256_blendv_pd(box.x, centroid.x, take_centroid), cy = _mm256_blendv_pd(box.y, centroid.y, take_centroid);
-    const __m256d cz = _mm256_blendv_pd(box.z, centroid.z, take_centroid), r = _mm256_blendv_pd(best_r, centroid_r, take_centroid);
-    store_spheres(spheres, leaves.data() + i, {cx, cy, cz, inflated_radius(cx, cy, cz, r)});
+  for (; i + 4 <= leaves.size(); i += 4) slice4(mesh, pieces, leaves.data() + i, spheres);
+  if (i < leaves.size()) {
+    const FourIndices tail = padded_tail(leaves, i);
+    slice4(mesh, pieces, tail.data(), spheres);
   }
-  sliced_piece_spheres_portable(mesh, pieces, leaves.subspan(i), spheres);
 }
 
 void sliced_piece_spheres(const TriangleMesh& mesh, const LeafPiece* pieces, std::span<const std::int32_t> leaves, Sphere* spheres) {
@@ -178,32 +208,40 @@ void merge_children_portable(const SphereTreeLinks* links, std::span<const std::
   for (const std::int32_t node : nodes) spheres[node] = enclosing_sphere(spheres[links[node].left], spheres[links[node].right]);
 }
 
+namespace {
+
+/// Four nodes' merges, lane by lane as enclosing_sphere() makes them.
+__attribute__((target("avx2"), always_inline)) inline void merge4(const SphereTreeLinks* links, const std::int32_t* node, Sphere* spheres) {
+  const SphereTreeLinks &l0 = links[node[0]], &l1 = links[node[1]], &l2 = links[node[2]], &l3 = links[node[3]];
+  const Columns4 a = transpose4(load_sphere(spheres[l0.left]), load_sphere(spheres[l1.left]), load_sphere(spheres[l2.left]),
+                                load_sphere(spheres[l3.left]));
+  const Columns4 b = transpose4(load_sphere(spheres[l0.right]), load_sphere(spheres[l1.right]), load_sphere(spheres[l2.right]),
+                                load_sphere(spheres[l3.right]));
+  const __m256d ox = _mm256_sub_pd(b.x, a.x), oy = _mm256_sub_pd(b.y, a.y), oz = _mm256_sub_pd(b.z, a.z);
+  const __m256d distance = _mm256_sqrt_pd(dot3(ox, oy, oz));
+  // Where one sphere holds the other, that one, as it is; else the sphere over both, inflated.
+  const __m256d a_holds_b = _mm256_cmp_pd(_mm256_add_pd(distance, b.w), a.w, _CMP_LE_OQ);
+  const __m256d b_holds_a = _mm256_cmp_pd(_mm256_add_pd(distance, a.w), b.w, _CMP_LE_OQ);
+  const __m256d radius = _mm256_mul_pd(_mm256_set1_pd(0.5), _mm256_add_pd(_mm256_add_pd(distance, a.w), b.w));
+  const __m256d step = _mm256_div_pd(_mm256_sub_pd(radius, a.w), distance);
+  const __m256d cx = _mm256_add_pd(a.x, _mm256_mul_pd(ox, step));
+  const __m256d cy = _mm256_add_pd(a.y, _mm256_mul_pd(oy, step));
+  const __m256d cz = _mm256_add_pd(a.z, _mm256_mul_pd(oz, step));
+  const __m256d cr = inflated_radius(cx, cy, cz, radius);
+  store_spheres(spheres, node,
+                {pick(a_holds_b, b_holds_a, cx, a.x, b.x), pick(a_holds_b, b_holds_a, cy, a.y, b.y), pick(a_holds_b, b_holds_a, cz, a.z, b.z),
+                 pick(a_holds_b, b_holds_a, cr, a.w, b.w)});
+}
+
+}  // namespace
+
 __attribute__((target("avx2"))) void merge_children_avx2(const SphereTreeLinks* links, std::span<const std::int32_t> nodes, Sphere* spheres) {
-  const std::size_t count = nodes.size();
-  const std::int32_t* node = nodes.data();
   std::size_t i = 0;
-  for (; i + 4 <= count; i += 4) {
-    const SphereTreeLinks &l0 = links[node[i]], &l1 = links[node[i + 1]], &l2 = links[node[i + 2]], &l3 = links[node[i + 3]];
-    const Columns4 a = transpose4(load_sphere(spheres[l0.left]), load_sphere(spheres[l1.left]), load_sphere(spheres[l2.left]),
-                                  load_sphere(spheres[l3.left]));
-    const Columns4 b = transpose4(load_sphere(spheres[l0.right]), load_sphere(spheres[l1.right]), load_sphere(spheres[l2.right]),
-                                  load_sphere(spheres[l3.right]));
-    const __m256d ox = _mm256_sub_pd(b.x, a.x), oy = _mm256_sub_pd(b.y, a.y), oz = _mm256_sub_pd(b.z, a.z);
-    const __m256d distance = _mm256_sqrt_pd(dot3(ox, oy, oz));
-    // Where one sphere holds the other, that one, as it is; else the sphere over both, inflated.
-    const __m256d a_holds_b = _mm256_cmp_pd(_mm256_add_pd(distance, b.w), a.w, _CMP_LE_OQ);
-    const __m256d b_holds_a = _mm256_cmp_pd(_mm256_add_pd(distance, a.w), b.w, _CMP_LE_OQ);
-    const __m256d radius = _mm256_mul_pd(_mm256_set1_pd(0.5), _mm256_add_pd(_mm256_add_pd(distance, a.w), b.w));
-    const __m256d step = _mm256_div_pd(_mm256_sub_pd(radius, a.w), distance);
-    const __m256d cx = _mm256_add_pd(a.x, _mm256_mul_pd(ox, step));
-    const __m256d cy = _mm256_add_pd(a.y, _mm256_mul_pd(oy, step));
-    const __m256d cz = _mm256_add_pd(a.z, _mm256_mul_pd(oz, step));
-    const __m256d cr = inflated_radius(cx, cy, cz, radius);
-    store_spheres(spheres, node + i,
-                  {pick(a_holds_b, b_holds_a, cx, a.x, b.x), pick(a_holds_b, b_holds_a, cy, a.y, b.y), pick(a_holds_b, b_holds_a, cz, a.z, b.z),
-                   pick(a_holds_b, b_holds_a, cr, a.w, b.w)});
+  for (; i + 4 <= nodes.size(); i += 4) merge4(links, nodes.data() + i, spheres);
+  if (i < nodes.size()) {
+    const FourIndices tail = padded_tail(nodes, i);
+    merge4(links, tail.data(), spheres);
   }
-  merge_children_portable(links, nodes.subspan(i), spheres);
 }
 
 void merge_children(const SphereTreeLinks* links, std::span<const std::int32_t> nodes, Sphere* spheres) {

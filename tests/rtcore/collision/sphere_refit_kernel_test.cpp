@@ -8,6 +8,7 @@
 
 #include <cstring>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "scene.h"
@@ -86,6 +87,14 @@ TEST(SphereRefitKernel, Avx2MergesMatchThePortableOnesInEveryCase) {
     if (k % 5 == 3) b = a;                                                             // the same sphere
     links[static_cast<std::size_t>(parent)] = {-1, left, right, 1};
     parents.push_back(parent);
+  }
+  // Spans of every remainder of four: the last one to three merges run as padded lanes.
+  for (const std::size_t count : {std::size_t{1}, std::size_t{2}, std::size_t{6}}) {
+    const std::span<const std::int32_t> span(parents.data() + 7, count);
+    std::vector<Sphere> portable = spheres, simd = spheres;
+    merge_children_portable(links.data(), span, portable.data());
+    merge_children_avx2(links.data(), span, simd.data());
+    for (std::size_t n = 0; n < spheres.size(); ++n) ASSERT_TRUE(same_bits(portable[n], simd[n])) << "sphere " << n << " of a span of " << count;
   }
   std::vector<Sphere> portable = spheres, simd = spheres;
   merge_children_portable(links.data(), parents, portable.data());
