@@ -2,6 +2,8 @@
 #include "recordings/recording_reader.h"
 
 #include <algorithm>
+#include <exception>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 
@@ -10,9 +12,17 @@
 namespace resecto::rec {
 
 Result<Recording> Recording::open(const std::filesystem::path& path) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) return Error{path.string() + ": is a folder, not a recording"};
   std::ifstream in(path, std::ios::binary);
   if (!in) return Error{path.string() + ": cannot open"};
-  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<std::uint8_t> bytes;
+  try {
+    // libstdc++'s stream buffer throws on a failed read (EIO, a special file) rather than setting badbit.
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  } catch (const std::exception& e) {
+    return Error{path.string() + ": read failed: " + e.what()};
+  }
   if (in.bad()) return Error{path.string() + ": read failed"};
   return from_bytes(std::move(bytes), path.string());
 }

@@ -1,32 +1,22 @@
 // rec recover and rec export.
 #include "recordings/recover.h"
 
-#include <cerrno>
 #include <cstdio>
-#include <cstring>
-#include <fstream>
 #include <string>
+#include <string_view>
 
 #include "recordings/byte_io.h"
 #include "recordings/recording_writer.h"
+#include "rtcore/base/atomic_file.h"
 #include "rtcore/mesh/mesh_io.h"
 
 namespace resecto::rec {
 namespace {
 
-/// Writes `bytes` to a temporary beside `out`, then renames it over `out`.
-Status write_file_atomically(const std::filesystem::path& out, std::span<const std::uint8_t> bytes) {
-  const std::filesystem::path temporary = out.string() + ".tmp";
-  {
-    std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
-    if (!file) return Error{temporary.string() + ": cannot create"};
-    file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    if (!file.flush()) return Error{temporary.string() + ": write failed"};
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, out, error);
-  if (error) return Error{out.string() + ": cannot rename the temporary file: " + error.message()};
-  return Ok{};
+/// The shared atomic writer (rtcore/base/atomic_file.h) for a byte buffer: it refuses a folder or
+/// device in the way and leaves no temporary behind on failure.
+Status write_bytes_atomically(const std::filesystem::path& out, std::span<const std::uint8_t> bytes) {
+  return write_file_atomically(out, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 }  // namespace
@@ -82,7 +72,7 @@ std::vector<std::uint8_t> recovered_bytes(const Recording& recording, RecoverRep
 Result<RecoverReport> recover(const Recording& recording, const std::filesystem::path& out) {
   RecoverReport report;
   const std::vector<std::uint8_t> bytes = recovered_bytes(recording, report);
-  if (Status written = write_file_atomically(out, bytes); !written) return Error{written.error()};
+  if (Status written = write_bytes_atomically(out, bytes); !written) return Error{written.error()};
   return report;
 }
 
@@ -90,7 +80,7 @@ Status export_keyframe(const Recording& recording, std::size_t k, const std::fil
   if (k >= recording.keyframes().size()) {
     return Error{"keyframe " + std::to_string(k) + " does not exist (" + std::to_string(recording.keyframes().size()) + " recorded)"};
   }
-  if (out.extension() == ".drc") return write_file_atomically(out, recording.keyframe_draco(k));
+  if (out.extension() == ".drc") return write_bytes_atomically(out, recording.keyframe_draco(k));
   Result<SurfaceFrame> frame = recording.decode_keyframe(k);
   if (!frame) return Error{frame.error()};
   TriangleMesh mesh;
@@ -110,7 +100,7 @@ Status export_inputs_csv(const Recording& recording, const std::filesystem::path
                   t.input.coagulate ? 1 : 0, t.input.tool_present ? 1 : 0);
     text += line;
   }
-  return write_file_atomically(out, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+  return write_file_atomically(out, text);
 }
 
 }  // namespace resecto::rec

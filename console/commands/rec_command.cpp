@@ -1,7 +1,9 @@
 // `resecto rec info|verify|recover|export`: the recording tools (recordings/README.md has the file's
 // layout). Every one reads damaged and cut files: what is intact is used, what is not is named.
 #include <cstdio>
+#include <filesystem>
 #include <memory>
+#include <span>
 #include <stdexcept>
 #include <string>
 
@@ -9,6 +11,7 @@
 
 #include "console/commands/command_registry.h"
 #include "recordings/recover.h"
+#include "rtcore/base/atomic_file.h"
 
 namespace resecto::cli {
 namespace {
@@ -119,6 +122,8 @@ void verify(const std::string& file) {
 
 void recover(const std::string& in, const std::string& out) {
   const rec::Recording r = open_recording(in);
+  const std::filesystem::path input(in);
+  if (Status ok = check_output_path(out, std::span(&input, 1)); !ok) throw std::runtime_error("rec recover: " + ok.error());
   Result<rec::RecoverReport> report = rec::recover(r, out);
   if (!report) throw std::runtime_error(report.error());
   std::printf("%s -> %s: kept %llu chunks, dropped %llu damaged ranges; %llu ticks (%.2f s) replayable\n", in.c_str(), out.c_str(),
@@ -139,7 +144,10 @@ void export_recording(const ExportOptions& o) {
   const rec::Recording r = open_recording(o.file);
   const int choices = (o.keyframe >= 0 ? 1 : 0) + (o.time_s >= 0.0 ? 1 : 0) + (o.inputs ? 1 : 0);
   if (choices != 1) throw std::runtime_error("rec export: give exactly one of --keyframe N, --time S or --inputs");
+  const std::filesystem::path input(o.file);
+  if (Status ok = check_output_path(o.out, std::span(&input, 1)); !ok) throw std::runtime_error("rec export: " + ok.error());
   if (o.inputs) {
+    if (std::filesystem::path(o.out).extension() != ".csv") throw std::runtime_error("rec export --inputs: " + o.out + ": the inputs are written as CSV; name the file .csv");
     if (Status written = rec::export_inputs_csv(r, o.out); !written) throw std::runtime_error(written.error());
     std::printf("%s: %zu ticks' inputs\n", o.out.c_str(), r.ticks().size());
     return;

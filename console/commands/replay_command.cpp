@@ -65,6 +65,14 @@ void replay(const ReplayOptions& o) {
                              " or the build differ");
   }
   if (o.verify && r.verified_hashes() == 0) throw std::runtime_error(o.file + ": no collision step's hash could be verified");
+  // A damaged file verifies only in part: the steps whose hashes were in damaged or undecodable
+  // chunks were never compared, so --verify cannot vouch for the recording.
+  const std::size_t broken = recording->damaged().size() + recording->content_errors().size();
+  if (o.verify && broken > 0) {
+    throw std::runtime_error(o.file + ": the recording is damaged (" + std::to_string(recording->damaged().size()) + " damaged ranges, " +
+                             std::to_string(recording->content_errors().size()) + " undecodable chunks; `resecto rec verify` names them): only " +
+                             std::to_string(r.verified_hashes()) + " collision steps' hashes could be compared");
+  }
 }
 
 void register_replay(CLI::App& app) {

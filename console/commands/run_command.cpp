@@ -77,6 +77,11 @@ void run(const RunOptions& o) {
     }
   }
   options.export_surface_path = o.export_surface;
+  // Every output checked before the run (which may take minutes): never a file the run reads, never
+  // one path for two outputs, and its folder there.
+  const std::vector<std::filesystem::path> inputs{std::filesystem::exists(o.procedure) ? o.procedure : std::string(), o.calibration};
+  const std::vector<std::filesystem::path> outputs{o.record, o.report, o.trace, o.export_surface};
+  if (Status ok = check_output_paths(outputs, inputs); !ok) throw std::runtime_error(ok.error());
   options.seed = o.seed;
   options.simulation.prostate_triangles = o.triangles;
   options.simulation.collision_hz = o.collision_hz;

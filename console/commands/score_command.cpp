@@ -41,6 +41,12 @@ void score(const ScoreOptions& o) {
   const std::vector<std::string>& files = comparing ? o.compare : o.files;
   if (files.empty()) throw std::runtime_error("score: no recording given (resecto score FILE... or --compare A B)");
 
+  // The outputs checked before minutes of re-simulation: never a recording being scored, never the
+  // same file twice. With several recordings --html is a folder of pages, made later.
+  const std::vector<std::filesystem::path> inputs(files.begin(), files.end());
+  const std::vector<std::filesystem::path> outputs{o.csv, comparing || files.size() == 1 ? o.html : std::string()};
+  if (Status ok = check_output_paths(outputs, inputs); !ok) throw std::runtime_error("score: " + ok.error());
+
   std::vector<RecordingScore> scored;
   nlohmann::ordered_json skipped = nlohmann::ordered_json::array();
   for (std::size_t n = 0; n < files.size(); ++n) {

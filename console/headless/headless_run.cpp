@@ -109,6 +109,17 @@ std::string hex_hash(std::uint64_t hash) {
 Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   SimulationConfig simulation = options.simulation;
   simulation.gimbal = gimbal_geometry_from(options.calibration);
+  {
+    // A run shorter than one collision step would report and record nothing a replay or score can use.
+    const double seconds = options.seconds > 0.0 ? options.seconds : options.procedure.duration_s();
+    const double step_s = simulation.tick_s() * simulation.physics_per_collision;
+    if (!(std::llround(seconds / simulation.tick_s()) >= simulation.physics_per_collision)) {
+      char text[256];
+      std::snprintf(text, sizeof text, "the run is %.3g s long (%s); it must last at least one collision step, %.4g s", seconds,
+                    options.seconds > 0.0 ? "--seconds" : "the procedure's length", step_s);
+      return Error{text};
+    }
+  }
   Result<std::unique_ptr<Simulation>> created = Simulation::create(simulation);
   if (!created) return Error{created.error()};
   Simulation& sim = **created;

@@ -116,6 +116,55 @@ void AtomicFile::discard() {
   temporary_.clear();
 }
 
+namespace {
+
+/// Whether two paths name one existing file (hard links, symbolic links and `..` included).
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
+  std::error_code error;
+  return std::filesystem::equivalent(a, b, error) && !error;
+}
+
+}  // namespace
+
+Status check_output_path(const std::filesystem::path& output, std::span<const std::filesystem::path> inputs) {
+  if (output.empty()) return Error{"an output path is empty"};
+  if (output.filename().empty() || output.filename() == "." || output.filename() == "..") {
+    return Error{output.string() + ": names a folder, not a file"};
+  }
+  struct stat existing {};
+  if (::stat(output.c_str(), &existing) == 0) {
+    if (S_ISDIR(existing.st_mode)) return Error{output.string() + ": is a folder; not replaced"};
+    if (!S_ISREG(existing.st_mode)) return Error{output.string() + ": is not a regular file (a device or pipe); not replaced"};
+    for (const std::filesystem::path& input : inputs) {
+      if (!input.empty() && same_file(input, output)) {
+        return Error{output.string() + ": is the input " + input.string() + "; writing it would destroy it (give another output path)"};
+      }
+    }
+  } else if (errno != ENOENT && errno != ENOTDIR) {  // ENOTDIR: a file where its folder should be, named below
+    return Error{output.string() + ": cannot inspect: " + std::strerror(errno)};
+  }
+  const std::filesystem::path folder = output.parent_path().empty() ? std::filesystem::path(".") : output.parent_path();
+  struct stat parent {};
+  if (::stat(folder.c_str(), &parent) != 0) return Error{output.string() + ": its folder " + folder.string() + " does not exist"};
+  if (!S_ISDIR(parent.st_mode)) return Error{output.string() + ": " + folder.string() + " is not a folder"};
+  return Ok{};
+}
+
+Status check_output_paths(std::span<const std::filesystem::path> outputs, std::span<const std::filesystem::path> inputs) {
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    if (outputs[i].empty()) continue;
+    if (Status ok = check_output_path(outputs[i], inputs); !ok) return ok;
+    for (std::size_t j = 0; j < i; ++j) {
+      // Two outputs on one path: compared as written and, when the file exists, as files.
+      if (!outputs[j].empty() && (std::filesystem::absolute(outputs[j]).lexically_normal() == std::filesystem::absolute(outputs[i]).lexically_normal() ||
+                                  same_file(outputs[j], outputs[i]))) {
+        return Error{outputs[i].string() + ": given for two outputs; the second would replace the first"};
+      }
+    }
+  }
+  return Ok{};
+}
+
 Status write_file_atomically(const std::filesystem::path& target, std::string_view bytes) {
   AtomicFile file;
   if (Status opened = file.open(target); !opened) return opened;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -45,6 +46,15 @@ class AtomicFile {
 
 /// Writes `bytes` as the whole of `target` through an AtomicFile.
 Status write_file_atomically(const std::filesystem::path& target, std::string_view bytes);
+
+/// Whether `output` can be written, checked before the work that produces it (a long run, a
+/// recovery) so a mistyped path costs nothing: an empty path, a folder or device in the way, a
+/// missing folder, or the very file of one of `inputs` (which the output would destroy) is an
+/// error naming the path.
+Status check_output_path(const std::filesystem::path& output, std::span<const std::filesystem::path> inputs = {});
+/// The same for several outputs of one command, which must also differ from each other (the last
+/// written would replace the others). Empty paths are outputs not asked for and are skipped.
+Status check_output_paths(std::span<const std::filesystem::path> outputs, std::span<const std::filesystem::path> inputs = {});
 
 /// Flushes standard output and reports a failed write (a full disk, a closed pipe) as an error.
 Status flush_standard_output();

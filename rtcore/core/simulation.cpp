@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <thread>
+#include <utility>
 
 #include "rtcore/base/units.h"
 #include "rtcore/core/thread_priority.h"
@@ -63,6 +65,22 @@ Status SimulationConfig::validate() const {
   if (physics_threads < 1 || physics_threads > 2) return Error{"physics threads " + std::to_string(physics_threads) + " is outside [1, 2]"};
   if (prostate_triangles < 200 || prostate_triangles > 1'000'000) {
     return Error{"prostate triangles " + std::to_string(prostate_triangles) + " is outside [200, 1000000]"};
+  }
+  // A recording's header carries these too: a bound that would ask TetGen for billions of
+  // tetrahedra, or buffers of billions of entries, is refused rather than attempted.
+  constexpr double kSmallestTetVolumeM3 = 1e-11;  // 0.01 mm^3: a few million tetrahedra in the gland
+  if (!(max_tet_volume_m3 == 0.0 || (max_tet_volume_m3 >= kSmallestTetVolumeM3 && max_tet_volume_m3 <= 1.0))) {
+    char text[128];
+    std::snprintf(text, sizeof text, "tetrahedron volume bound %g m^3 is neither 0 (none) nor within [1e-11, 1]", max_tet_volume_m3);
+    return Error{text};
+  }
+  constexpr std::int32_t kLargestContactCapacity = 1 << 22;
+  const ToolContactCapacity& capacity = tissue.contact_capacity;
+  for (const auto& [name, value] : {std::pair{"max_tissue_nodes", capacity.max_tissue_nodes}, std::pair{"max_tool_vertices", capacity.max_tool_vertices},
+                                    std::pair{"max_pair_entries", capacity.max_pair_entries}}) {
+    if (value < 1 || value > kLargestContactCapacity) {
+      return Error{std::string("contact capacity ") + name + " " + std::to_string(value) + " is outside [1, " + std::to_string(kLargestContactCapacity) + "]"};
+    }
   }
   return Ok{};
 }

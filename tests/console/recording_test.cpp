@@ -119,6 +119,10 @@ TEST(RecordingCommands, VerifyNamesADamagedChunkAndRecoverRepairsIt) {
   const testing::CommandOutput verify = run_resecto("rec verify " + damaged.string());
   EXPECT_NE(verify.exit_code, 0);
   EXPECT_NE(verify.err.find("at byte " + std::to_string(victim.offset)), std::string::npos) << verify.err;
+  // Replaying the damaged file itself cannot vouch for it: the steps in the lost chunk were never compared.
+  const testing::CommandOutput partial = run_resecto("replay " + damaged.string() + " --verify");
+  EXPECT_NE(partial.exit_code, 0);
+  EXPECT_NE(partial.err.find("the recording is damaged (1 damaged ranges"), std::string::npos) << partial.err;
   const nlohmann::json info = json_of(run_resecto("rec info " + damaged.string() + " --json"));
   EXPECT_EQ(info["damaged_chunks"], 1);
   const auto recovered = dir / "recovered.rsrec";
@@ -128,6 +132,48 @@ TEST(RecordingCommands, VerifyNamesADamagedChunkAndRecoverRepairsIt) {
   const testing::CommandOutput replay = run_resecto("replay " + recovered.string() + " --verify --json");
   EXPECT_EQ(replay.exit_code, 0) << replay.err;
   EXPECT_EQ(json_of(replay)["mismatches"], 0);
+}
+
+TEST(RecordingCommands, NoOutputEverReplacesTheFileItIsMadeFrom) {
+  const auto dir = scratch_directory("recording_own_input");
+  const auto file = dir / "demo.rsrec";
+  record(file, "--seconds 0.5");
+  const std::uintmax_t size = std::filesystem::file_size(file);
+  std::filesystem::create_directories(dir / "sub");
+  const std::string same = (dir / "sub" / ".." / "demo.rsrec").string();
+  for (const std::string& command : {"rec recover " + file.string() + " " + same, "rec export " + file.string() + " --inputs -o " + same,
+                                     "score " + file.string() + " --csv " + same}) {
+    const testing::CommandOutput out = run_resecto(command);
+    EXPECT_NE(out.exit_code, 0) << command;
+    EXPECT_NE(out.err.find("is the input"), std::string::npos) << command << ": " << out.err;
+  }
+  EXPECT_EQ(std::filesystem::file_size(file), size);
+  EXPECT_EQ(run_resecto("replay " + file.string() + " --verify").exit_code, 0);
+  // A folder given as a recording is named as one.
+  const testing::CommandOutput folder = run_resecto("rec info " + (dir / "sub").string());
+  EXPECT_NE(folder.exit_code, 0);
+  EXPECT_NE(folder.err.find("sub: is a folder, not a recording"), std::string::npos) << folder.err;
+}
+
+TEST(RunCommand, OutputsAndLengthAreCheckedBeforeTheRun) {
+  const auto dir = scratch_directory("run_outputs");
+  const auto kept = dir / "kept.rsrec";
+  record(kept, "--seconds 0.5");
+  const std::uintmax_t size = std::filesystem::file_size(kept);
+  // The recording would have been replaced before a report into a missing folder failed at the end.
+  const testing::CommandOutput missing =
+      run_resecto("run --headless --triangles 1296 --seconds 0.5 --record " + kept.string() + " --report " + (dir / "no" / "r.json").string());
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_NE(missing.err.find("does not exist"), std::string::npos) << missing.err;
+  const testing::CommandOutput twice =
+      run_resecto("run --headless --triangles 1296 --seconds 0.5 --record " + kept.string() + " --report " + kept.string());
+  EXPECT_NE(twice.exit_code, 0);
+  EXPECT_NE(twice.err.find("given for two outputs"), std::string::npos) << twice.err;
+  EXPECT_EQ(std::filesystem::file_size(kept), size);
+  // Shorter than one collision step: nothing a replay or a score could use.
+  const testing::CommandOutput short_run = run_resecto("run --headless --triangles 1296 --seconds 0.001");
+  EXPECT_NE(short_run.exit_code, 0);
+  EXPECT_NE(short_run.err.find("at least one collision step"), std::string::npos) << short_run.err;
 }
 
 TEST(RecordingCommands, ExportsKeyframesAndInputsThatOtherProgramsRead) {

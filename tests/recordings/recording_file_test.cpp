@@ -6,9 +6,11 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <string>
 
 #include "recordings/recover.h"
 #include "recordings/replay.h"
+#include "recordings/session_header.h"
 #include "tests/recordings/short_recording.h"
 
 namespace resecto::rec {
@@ -188,6 +190,34 @@ TEST(RecordingFile, AFlippedBitInChunkKLosesChunkKOnly) {
       }
     }
   }
+}
+
+}  // namespace
+}  // namespace resecto::rec
+
+namespace resecto::rec {
+namespace {
+
+// A header whose checksums are right but whose values would make the replay build a model of
+// billions of tetrahedra or buffers of billions of entries is refused by name, not attempted.
+TEST(SessionHeaderJson, RefusesBoundsNoReplayCouldBuild) {
+  SessionHeader header;
+  header.format_version = kFormatVersion;
+  header.grid.bits = 11;
+  header.grid.range = 0.1f;
+  const auto refused = [&](const char* key_path, double value) {
+    nlohmann::ordered_json json = header_to_json(header);
+    nlohmann::ordered_json* at = &json["simulation"];
+    std::string path = key_path;
+    for (std::size_t dot; (dot = path.find('.')) != std::string::npos; path = path.substr(dot + 1)) at = &(*at)[path.substr(0, dot)];
+    (*at)[path] = value;
+    const Result<SessionHeader> parsed = header_from_json(json.dump());
+    return parsed ? std::string() : parsed.error();
+  };
+  EXPECT_EQ(refused("max_tet_volume_m3", 0.0), "");
+  EXPECT_NE(refused("max_tet_volume_m3", 1e-30).find("tetrahedron volume bound 1e-30 m^3"), std::string::npos);
+  EXPECT_NE(refused("tissue.contact_capacity.max_pair_entries", 0).find("max_pair_entries 0 is outside"), std::string::npos);
+  EXPECT_NE(refused("tissue.contact_capacity.max_tissue_nodes", 1 << 30).find("max_tissue_nodes"), std::string::npos);
 }
 
 }  // namespace

@@ -6,8 +6,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <span>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "rtcore/base/atomic_file.h"
 #include "rtcore/base/checked_number.h"
@@ -61,6 +63,34 @@ TEST(AtomicFile, NothingAppearsUntilCommitAndAnUncommittedFileLeavesNothing) {
   }
   EXPECT_EQ(contents(target), "good\n");
   EXPECT_EQ(entries(dir), 1u);
+}
+
+TEST(OutputPath, IsCheckedBeforeTheWorkThatWouldWriteIt) {
+  const auto dir = scratch("check");
+  ASSERT_TRUE(write_file_atomically(dir / "input.rsrec", "precious\n").ok());
+  std::filesystem::create_directories(dir / "sub");
+  std::filesystem::create_hard_link(dir / "input.rsrec", dir / "linked.rsrec");
+  const std::filesystem::path input = dir / "input.rsrec";
+  const std::span<const std::filesystem::path> inputs(&input, 1);
+  EXPECT_TRUE(check_output_path(dir / "new.rsrec", inputs).ok());
+  EXPECT_TRUE(check_output_path(dir / "sub" / "..", inputs).error().find("names a folder") != std::string::npos);
+  // The input under another spelling, or a hard link to it: writing would destroy it.
+  for (const std::filesystem::path& same : {dir / "sub" / ".." / "input.rsrec", dir / "linked.rsrec"}) {
+    const Status status = check_output_path(same, inputs);
+    ASSERT_FALSE(status.ok()) << same;
+    EXPECT_NE(status.error().find("is the input"), std::string::npos) << status.error();
+  }
+  EXPECT_NE(check_output_path("/dev/null").error().find("is not a regular file"), std::string::npos);
+  EXPECT_NE(check_output_path(dir / "sub").error().find("is a folder"), std::string::npos);
+  EXPECT_NE(check_output_path(dir / "no" / "report.json").error().find("does not exist"), std::string::npos);
+  EXPECT_NE(check_output_path(dir / "input.rsrec" / "report.json").error().find("is not a folder"), std::string::npos);
+  // Two outputs of one command on one path, even one not yet written; outputs not asked for are empty.
+  const std::vector<std::filesystem::path> outputs{dir / "a.json", "", dir / "sub" / ".." / "a.json"};
+  const Status twice = check_output_paths(outputs);
+  ASSERT_FALSE(twice.ok());
+  EXPECT_NE(twice.error().find("given for two outputs"), std::string::npos) << twice.error();
+  EXPECT_TRUE(check_output_paths(std::vector<std::filesystem::path>{dir / "a.json", "", dir / "b.json"}).ok());
+  EXPECT_EQ(contents(dir / "input.rsrec"), "precious\n");
 }
 
 TEST(AtomicFile, RefusesFoldersDevicesAndMissingFolders) {
