@@ -3,6 +3,7 @@
 // passed it; it also prints bounds rounded to six digits ("230.0001 is outside [0, 230]").
 #pragma once
 
+#include <algorithm>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -35,6 +36,19 @@ inline CLI::Validator positive_up_to(double hi) {
         return std::string();
       },
       "NUMBER in (0, " + exact_number(hi) + "]");
+}
+
+/// Accepts a whole number in [0, 2^64 - 1] written in decimal digits: the conversion underneath
+/// would take "-1" as 2^64 - 1 and saturate a longer number, both without a word.
+inline CLI::Validator unsigned_64() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos) return "'" + text + "' is not a whole number of decimal digits";
+        const std::string digits = text.substr(std::min(text.find_first_not_of('0'), text.size() - 1));
+        if (digits.size() > 20 || (digits.size() == 20 && digits > "18446744073709551615")) return text + " is past 18446744073709551615";
+        return std::string();
+      },
+      "UINT64");
 }
 
 }  // namespace resecto::cli

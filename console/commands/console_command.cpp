@@ -5,6 +5,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "console/commands/checked_options.h"
 #include "console/commands/command_registry.h"
 #include "console/commands/parameter_options.h"
 #include "console/gui/console_app.h"
@@ -25,7 +26,7 @@ void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_r
                    "Threads sharing each physics step's spring and node loops: 1, or 2 (the core and a helper); same state hashes")
         ->check(CLI::Range(1, 2))
         ->capture_default_str();
-    cmd.add_option("--seed", o.seed, "Seed of the emulated sensors' noise")->capture_default_str();
+    cmd.add_option("--seed", o.seed, "Seed of the emulated sensors' noise")->check(unsigned_64())->capture_default_str();
     cmd.add_option("--calibration", o.calibration, "Device calibration file (default: the reference device's)");
   }
   cmd.add_option("--device", o.device,

@@ -138,10 +138,22 @@ void register_run(CLI::App& app) {
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
   cmd->add_option("--calibration", o->calibration, "Device calibration file (default: the reference device's)");
-  cmd->add_option("--seed", o->seed, "Seed of the emulated sensors' noise")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Seed of the emulated sensors' noise")->check(unsigned_64())->capture_default_str();
   cmd->add_flag("--json", o->json, "Print the JSON report instead of the summary");
   add_console_options(*cmd, o->console, true);
-  cmd->callback([o] { run(*o); });
+  cmd->callback([o, cmd] {
+    // The console's own options mean nothing to a headless run (it is driven by its procedure through
+    // the emulated device); taking `--device hid` silently would let a user believe hardware drove it.
+    if (o->headless) {
+      for (const char* console_only : {"--device", "--preset", "--replay", "--actions", "--frames", "--screenshot", "--lockstep", "--insertion-mm",
+                                       "--width", "--height", "--slow-frame-ms", "--view-scale", "--no-vsync"}) {
+        if (cmd->count(console_only) > 0) {
+          throw std::runtime_error(std::string(console_only) + " is an option of the operator console; a --headless run follows its procedure through the emulated device");
+        }
+      }
+    }
+    run(*o);
+  });
 }
 
 const RegisterCommand kRegister{"run", &register_run};
