@@ -34,12 +34,20 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
   if (!r.scan_.signature_ok) return Error{name + ": not a Resecto recording (bad signature)"};
   bool have_header = false;
   for (std::size_t c = 0; c < r.scan_.chunks.size(); ++c) {
+    if (have_header && r.scan_.chunks[c].type == static_cast<std::uint16_t>(ChunkType::kHeader)) {
+      // A second header starts another recording (two files joined): its ticks would pass for this
+      // one's past its end. It and everything after it are left out, and the file is not sound.
+      r.content_errors_.push_back("header chunk " + std::to_string(r.scan_.chunks[c].sequence) + " at byte " + std::to_string(r.scan_.chunks[c].offset) +
+                                  ": a second header, another recording (two files joined?); it and the " +
+                                  std::to_string(r.scan_.chunks.size() - c) + " chunks from it on are left out");
+      r.scan_.chunks.resize(c);
+      break;
+    }
     const ChunkLocation& chunk = r.scan_.chunks[c];
     const std::span<const std::uint8_t> payload = r.payload(chunk);
     const std::string where = std::string(chunk_type_name(chunk.type)) + " chunk " + std::to_string(chunk.sequence) + " at byte " + std::to_string(chunk.offset);
     switch (static_cast<ChunkType>(chunk.type)) {
       case ChunkType::kHeader: {
-        if (have_header) break;  // only the first counts
         Result<SessionHeader> header = header_from_json(std::string_view(reinterpret_cast<const char*>(payload.data()), payload.size()));
         if (!header) return Error{name + ": " + header.error()};
         r.header_ = std::move(*header);

@@ -222,3 +222,29 @@ TEST(SessionHeaderJson, RefusesBoundsNoReplayCouldBuild) {
 
 }  // namespace
 }  // namespace resecto::rec
+
+namespace resecto::rec {
+namespace {
+
+// Two recordings joined (`cat a b > c`): the second's chunks would pass for the first's, so the file
+// reads as the first recording with a content error, and recovering it keeps only the first.
+TEST(RecordingFile, ASecondRecordingJoinedOnIsLeftOutAndNamed) {
+  const std::vector<std::uint8_t>& file = testing::short_recording().file;
+  std::vector<std::uint8_t> joined = file;
+  joined.insert(joined.end(), file.begin(), file.end());
+  Result<Recording> original = Recording::from_bytes(file);
+  Result<Recording> r = Recording::from_bytes(joined);
+  ASSERT_TRUE(original && r);
+  ASSERT_EQ(r->content_errors().size(), 1u);
+  EXPECT_NE(r->content_errors()[0].find("a second header"), std::string::npos) << r->content_errors()[0];
+  EXPECT_EQ(r->chunks().size(), original->chunks().size());
+  EXPECT_EQ(r->ticks().size(), original->ticks().size());
+  RecoverReport report;
+  Result<Recording> recovered = Recording::from_bytes(recovered_bytes(*r, report));
+  ASSERT_TRUE(recovered);
+  EXPECT_TRUE(recovered->content_errors().empty());
+  EXPECT_EQ(recovered->ticks().size(), original->ticks().size());
+}
+
+}  // namespace
+}  // namespace resecto::rec
