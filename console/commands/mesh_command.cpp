@@ -33,6 +33,7 @@ std::filesystem::path landmarks_path_for(const std::filesystem::path& mesh_path)
 
 void print_surface_report(const SurfaceReport& r) {
   std::printf("  triangles        %zu\n  vertices         %zu\n  edges            %zu\n", r.triangles, r.vertices, r.edges);
+  if (r.unused_vertices > 0) std::printf("  unused vertices  %zu (no face uses them: ignored)\n", r.unused_vertices);
   std::printf("  components       %d\n  genus            %d\n", r.components, r.genus);
   std::printf("  area             %.1f mm^2\n  volume           %.2f ml\n", r.area_m2 * 1e6, units::m3_to_ml(r.volume_m3));
   std::printf("  edge length      %.3f .. %.3f mm\n  smallest angle   %.2f deg\n", units::m_to_mm(r.min_edge_m),
@@ -132,9 +133,9 @@ void register_tetra(CLI::App& mesh) {
   CLI::App* cmd = mesh.add_subcommand("tetra", "Fill a closed surface with tetrahedra (TetGen), labelled capsule or adenoma");
   cmd->add_option("input", options->input, "Closed surface (.off, .obj, .ply, .stl), millimetres")->required();
   cmd->add_option("-o,--output", options->output, "Tetrahedral mesh, legacy VTK (.vtk), millimetres")->required();
-  cmd->add_option("--radius-edge", options->radius_edge, "Largest radius-edge ratio TetGen may leave (-q)")
+  cmd->add_option("--radius-edge", options->radius_edge, "Largest radius-edge ratio TetGen may leave (-q); too tight for the surface is an error after a bounded refinement")
       ->check(finite_range(1.0, 10.0))->capture_default_str();
-  cmd->add_option("--min-dihedral", options->min_dihedral_deg, "Smallest dihedral angle TetGen aims for, degrees (-q)")
+  cmd->add_option("--min-dihedral", options->min_dihedral_deg, "Smallest dihedral angle TetGen aims for, degrees (-q); too tight for the surface is an error after a bounded refinement")
       ->check(finite_range(0.0, 30.0))->capture_default_str();
   cmd->add_option("--max-volume", options->max_volume_mm3, "Largest tetrahedron volume, mm^3 (-a); 0 = unbounded")
       ->check(finite_range(0.0, 1e9))->capture_default_str();

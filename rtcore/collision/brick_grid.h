@@ -3,7 +3,9 @@
 // store their cells in this order; a query walking the tissue looks up neighbouring cells in turn.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 
 #include "rtcore/geometry/vec3.h"
@@ -13,15 +15,28 @@ namespace resecto {
 class BrickGrid {
  public:
   static constexpr std::size_t kBrick = 4;
+  static constexpr double kMaxCellsPerAxis = 1 << 16;
 
   BrickGrid() = default;
   /// Cells of side `cell_m` from `lower`, enough to cover `extent` (one more than it needs on each
   /// axis, so the box's upper faces are inside).
+  /// Never more than kMaxCellsPerAxis + 1 a side: a box or cell that is not finite (NaN, infinity)
+  /// gets a single cell rather than an unbounded count.
   BrickGrid(const Vec3& lower, const Vec3& extent, double cell_m) : lower_(lower), cell_m_(cell_m), inverse_cell_(1.0 / cell_m) {
     for (std::size_t a = 0; a < 3; ++a) {
-      dims_[a] = static_cast<std::size_t>(extent[static_cast<int>(a)] * inverse_cell_) + 1;
+      const double span = extent[static_cast<int>(a)] * inverse_cell_;
+      dims_[a] = (span >= 0.0 ? static_cast<std::size_t>(std::min(span, kMaxCellsPerAxis)) : 0) + 1;
       bricks_[a] = (dims_[a] + kBrick - 1) / kBrick;
     }
+  }
+
+  /// The side of cubic cells of which about `cells` fill a box of `extent`. The volume overflows
+  /// to infinity past 1e102 on a side, so then the sides' cube roots are taken apart (the finite
+  /// form is kept as it was: the tool grids' values, and so the golden hashes, depend on it).
+  static double cell_side_for(const Vec3& extent, double cells) {
+    const double volume = extent.x * extent.y * extent.z;
+    if (std::isfinite(volume)) return std::cbrt(volume / cells);
+    return std::cbrt(extent.x) * std::cbrt(extent.y) * std::cbrt(extent.z) / std::cbrt(cells);
   }
 
   /// The storage index of the cell holding p; false when p is outside the grid.

@@ -124,7 +124,10 @@ int SphereTree::slice_count(const TriangleMesh& mesh, std::uint32_t t, std::uint
   if (!(shortest > 0.0)) return 1;
   const double height = length(cross(base, v[apex] - v[(apex + 1) % 3])) / shortest;
   const double slices = std::ceil(height / (aspect * shortest));
-  return static_cast<int>(std::clamp(slices, 1.0, static_cast<double>(kMaxSlices)));
+  // Edges past 1e154 square to infinity and the ratio to NaN, which std::clamp passes through (and
+  // casting it is undefined): such a triangle keeps one leaf, so the leaf count stays bounded.
+  if (!(slices >= 1.0)) return 1;
+  return static_cast<int>(std::min(slices, static_cast<double>(kMaxSlices)));
 }
 
 Sphere SphereTree::piece_sphere(const TriangleMesh& mesh, const LeafPiece& piece) {

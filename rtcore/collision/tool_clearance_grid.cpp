@@ -40,7 +40,7 @@ void ToolClearanceGrid::build(const TriangleMesh& mesh, std::size_t max_cells) {
   const Vec3 extent = all.size();
   const double longest = std::max({extent.x, extent.y, extent.z, 1e-300});
   const Vec3 sized = glm::max(extent, Vec3(longest / 64.0));
-  const double cell_m = std::cbrt(sized.x * sized.y * sized.z / static_cast<double>(std::max<std::size_t>(max_cells, 64)));
+  const double cell_m = BrickGrid::cell_side_for(sized, static_cast<double>(std::max<std::size_t>(max_cells, 64)));
   band_m_ = kBandCells * cell_m;
   cells_ = BrickGrid(all.min - Vec3(band_m_), extent + Vec3(2.0 * band_m_), cell_m);
   step_m_ = band_m_ / 255.0;

@@ -25,7 +25,7 @@ void ToolProximityGrid::build(const TriangleMesh& mesh, double reach_m, std::siz
   const Vec3 extent = upper_ - lower;
   // Half the reach keeps a cell's lists near the true ones (a list holds what is within the reach
   // plus half the cell's diagonal); a long part gets larger cells rather than an unbounded grid.
-  cells_ = BrickGrid(lower, extent, std::max(0.5 * reach_m, std::cbrt(extent.x * extent.y * extent.z / static_cast<double>(max_cells))));
+  cells_ = BrickGrid(lower, extent, std::max(0.5 * reach_m, BrickGrid::cell_side_for(extent, static_cast<double>(max_cells))));
 
   // Any point of a cell is within half its diagonal of the centre, so a triangle within the reach
   // of such a point is within reach + half diagonal of the centre: the test below keeps it.

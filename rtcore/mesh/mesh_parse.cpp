@@ -122,6 +122,9 @@ struct RawMesh {
 
 Result<TriangleMesh> triangulate(const RawMesh& raw, const std::string& name, double metres_per_unit) {
   if (raw.face_count() == 0) return Error{name + ": the file holds no faces"};
+  // Every reader's points pass here, so the bound is checked once for all formats, in the file's
+  // own millimetres whatever scale the caller reads them at.
+  if (Status sane = check_coordinate_bound(raw.points, 1.0); !sane) return Error{name + ": " + sane.error()};
   TriangleMesh mesh;
   mesh.positions.reserve(raw.points.size());
   for (const Vec3& p : raw.points) mesh.positions.push_back(p * metres_per_unit);

@@ -26,7 +26,8 @@ enum class MeshFormat { off, obj, ply, stl };
 
 /// Parses a whole file's bytes; `name` prefixes every error. Coordinates are scaled by
 /// `metres_per_unit`; polygons become fans around their first corner, in file order. STL's
-/// unshared corners are merged where their coordinates are identical.
+/// unshared corners are merged where their coordinates are identical. A coordinate beyond
+/// kMaxSurfaceCoordinateMm is an error naming the vertex.
 Result<TriangleMesh> parse_surface_mesh(std::string_view bytes, MeshFormat format, const std::string& name,
                                         double metres_per_unit);
 

@@ -62,12 +62,7 @@ Status check_faces(const TriangleMesh& mesh, const ValidationOptions& options) {
       return Error{"degenerate triangle: " + face_name(f) + " uses a vertex twice"};
     }
   }
-  for (std::size_t v = 0; v < vertex_count; ++v) {
-    const Vec3& p = mesh.positions[v];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      return Error{vertex_name(v) + " has a non-finite coordinate"};
-    }
-  }
+  if (Status bounded = check_coordinate_bound(mesh.positions, units::kMillimetresPerMetre); !bounded) return bounded;
   const double mean_area = surface_area(mesh) / static_cast<double>(std::max<std::size_t>(1, mesh.triangle_count()));
   const double threshold = options.degenerate_area_fraction * mean_area;
   for (std::size_t f = 0; f < mesh.triangle_count(); ++f) {
@@ -247,7 +242,10 @@ Result<SurfaceReport> validate_closed_surface(const TriangleMesh& mesh, const Va
     components.unite(t[1], t[2]);
   }
   for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
-    if (!used[v]) continue;
+    if (!used[v]) {
+      ++report.unused_vertices;
+      continue;
+    }
     ++report.vertices;
     if (components.find(static_cast<std::uint32_t>(v)) == v) ++report.components;
   }

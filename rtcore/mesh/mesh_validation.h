@@ -10,7 +10,8 @@ namespace resecto {
 
 /// Topology and geometry facts of a surface.
 struct SurfaceReport {
-  std::size_t vertices = 0;
+  std::size_t vertices = 0;         ///< the vertices the faces use
+  std::size_t unused_vertices = 0;  ///< vertices no face uses: no part of the surface, ignored
   std::size_t edges = 0;
   std::size_t triangles = 0;
   int components = 0;

@@ -2,6 +2,9 @@
 #include "rtcore/mesh/triangle_mesh.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdint>
 
 namespace resecto {
 
@@ -47,6 +50,38 @@ void append_mesh(TriangleMesh& mesh, const TriangleMesh& other) {
   for (const Triangle& tri : other.triangles) {
     mesh.triangles.push_back({tri[0] + offset, tri[1] + offset, tri[2] + offset});
   }
+}
+
+Status check_coordinate_bound(const std::vector<Vec3>& positions, double mm_per_unit) {
+  for (std::size_t v = 0; v < positions.size(); ++v) {
+    for (int a = 0; a < 3; ++a) {
+      const double mm = positions[v][a] * mm_per_unit;
+      if (std::abs(mm) <= kMaxSurfaceCoordinateMm) continue;  // false for NaN too
+      char what[128];
+      std::snprintf(what, sizeof what, "vertex %zu has coordinate %g mm, beyond the ±%g mm a surface may reach", v, mm,
+                    kMaxSurfaceCoordinateMm);
+      return Error{what};
+    }
+  }
+  return Ok{};
+}
+
+TriangleMesh without_unused_vertices(const TriangleMesh& mesh) {
+  constexpr std::uint32_t kUnused = UINT32_MAX;
+  std::vector<std::uint32_t> renumbered(mesh.vertex_count(), kUnused);
+  for (const Triangle& tri : mesh.triangles) {
+    for (std::uint32_t v : tri) renumbered[v] = 0;
+  }
+  TriangleMesh compact;
+  // Kept in input order, so the mesh with every vertex used comes back unchanged.
+  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+    if (renumbered[v] == kUnused) continue;
+    renumbered[v] = static_cast<std::uint32_t>(compact.positions.size());
+    compact.positions.push_back(mesh.positions[v]);
+  }
+  compact.triangles.reserve(mesh.triangle_count());
+  for (const Triangle& tri : mesh.triangles) compact.triangles.push_back({renumbered[tri[0]], renumbered[tri[1]], renumbered[tri[2]]});
+  return compact;
 }
 
 }  // namespace resecto

@@ -8,11 +8,18 @@
 
 #include <glm/common.hpp>
 
+#include "rtcore/base/result.h"
 #include "rtcore/geometry/vec3.h"
 
 namespace resecto {
 
 using Triangle = std::array<std::uint32_t, 3>;
+
+/// The largest coordinate magnitude a surface may have, in millimetres: 1 km, far beyond any gland
+/// or tool. Past 1e154 squared lengths overflow to infinity (areas, sphere radii, grid cell counts),
+/// so such coordinates would hang or exhaust the builders rather than mean anything; the readers
+/// and validate_closed_surface() refuse them.
+inline constexpr double kMaxSurfaceCoordinateMm = 1e6;
 
 /// An indexed triangle mesh; positions in metres, triangles counter-clockwise seen from outside.
 struct TriangleMesh {
@@ -49,5 +56,12 @@ double signed_volume(const TriangleMesh& mesh);
 Aabb bounding_box(const TriangleMesh& mesh);
 /// Appends `other` to `mesh`, offsetting its indices.
 void append_mesh(TriangleMesh& mesh, const TriangleMesh& other);
+/// The first vertex with a coordinate that is not finite or beyond ±kMaxSurfaceCoordinateMm, as an
+/// error naming it; `mm_per_unit` says what the positions are in (1 for a file's millimetres, 1000
+/// for metres).
+Status check_coordinate_bound(const std::vector<Vec3>& positions, double mm_per_unit);
+/// The mesh over only the vertices its triangles use, kept in their order (the triangles renumbered,
+/// unchanged otherwise). A vertex no face uses is no part of the surface it sits in.
+TriangleMesh without_unused_vertices(const TriangleMesh& mesh);
 
 }  // namespace resecto

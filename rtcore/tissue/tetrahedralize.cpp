@@ -33,16 +33,18 @@ std::string tetgen_failure(int code) {
 
 /// Uniform grid over the outer surface's faces, to answer "is this point within d of the outer
 /// surface?" by visiting only nearby faces. Cells are kept as a sorted (cell, face) list so lookups
-/// and their order are deterministic.
+/// and their order are deterministic. The grid only narrows the search: the answer is the exact
+/// distance test, whatever the cell size (at least the reach, so the 27 cells around a point hold
+/// every face within reach of it).
 class OuterSurfaceProximity {
  public:
+  /// On average a face's box may cover this many cells; past it the cells grow.
+  static constexpr double kCellsPerFace = 64.0;
+
   OuterSurfaceProximity(const TriangleMesh& surface, std::vector<std::uint32_t> faces, double reach_m)
-      : surface_(surface), reach_m_(reach_m), cell_m_(std::max(reach_m, 1e-6)) {
+      : surface_(surface), reach_m_(reach_m), cell_m_(bounded_cell_m(surface, faces, reach_m)) {
     for (std::uint32_t f : faces) {
-      const Triangle& t = surface.triangles[f];
-      const Vec3 lo = glm::min(glm::min(surface.positions[t[0]], surface.positions[t[1]]), surface.positions[t[2]]);
-      const Vec3 hi = glm::max(glm::max(surface.positions[t[0]], surface.positions[t[1]]), surface.positions[t[2]]);
-      const auto a = cell_of(lo), b = cell_of(hi);
+      const auto [a, b] = cell_span(face_box(surface, f), cell_m_);
       for (long long x = a[0]; x <= b[0]; ++x)
         for (long long y = a[1]; y <= b[1]; ++y)
           for (long long z = a[2]; z <= b[2]; ++z) entries_.push_back({key(x, y, z), f});
@@ -68,9 +70,35 @@ class OuterSurfaceProximity {
   }
 
  private:
-  std::array<long long, 3> cell_of(const Vec3& p) const {
-    return {static_cast<long long>(std::floor(p.x / cell_m_)), static_cast<long long>(std::floor(p.y / cell_m_)),
-            static_cast<long long>(std::floor(p.z / cell_m_))};
+  using Cell = std::array<long long, 3>;
+
+  static Aabb face_box(const TriangleMesh& surface, std::uint32_t f) {
+    const Triangle& t = surface.triangles[f];
+    return triangle_box(surface.positions[t[0]], surface.positions[t[1]], surface.positions[t[2]]);
+  }
+  static Cell cell_of(const Vec3& p, double cell_m) {
+    return {static_cast<long long>(std::floor(p.x / cell_m)), static_cast<long long>(std::floor(p.y / cell_m)),
+            static_cast<long long>(std::floor(p.z / cell_m))};
+  }
+  static std::pair<Cell, Cell> cell_span(const Aabb& box, double cell_m) { return {cell_of(box.min, cell_m), cell_of(box.max, cell_m)}; }
+  Cell cell_of(const Vec3& p) const { return cell_of(p, cell_m_); }
+
+  /// The reach (at least 1 um), doubled until the faces' boxes cover at most kCellsPerFace cells
+  /// each on average: a thin shell or a wide surface once asked for one entry per micrometre cell
+  /// (16.8 GB for a capsule of 0 mm on a 10 mm tetrahedron). Bounded: once cells outgrow every box,
+  /// each box covers at most 8.
+  static double bounded_cell_m(const TriangleMesh& surface, const std::vector<std::uint32_t>& faces, double reach_m) {
+    double cell_m = std::max(reach_m, 1e-6);
+    const double budget = kCellsPerFace * static_cast<double>(faces.size());
+    for (int doubling = 0; doubling < 1100; ++doubling, cell_m *= 2.0) {
+      double cells = 0.0;
+      for (std::uint32_t f : faces) {
+        const auto [a, b] = cell_span(face_box(surface, f), cell_m);
+        cells += static_cast<double>(b[0] - a[0] + 1) * static_cast<double>(b[1] - a[1] + 1) * static_cast<double>(b[2] - a[2] + 1);
+      }
+      if (cells <= budget) break;
+    }
+    return cell_m;
   }
   static std::uint64_t key(long long x, long long y, long long z) {
     auto part = [](long long v) { return static_cast<std::uint64_t>(v + (1 << 20)) & 0x1FFFFF; };
@@ -104,17 +132,43 @@ std::vector<std::uint32_t> outer_faces(const TriangleMesh& surface, const Tetrah
   return faces;
 }
 
+/// How many points TetGen's refinement may add (its -S). Tight bounds (a radius-edge ratio near 1,
+/// dihedral angles near 30 degrees) make it refine without end on a plain icosphere; the budget
+/// turns that into an error after bounded work. Reachable bounds need far less: the procedural
+/// gland adds about 2 points per surface vertex at --min-dihedral 18, and a volume bound about one
+/// per max_volume of the enclosed volume.
+int steiner_point_budget(const TriangleMesh& surface, double volume_m3, const TetrahedralizeOptions& options) {
+  if (options.max_steiner_points > 0) return options.max_steiner_points;
+  double budget = TetrahedralizeOptions::kSteinerPointsPerSurfaceVertex * static_cast<double>(surface.vertex_count());
+  if (options.max_volume_m3 > 0.0) budget += 2.0 * volume_m3 / options.max_volume_m3;
+  return static_cast<int>(std::clamp(budget, static_cast<double>(TetrahedralizeOptions::kMinSteinerPoints),
+                                     static_cast<double>(TetrahedralizeOptions::kMaxSteinerPoints)));
+}
+
+/// The error when refinement stopped at the budget: what was asked and what was reached.
+std::string quality_not_met(const TetMesh& mesh, const TetrahedralizeOptions& options, int budget) {
+  const TetMeshStats stats = compute_stats(mesh);
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "TetGen's refinement added its limit of %d points without reaching a radius-edge ratio of %.3g and dihedral "
+                "angles of %.3g deg (reached %.3g and %.3g deg); loosen the radius-edge, dihedral or volume bound",
+                budget, options.max_radius_edge_ratio, options.min_dihedral_deg, stats.max_radius_edge_ratio, stats.min_dihedral_deg);
+  return text;
+}
+
 }  // namespace
 
-Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const TetrahedralizeOptions& options) {
+Result<TetMesh> tetrahedralize(const TriangleMesh& input, const TetrahedralizeOptions& options) {
   if (!(options.max_radius_edge_ratio >= 1.0)) return Error{"radius-edge ratio bound must be at least 1.0"};
   if (!(options.min_dihedral_deg >= 0.0 && options.min_dihedral_deg < 70.0)) return Error{"minimum dihedral angle must be in [0, 70) degrees"};
   if (!(options.max_volume_m3 >= 0.0)) return Error{"maximum tetrahedron volume must not be negative"};
   if (!(options.capsule_thickness_m >= 0.0)) return Error{"capsule thickness must not be negative"};
   // TetGen can crash (not throw) on some invalid surfaces, so nothing invalid reaches it.
-  if (Result<SurfaceReport> valid = validate_closed_surface(surface); !valid) {
-    return Error{"cannot tetrahedralize: " + valid.error()};
-  }
+  Result<SurfaceReport> valid = validate_closed_surface(input);
+  if (!valid) return Error{"cannot tetrahedralize: " + valid.error()};
+  // Only the vertices the faces use reach TetGen: an unused one inside would become a node (and
+  // slivers around it), one outside the hull crashes TetGen's cleanup.
+  const TriangleMesh surface = without_unused_vertices(input);
 
   // TetGen works in millimetres: its tolerances are tuned for coordinates of order one.
   tetgenio in;
@@ -144,10 +198,12 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
   } else {
     std::snprintf(switches, sizeof switches, "pYq%.4g/%.4gQ", options.max_radius_edge_ratio, options.min_dihedral_deg);
   }
+  const int steiner_budget = steiner_point_budget(surface, valid->volume_m3, options);
   tetgenio out;
   try {
     tetgenbehavior behaviour;
     if (!behaviour.parse_commandline(switches)) return Error{std::string("TetGen rejected the switches ") + switches};
+    behaviour.steinerleft = steiner_budget;  // -S: the quality refinement stops here
     ::tetrahedralize(&behaviour, &in, &out);
   } catch (int code) {
     return Error{"tetrahedralization failed: " + tetgen_failure(code)};
@@ -178,6 +234,9 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const Tetrahedralize
     const Tetrahedron& tet = mesh.tetrahedra[t];
     const Vec3 centroid = 0.25 * (mesh.positions[tet[0]] + mesh.positions[tet[1]] + mesh.positions[tet[2]] + mesh.positions[tet[3]]);
     mesh.regions[t] = outer.within_reach(centroid) ? TissueRegion::kCapsule : TissueRegion::kAdenoma;
+  }
+  if (out.numberofpoints - static_cast<int>(surface.vertex_count()) >= steiner_budget) {
+    return Error{quality_not_met(mesh, options, steiner_budget)};
   }
   return mesh;
 }

@@ -18,11 +18,19 @@ struct TetrahedralizeOptions {
   /// The urethral channel's axis (apex point, bladder-neck point): boundary faces facing it are the
   /// channel wall, not the capsule. Without it, every boundary face is outer surface.
   std::optional<std::pair<Vec3, Vec3>> channel_axis;
+  /// Most points TetGen's refinement may add (-S); reaching it is an error. 0 = kSteinerPointsPerSurfaceVertex
+  /// per surface vertex plus two per max_volume_m3 of the enclosed volume, within [kMinSteinerPoints,
+  /// kMaxSteinerPoints] (the last about 4 GB of TetGen's memory).
+  int max_steiner_points = 0;
+  static constexpr double kSteinerPointsPerSurfaceVertex = 50.0;
+  static constexpr int kMinSteinerPoints = 20'000;
+  static constexpr int kMaxSteinerPoints = 4'000'000;
 };
 
 /// Fills the closed surface with tetrahedra, keeping its boundary faces exactly (TetGen -pY), so the
-/// tissue's surface is the input surface. Errors: a surface TetGen cannot mesh (self-intersecting,
-/// open), reported with TetGen's reason.
+/// tissue's surface is the input surface (over the vertices its faces use, renumbered in order when
+/// some are unused). Errors: a surface TetGen cannot mesh (self-intersecting, open), reported with
+/// TetGen's reason; quality bounds the refinement could not reach within max_steiner_points.
 Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const TetrahedralizeOptions& options = {});
 
 }  // namespace resecto

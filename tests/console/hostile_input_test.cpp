@@ -128,6 +128,39 @@ TEST_F(HostileInput, ObjAndStlFacesAndNumbersAreNeverDroppedSilently) {
                        "OFF nan vertex");
 }
 
+TEST_F(HostileInput, SurfacesThatCrashedOrExhaustedTetraAndCollideAreHandled) {
+  const std::string faces = "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  const auto corner = [&](const std::string& side, const std::string& extra_vertex = "") {
+    return "OFF\n" + std::string(extra_vertex.empty() ? "4" : "5") + " 4 0\n0 0 0\n" + side + " 0 0\n0 " + side + " 0\n0 0 " + side +
+           "\n" + extra_vertex + faces;
+  };
+  // An unused vertex outside the hull crashed TetGen (139); it is now no part of the surface.
+  write_bytes(path("unused.off"), corner("10", "50 50 50\n"));
+  CommandOutput run = run_resecto_bounded("mesh tetra " + arg("unused.off") + " -o " + arg("unused.vtk"));
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("1 tetrahedra over 4 nodes"), std::string::npos) << run.out;
+  run = run_resecto_bounded("mesh check " + arg("unused.off"));
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("unused vertices  1"), std::string::npos) << run.out;
+  // A 0 mm capsule asked for 16.8 GB, a 10 m tetrahedron as much: now within 512 MB and 5 s.
+  write_bytes(path("tet10.off"), corner("10"));
+  write_bytes(path("tet1e4.off"), corner("1e4"));
+  EXPECT_EQ(run_resecto_bounded("mesh tetra " + arg("tet10.off") + " --capsule 0 -o " + arg("t.vtk")).exit_code, 0);
+  EXPECT_EQ(run_resecto_bounded("mesh tetra " + arg("tet1e4.off") + " -o " + arg("t.vtk")).exit_code, 0);
+  // Quality bounds TetGen cannot reach used to refine forever; the bounded refinement says so.
+  expect_clean_failure(run_resecto_bounded("mesh tetra " + arg("p.off") + " --min-dihedral 30 -o " + arg("q.vtk"), 30.0),
+                       "without reaching a radius-edge ratio of 1.8 and dihedral angles of 30 deg (reached", "--min-dihedral 30");
+  EXPECT_FALSE(std::filesystem::exists(path("q.vtk")));
+  // Coordinates of 1e150 hung the clearance grid, 1e300 took 7.5 GB: refused where they are read.
+  write_bytes(path("huge_tool.off"), corner("1e150"));
+  expect_clean_failure(run_resecto_bounded("collide --tissue " + arg("tet10.off") + " --tool " + arg("huge_tool.off") + " --poses " + arg("pose.txt")),
+                       "huge_tool.off: vertex 1 has coordinate 1e+150 mm, beyond the ±1e+06 mm a surface may reach", "collide 1e150 tool");
+  write_bytes(path("huge_tissue.off"), corner("1e300"));
+  expect_clean_failure(run_resecto_bounded(collide_args(arg("huge_tissue.off"))), "huge_tissue.off: vertex 1 has coordinate 1e+300 mm",
+                       "collide 1e300 tissue");
+  expect_clean_failure(run_resecto_bounded("mesh check " + arg("huge_tissue.off")), "vertex 1 has coordinate 1e+300 mm", "mesh check 1e300");
+}
+
 TEST_F(HostileInput, CollideRefusesTruncatedMeshesInEveryFormat) {
   for (const char* format : {"off", "obj", "ply", "stl"}) {
     const std::string whole = "whole." + std::string(format);

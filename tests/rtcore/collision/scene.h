@@ -85,4 +85,13 @@ inline void expect_slabs_cover(const SphereTree& tree, const TriangleMesh& mesh)
   }
 }
 
+/// A closed outward tetrahedron with legs of `side` from the origin: past 1e154 its squared lengths
+/// overflow to infinity, at 1e150 its volume does.
+inline TriangleMesh corner_tetrahedron(double side) {
+  TriangleMesh mesh;
+  mesh.positions = {{0, 0, 0}, {side, 0, 0}, {0, side, 0}, {0, 0, side}};
+  mesh.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  return mesh;
+}
+
 }  // namespace resecto::testing

@@ -168,5 +168,16 @@ TEST(SphereTree, RemovingEveryTriangleFreesEveryNodeAndInsertingReusesThem) {
   testing::expect_tree_invariants(tree);
 }
 
+
+TEST(SphereTree, HugeCoordinatesKeepOneLeafPerTriangle) {
+  // Their slice count was NaN, cast to an int: billions of leaves (5-7.5 GB) before the readers
+  // refused such files. A programmatic caller still gets a bounded tree.
+  for (const double side : {1e150, 1e155, 1e300}) {
+    SphereTree tree;
+    tree.build(testing::corner_tetrahedron(side));
+    EXPECT_LE(tree.leaf_count(), 4 * SphereTree::kMaxSlices) << side;
+  }
+}
+
 }  // namespace
 }  // namespace resecto

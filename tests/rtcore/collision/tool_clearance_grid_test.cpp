@@ -11,6 +11,7 @@
 
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/geometry/closest_point.h"
+#include "scene.h"
 
 namespace resecto {
 namespace {
@@ -68,6 +69,17 @@ TEST(ToolClearanceGrid, AnEmptyMeshGivesAnEmptyGrid) {
   ToolClearanceGrid grid;
   grid.build(TriangleMesh{});
   EXPECT_TRUE(grid.empty());
+}
+
+
+TEST(ToolClearanceGrid, HugeCoordinatesKeepTheCellCountBounded) {
+  // At 1e150 the box's volume overflowed, the cell side became infinite and the cell count NaN:
+  // the build spun forever. The cell side is now taken per axis, and a count past the cap is capped.
+  for (const double side : {1e150, 1e155, 1e300}) {
+    ToolClearanceGrid grid;
+    grid.build(testing::corner_tetrahedron(side), 4096);
+    EXPECT_LE(grid.cell_count(), 16u * 4096u) << side;  // the asked-for cells plus the band's 8 around them
+  }
 }
 
 }  // namespace

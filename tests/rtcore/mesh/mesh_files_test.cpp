@@ -175,4 +175,47 @@ TEST(MeshFiles, WriteThenReadRoundTripsEveryFormat) {
 }
 
 }  // namespace
+
+TEST(MeshFiles, CoordinatesBeyondOneKilometreAreRefusedNamingTheVertex) {
+  // 1e150 hung the tool's clearance grid, 1e155 and more exhausted memory in the sphere tree, and
+  // `mesh check` called them degenerate with an area of inf: every reader now refuses them.
+  const std::string faces = "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  const std::string huge = "OFF\n4 4 0\n0 0 0\n1e150 0 0\n0 10 0\n0 0 10\n" + faces;
+  const std::string error = validation_error(write_file("huge.off", huge));
+  EXPECT_NE(error.find("huge.off: vertex 1 has coordinate 1e+150 mm, beyond the ±1e+06 mm a surface may reach"), std::string::npos)
+      << error;
+  const std::string obj = "v 0 0 0\nv 10 0 0\nv 0 10 0\nv 0 0 -2e6\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  EXPECT_NE(validation_error(write_file("huge.obj", obj)).find("vertex 3 has coordinate -2e+06 mm"), std::string::npos);
+  // At the bound itself the file is fine.
+  EXPECT_EQ(validation_error(write_file("km.off", "OFF\n4 4 0\n0 0 0\n1e6 0 0\n0 1e6 0\n0 0 1e6\n" + faces)), "");
+  // A mesh built in memory (metres) meets the same bound in validation.
+  TriangleMesh mesh;
+  mesh.positions = {{0, 0, 0}, {2e3, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  mesh.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  Result<SurfaceReport> report = validate_closed_surface(mesh);
+  ASSERT_FALSE(report);
+  EXPECT_EQ(report.error(), "vertex 1 has coordinate 2e+06 mm, beyond the ±1e+06 mm a surface may reach");
+}
+
+TEST(MeshFiles, UnusedVerticesAreCountedAndCanBeDropped) {
+  // A vertex no face uses is no part of the surface: a note in the report, never a failure.
+  const auto path = write_file("unused.off", "OFF\n5 4 0\n50 50 50\n0 0 0\n10 0 0\n0 10 0\n0 0 10\n"
+                                             "3 1 3 2\n3 1 2 4\n3 1 4 3\n3 2 3 4\n");
+  Result<TriangleMesh> mesh = read_surface_mesh(path);
+  ASSERT_TRUE(mesh) << mesh.error();
+  Result<SurfaceReport> report = validate_closed_surface(*mesh);
+  ASSERT_TRUE(report) << report.error();
+  EXPECT_EQ(report->vertices, 4u);
+  EXPECT_EQ(report->unused_vertices, 1u);
+  const TriangleMesh compact = without_unused_vertices(*mesh);
+  ASSERT_EQ(compact.vertex_count(), 4u);
+  EXPECT_EQ(compact.positions[0], mesh->positions[1]);
+  EXPECT_EQ(compact.triangles[0], (Triangle{0, 2, 1}));
+  EXPECT_EQ(compact.triangles[3], (Triangle{1, 2, 3}));
+  // With every vertex used, nothing changes.
+  const TriangleMesh again = without_unused_vertices(compact);
+  EXPECT_EQ(again.positions, compact.positions);
+  EXPECT_EQ(again.triangles, compact.triangles);
+}
+
 }  // namespace resecto

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <unistd.h>
 
 #include "rtcore/anatomy/prostate.h"
@@ -104,6 +105,64 @@ TEST(Tetrahedralize, SelfIntersectingSurfaceIsAnErrorNotACrash) {
   Result<TetMesh> tetra = tetrahedralize(mesh);
   ASSERT_FALSE(tetra);
   EXPECT_NE(tetra.error().find("self-intersection"), std::string::npos) << tetra.error();
+}
+
+/// A closed outward tetrahedron with `side_m` legs at the origin, and optionally one vertex no face
+/// uses, at `unused` (placed first, so the used ones are renumbered).
+TriangleMesh corner_tetrahedron(double side_m, std::optional<Vec3> unused = std::nullopt) {
+  TriangleMesh mesh;
+  mesh.positions = {{0, 0, 0}, {side_m, 0, 0}, {0, side_m, 0}, {0, 0, side_m}};
+  mesh.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  if (unused) {
+    mesh.positions.insert(mesh.positions.begin(), *unused);
+    for (Triangle& t : mesh.triangles) {
+      for (std::uint32_t& v : t) ++v;
+    }
+  }
+  return mesh;
+}
+
+TEST(Tetrahedralize, UnusedVerticesNeverReachTetGen) {
+  // Outside the hull it crashed TetGen (SIGSEGV in its memory pool); inside it became a node with
+  // slivers around it. Either way the tissue is the tetrahedron alone, on its 4 corners in order.
+  for (const Vec3 unused : {Vec3(0.05, 0.05, 0.05), Vec3(0.001, 0.001, 0.001), Vec3(0.005, 0.005, 0.0)}) {
+    const TriangleMesh surface = corner_tetrahedron(0.01, unused);
+    Result<TetMesh> tetra = tetrahedralize(surface);
+    ASSERT_TRUE(tetra) << tetra.error();
+    EXPECT_EQ(tetra->tetrahedron_count(), 1u);
+    ASSERT_EQ(tetra->node_count(), 4u);
+    for (std::size_t v = 0; v < 4; ++v) EXPECT_EQ(tetra->positions[v], surface.positions[v + 1]);
+  }
+}
+
+TEST(Tetrahedralize, CapsuleLabellingIsBoundedByTheFaceCountNotTheShell) {
+  // A 0 mm shell once meant 1 um cells (16.8 GB for a 10 mm tetrahedron), and 2.5 mm cells over a
+  // 10 m tetrahedron as much: the grid now grows its cells, and the labels stay exact.
+  TetrahedralizeOptions thin;
+  thin.capsule_thickness_m = 0.0;
+  Result<TetMesh> small = tetrahedralize(corner_tetrahedron(0.01), thin);
+  ASSERT_TRUE(small) << small.error();
+  EXPECT_EQ(small->regions, std::vector<TissueRegion>{TissueRegion::kAdenoma});
+  Result<TetMesh> large = tetrahedralize(corner_tetrahedron(10.0));
+  ASSERT_TRUE(large) << large.error();
+  EXPECT_EQ(large->regions, std::vector<TissueRegion>{TissueRegion::kAdenoma});  // centroid 1.4 m in
+  TetrahedralizeOptions thick;
+  thick.capsule_thickness_m = 2.0;  // beyond the centroid's 1.44 m from the nearest face
+  Result<TetMesh> shell = tetrahedralize(corner_tetrahedron(10.0), thick);
+  ASSERT_TRUE(shell) << shell.error();
+  EXPECT_EQ(shell->regions, std::vector<TissueRegion>{TissueRegion::kCapsule});
+}
+
+TEST(Tetrahedralize, UnreachableQualityIsAnErrorAtTheSteinerBudget) {
+  // Bounds this tight never terminate in TetGen on a smooth surface; the budget stops it and says so.
+  const ProstateModel model = generate_prostate(1296);
+  TetrahedralizeOptions options = prostate_options(model);
+  options.min_dihedral_deg = 30.0;
+  options.max_steiner_points = 50;
+  Result<TetMesh> tetra = tetrahedralize(model.surface, options);
+  ASSERT_FALSE(tetra);
+  EXPECT_NE(tetra.error().find("limit of 50 points"), std::string::npos) << tetra.error();
+  EXPECT_NE(tetra.error().find("dihedral angles of 30 deg (reached"), std::string::npos) << tetra.error();
 }
 
 TEST(Tetrahedralize, RejectsImpossibleOptions) {
