@@ -236,8 +236,10 @@ TEST(RecordingCommands, AKilledRealTimeRecordingRecoversAtLeastFourOfFiveSeconds
   ASSERT_GE(child, 0);
   if (child == 0) {
     std::freopen("/dev/null", "w", stdout);
-    ::execl(RESECTO_EXE, RESECTO_EXE, "run", "--headless", "--realtime", "--procedure", "demo", "--seconds", "60", "--record", file.c_str(),
-            static_cast<char*>(nullptr));
+    // The 1296-triangle gland keeps real time on a slow or loaded machine (the 8640 one fell behind
+    // on a 2-vCPU Xeon and simulated 3.x s in 5): this tests the recorder's flushing, not the core's speed.
+    ::execl(RESECTO_EXE, RESECTO_EXE, "run", "--headless", "--realtime", "--procedure", "demo", "--triangles", "1296", "--seconds", "60", "--record",
+            file.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
   // The recording starts when the model is built and the recorder has written its header.
