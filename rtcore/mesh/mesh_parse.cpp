@@ -152,8 +152,8 @@ std::optional<std::string> count_problem(std::int64_t count, std::size_t cap, st
     return std::string(what) + " count " + std::to_string(count) + " is over the limit of " + std::to_string(cap);
   }
   if (min_bytes_each > 0 && static_cast<std::uint64_t>(count) > bytes_left / min_bytes_each) {
-    return "declares " + std::to_string(count) + " " + what + "s, but only " + std::to_string(bytes_left) +
-           " bytes follow (truncated file or a wrong count)";
+    return std::string(what) + " count " + std::to_string(count) + " needs at least " + std::to_string(min_bytes_each) + " bytes each, but only " +
+           std::to_string(bytes_left) + " bytes follow (truncated file or a wrong count)";
   }
   return std::nullopt;
 }
@@ -193,10 +193,6 @@ Result<RawMesh> parse_off(std::string_view text, const std::string& name) {
   if (auto problem = count_problem(counts[0], kMaxMeshVertices, lines.bytes_left(), 6, "vertex")) return lines.error_at(header[1], *problem);
   if (auto problem = count_problem(counts[1], kMaxMeshFaces, lines.bytes_left(), 8, "face")) return lines.error_at(header[2], *problem);
   if (counts[2] < 0) return lines.error_at(header[3], "edge count " + std::to_string(counts[2]) + " is negative");
-  if (6 * counts[0] + 8 * counts[1] > static_cast<std::int64_t>(lines.bytes_left())) {
-    return lines.error_at(header[1], "declares " + std::to_string(counts[0]) + " vertices and " + std::to_string(counts[1]) +
-                                         " faces, more than the " + std::to_string(lines.bytes_left()) + " bytes that follow hold");
-  }
   const auto vertex_count = static_cast<std::size_t>(counts[0]);
   const auto face_count = static_cast<std::size_t>(counts[1]);
   RawMesh raw;

@@ -80,10 +80,13 @@ TEST_F(HostileInput, OffHeadersWithoutUsableCountsAreBoundedErrors) {
       {"huge_face.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1000000000 1 2 3\n"},
       {"binary.off", std::string("OFF BINARY\n") + std::string("\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff", 12)},
       {"more_faces_claimed.off", "OFF\n4 100 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"},
+      // Right counts, a bad face: the face is named, not the counts.
+      {"two_corner_face.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n2 0 1\n"},
   };
   const char* expected[] = {"the header ends before its vertex, face and edge counts", "vertex count -4 is negative",
                             "vertex count 2000000000 is over the limit", "face 0 has 1000000000 corners",
-                            "binary OFF is not read", "declares 100 faces"};
+                            "binary OFF is not read", "face count 100 needs at least 8 bytes each",
+                            "face 0 has 2 corners"};
   for (std::size_t i = 0; i < std::size(cases); ++i) {
     write_bytes(path(cases[i].first), cases[i].second);
     const std::string file = arg(cases[i].first);
