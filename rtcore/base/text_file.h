@@ -47,4 +47,10 @@ inline Result<std::string> read_text_file(const std::filesystem::path& path, con
   return bytes;
 }
 
+/// Drops a leading UTF-8 byte-order mark, which spreadsheets and Windows editors put before text
+/// files; it carries nothing, and left in it made the first word unreadable ("'\xEF\xBB\xBFOFF'").
+inline void strip_utf8_bom(std::string& text) {
+  if (text.size() >= 3 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);
+}
+
 }  // namespace resecto

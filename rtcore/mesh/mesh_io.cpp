@@ -58,6 +58,8 @@ Result<TriangleMesh> read_surface_mesh(const std::filesystem::path& path, double
   Result<std::string> bytes = read_text_file(path, " the mesh", kMaxMeshFileBytes);
   if (!bytes) return Error{bytes.error()};
   const MeshFormat format = ext == ".off" ? MeshFormat::off : ext == ".obj" ? MeshFormat::obj : ext == ".ply" ? MeshFormat::ply : MeshFormat::stl;
+  // A binary STL's 80-byte header is free bytes, so only the formats that open with text lose a mark.
+  if (format != MeshFormat::stl) strip_utf8_bom(*bytes);
   return parse_surface_mesh(*bytes, format, name, metres_per_unit);
 }
 

@@ -176,6 +176,7 @@ Result<Procedure> parse_procedure(const std::string& text, const std::string& so
 Result<Procedure> load_procedure(const std::filesystem::path& path) {
   Result<std::string> text = read_text_file(path, " the procedure file");
   if (!text) return Error{text.error()};
+  strip_utf8_bom(*text);
   return parse_procedure(*text, path.string());
 }
 

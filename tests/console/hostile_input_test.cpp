@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <string>
 
@@ -260,6 +261,21 @@ TEST_F(HostileInput, AFullStandardOutputIsAFailure) {
                        "mesh check > /dev/full");
   expect_clean_failure(run_resecto_bounded(collide_args(arg("p.off")) + " --json", 5.0, 512, "/dev/full"),
                        "cannot write to standard output", "collide --json > /dev/full");
+}
+
+// Files saved by Windows editors and spreadsheets start with a UTF-8 byte-order mark: read as if it were not there.
+TEST_F(HostileInput, AByteOrderMarkBeforeTextIsIgnored) {
+  const std::string bom = "\xEF\xBB\xBF";
+  std::ifstream in(path("p.off"), std::ios::binary);
+  const std::string surface((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  write_bytes(path("bom.off"), bom + surface);
+  write_bytes(path("bom_pose.txt"), bom + std::string(kIdentityPose));
+  write_bytes(path("bom.proc"), bom + "0 0 0 0 125 0 0 0\n1 0 0 0 140 0 0 0\n");
+  EXPECT_EQ(run_resecto_bounded("mesh check " + arg("bom.off")).exit_code, 0);
+  const CommandOutput collide = run_resecto_bounded(collide_args(arg("bom.off"), "bom_pose.txt"));
+  EXPECT_EQ(collide.exit_code, 0) << collide.err;
+  const CommandOutput run = run_resecto_bounded("run --headless --triangles 1296 --procedure " + arg("bom.proc"), 60.0);
+  EXPECT_EQ(run.exit_code, 0) << run.err;
 }
 
 /// A 256 KiB tmpfs, mounted for one test and filled to the last byte after the good files are in.
