@@ -218,6 +218,10 @@ Result<std::vector<ParameterCommand>> decode_command_block(std::span<const std::
     if (id >= kTissueParameterCount) return Error{"commands: unknown parameter " + std::to_string(id)};
     c.id = static_cast<TissueParameter>(id);
     c.value = r.get<double>();
+    // The core applies a command as already validated (ParameterCommand::value): one the console
+    // could never have sent (NaN, out of its range) marks a file made by something else.
+    TissueParameters check;
+    if (Status valid = check.set(c.id, c.value); !valid) return Error{"commands: tick " + std::to_string(c.apply_tick) + ": " + valid.error()};
   }
   return commands;
 }

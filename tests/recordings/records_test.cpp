@@ -6,6 +6,7 @@
 
 #include <bit>
 #include <cmath>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -72,6 +73,28 @@ TEST(StepRecords, NoDistalMarginYetStaysNone) {
   // The sentinel files held before the margin was optional.
   metrics.distal_margin_mm = 1e9;
   EXPECT_FALSE(round_trip(metrics).distal_margin_mm.has_value());
+}
+
+}  // namespace
+}  // namespace resecto::rec
+
+namespace resecto::rec {
+namespace {
+
+// A command block carrying a value the console could never have sent is refused when read, so a
+// replay never applies a NaN stiffness as if it had been validated.
+TEST(CommandRecords, AValueOutsideItsParameterRangeIsUndecodable) {
+  std::vector<std::uint8_t> payload;
+  const std::vector<ParameterCommand> good{{960, TissueParameter::kStiffness, tissue_parameter_spec(TissueParameter::kStiffness).default_value}};
+  encode_command_block(good, payload);
+  ASSERT_TRUE(decode_command_block(payload));
+  for (const double bad : {std::nan(""), tissue_parameter_spec(TissueParameter::kStiffness).max_value * 2.0}) {
+    const std::vector<ParameterCommand> commands{{960, TissueParameter::kStiffness, bad}};
+    encode_command_block(commands, payload);
+    const Result<std::vector<ParameterCommand>> decoded = decode_command_block(payload);
+    ASSERT_FALSE(decoded) << bad;
+    EXPECT_NE(decoded.error().find("tick 960"), std::string::npos) << decoded.error();
+  }
 }
 
 }  // namespace
