@@ -4,6 +4,7 @@
 // the exit status is 1 when any was skipped.
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -82,9 +83,17 @@ void score(const ScoreOptions& o) {
       std::error_code error;
       std::filesystem::create_directories(o.html, error);
       if (error) throw std::runtime_error("score --html " + o.html + ": cannot create the directory: " + error.message());
+      // A page per recording, named by its file's stem; recordings of one stem from different
+      // folders (trainee1/demo.rsrec, trainee2/demo.rsrec) get -2, -3, ... rather than one page each
+      // written over the last.
+      std::map<std::string, int> pages_of_stem;
       for (const RecordingScore& s : scored) {
-        write_or_throw(std::filesystem::path(o.html) / (std::filesystem::path(s.file).stem().string() + ".html"),
-                       debrief_html(std::span<const RecordingScore>(&s, 1)));
+        const std::string stem = std::filesystem::path(s.file).stem().string();
+        const int seen = ++pages_of_stem[stem];
+        std::string page = stem;
+        if (seen > 1) page.append("-").append(std::to_string(seen));  // appended: GCC 12's -O3 -Wrestrict false positive
+        page.append(".html");
+        write_or_throw(std::filesystem::path(o.html) / page, debrief_html(std::span<const RecordingScore>(&s, 1)));
       }
     }
   }

@@ -148,6 +148,19 @@ TEST(ScoreCommand, CohortCsvSkipsTheDamagedRecording) {
   EXPECT_EQ(read_text(dir / "cohort.csv").find("damaged"), std::string::npos);
 }
 
+TEST(ScoreCommand, RecordingsOfOneNameFromTwoFoldersGetAPageEach) {
+  const auto dir = scratch_directory("score_same_name");
+  std::filesystem::create_directories(dir / "trainee1");
+  std::filesystem::create_directories(dir / "trainee2");
+  run_and_record("demo", dir / "trainee1" / "demo.resecto", " --seconds 0.5");
+  run_and_record("demo", dir / "trainee2" / "demo.resecto", " --seconds 0.5 --seed 2");
+  const CommandOutput scored = run_resecto("score --quiet --html " + (dir / "pages").string() + " " + (dir / "trainee1" / "demo.resecto").string() +
+                                           " " + (dir / "trainee2" / "demo.resecto").string());
+  ASSERT_EQ(scored.exit_code, 0) << scored.err;
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir / "pages" / "demo.html"));
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir / "pages" / "demo-2.html"));
+}
+
 TEST(ScoreCommand, BadArgumentsAreNamed) {
   const CommandOutput none = run_resecto("score");
   EXPECT_NE(none.exit_code, 0);
