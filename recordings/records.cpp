@@ -212,6 +212,7 @@ Result<std::vector<ParameterCommand>> decode_command_block(std::span<const std::
   const std::uint32_t count = r.get<std::uint32_t>();
   if (std::uint64_t{count} * 17 != r.remaining()) return Error{"commands: count and length disagree"};
   std::vector<ParameterCommand> commands(count);
+  TissueParameters check;  // the console's own range check, reused
   for (ParameterCommand& c : commands) {
     c.apply_tick = r.get<std::int64_t>();
     const auto id = r.get<std::uint8_t>();
@@ -220,7 +221,6 @@ Result<std::vector<ParameterCommand>> decode_command_block(std::span<const std::
     c.value = r.get<double>();
     // The core applies a command as already validated (ParameterCommand::value): one the console
     // could never have sent (NaN, out of its range) marks a file made by something else.
-    TissueParameters check;
     if (Status valid = check.set(c.id, c.value); !valid) return Error{"commands: tick " + std::to_string(c.apply_tick) + ": " + valid.error()};
   }
   return commands;

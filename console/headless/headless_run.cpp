@@ -109,24 +109,22 @@ std::string hex_hash(std::uint64_t hash) {
 Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   SimulationConfig simulation = options.simulation;
   simulation.gimbal = gimbal_geometry_from(options.calibration);
-  {
-    // A run shorter than one collision step would report and record nothing a replay or score can use.
-    const double seconds = options.seconds > 0.0 ? options.seconds : options.procedure.duration_s();
-    const double step_s = simulation.tick_s() * simulation.physics_per_collision;
-    if (!(std::llround(seconds / simulation.tick_s()) >= simulation.physics_per_collision)) {
-      char text[256];
-      std::snprintf(text, sizeof text, "the run is %.3g s long (%s); it must last at least one collision step, %.4g s", seconds,
-                    options.seconds > 0.0 ? "--seconds" : "the procedure's length", step_s);
-      return Error{text};
-    }
+  // The configuration is validated as it is given (Simulation::create copies it), so the run's length
+  // is known, and checked, before the model is built. A run shorter than one collision step would
+  // report and record nothing a replay or score can use.
+  const double seconds = options.seconds > 0.0 ? options.seconds : options.procedure.duration_s();
+  const double tick_s = simulation.tick_s();
+  const auto ticks = static_cast<std::uint64_t>(std::max<long long>(0, std::llround(seconds / tick_s)));
+  if (!(ticks >= static_cast<std::uint64_t>(simulation.physics_per_collision))) {
+    char text[256];
+    std::snprintf(text, sizeof text, "the run is %.3g s long (%s); it must last at least one collision step, %.4g s", seconds,
+                  options.seconds > 0.0 ? "--seconds" : "the procedure's length", tick_s * simulation.physics_per_collision);
+    return Error{text};
   }
   Result<std::unique_ptr<Simulation>> created = Simulation::create(simulation);
   if (!created) return Error{created.error()};
   Simulation& sim = **created;
   const SimulationConfig& config = sim.config();
-  const double seconds = options.seconds > 0.0 ? options.seconds : options.procedure.duration_s();
-  const double tick_s = config.tick_s();
-  const auto ticks = static_cast<std::uint64_t>(std::llround(seconds / tick_s));
   const auto period_ns = static_cast<std::int64_t>(std::llround(tick_s * 1e9));
 
   FrameProfiler profiler(default_stage_budgets_us(config), std::min<std::uint64_t>(ticks * 6 + 64, 1u << 22));

@@ -29,6 +29,21 @@ std::filesystem::path temporary_beside(const std::filesystem::path& target) {
   return target.parent_path() / leaf;
 }
 
+/// The checks every output path gets: a file name, and only a regular file in the way (renaming over
+/// a device or a folder would destroy it). `stat_errno` is 0 when the target exists (`existing` is
+/// its stat), else stat's errno.
+Status inspect_target(const std::filesystem::path& target, struct stat& existing, int& stat_errno) {
+  if (target.empty()) return Error{"an output path is empty"};
+  if (target.filename().empty() || target.filename() == "." || target.filename() == "..") {
+    return Error{target.string() + ": names a folder, not a file"};
+  }
+  stat_errno = ::stat(target.c_str(), &existing) == 0 ? 0 : errno;
+  if (stat_errno != 0) return Ok{};
+  if (S_ISDIR(existing.st_mode)) return Error{target.string() + ": is a folder; not replaced"};
+  if (!S_ISREG(existing.st_mode)) return Error{target.string() + ": is not a regular file (a device or pipe); not replaced"};
+  return Ok{};
+}
+
 }  // namespace
 
 AtomicFile::~AtomicFile() { discard(); }
@@ -42,20 +57,14 @@ Status AtomicFile::open(const std::filesystem::path& target) {
   discard();
   target_ = target;
   first_error_.clear();
-  if (target.empty()) return Error{"an output path is empty"};
-  if (target.filename().empty() || target.filename() == "." || target.filename() == "..") {
-    return Error{target.string() + ": names a folder, not a file"};
-  }
-  // Only a regular file is ever replaced: renaming over a device or a folder would destroy it.
   struct stat existing {};
-  keep_mode_ = false;
-  if (::stat(target.c_str(), &existing) == 0) {
-    if (S_ISDIR(existing.st_mode)) return Error{target.string() + ": is a folder; not replaced"};
-    if (!S_ISREG(existing.st_mode)) return Error{target.string() + ": is not a regular file (a device or pipe); not replaced"};
+  int stat_errno = 0;
+  if (Status replaceable = inspect_target(target, existing, stat_errno); !replaceable) return replaceable;
+  keep_mode_ = stat_errno == 0;
+  if (keep_mode_) {
     mode_ = static_cast<int>(existing.st_mode & 07777);
-    keep_mode_ = true;
-  } else if (errno != ENOENT) {
-    return failure("cannot inspect the target", errno);
+  } else if (stat_errno != ENOENT) {
+    return failure("cannot inspect the target", stat_errno);
   }
   for (int attempt = 0; attempt < 16; ++attempt) {
     temporary_ = temporary_beside(target);
@@ -127,21 +136,17 @@ bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
 }  // namespace
 
 Status check_output_path(const std::filesystem::path& output, std::span<const std::filesystem::path> inputs) {
-  if (output.empty()) return Error{"an output path is empty"};
-  if (output.filename().empty() || output.filename() == "." || output.filename() == "..") {
-    return Error{output.string() + ": names a folder, not a file"};
-  }
   struct stat existing {};
-  if (::stat(output.c_str(), &existing) == 0) {
-    if (S_ISDIR(existing.st_mode)) return Error{output.string() + ": is a folder; not replaced"};
-    if (!S_ISREG(existing.st_mode)) return Error{output.string() + ": is not a regular file (a device or pipe); not replaced"};
+  int stat_errno = 0;
+  if (Status replaceable = inspect_target(output, existing, stat_errno); !replaceable) return replaceable;
+  if (stat_errno == 0) {
     for (const std::filesystem::path& input : inputs) {
       if (!input.empty() && same_file(input, output)) {
         return Error{output.string() + ": is the input " + input.string() + "; writing it would destroy it (give another output path)"};
       }
     }
-  } else if (errno != ENOENT && errno != ENOTDIR) {  // ENOTDIR: a file where its folder should be, named below
-    return Error{output.string() + ": cannot inspect: " + std::strerror(errno)};
+  } else if (stat_errno != ENOENT && stat_errno != ENOTDIR) {  // ENOTDIR: a file where its folder should be, named below
+    return Error{output.string() + ": cannot inspect: " + std::strerror(stat_errno)};
   }
   const std::filesystem::path folder = output.parent_path().empty() ? std::filesystem::path(".") : output.parent_path();
   struct stat parent {};
