@@ -23,6 +23,33 @@ struct SpringGeometry {
 
 [[gnu::always_inline]] inline bool compressed_below_half(double length, double rest_m) { return length > 0.0 && 2.0 * length < rest_m; }
 
+constexpr SpringForce kPlusZeroRow{0.0, 0.0, 0.0, 0.0};
+constexpr SpringForce kMinusZeroRow{-0.0, -0.0, -0.0, -0.0};
+constexpr std::size_t kPaddingRows = 2;
+
+/// A node list of every group, padded to the group's longest and interleaved (SpringIncidence).
+/// `spring_at(p)` is the spring at position p of `list_first`'s lists.
+template <class SpringAt>
+void interleave_groups(const std::vector<std::uint32_t>& list_first, SpringAt spring_at, std::uint32_t padding, std::vector<std::uint32_t>& offsets,
+                       std::vector<std::uint32_t>& entries) {
+  const std::size_t groups = (list_first.size() - 1) / kSpringSumGroup;
+  offsets.resize(groups + 1);
+  entries.clear();
+  offsets[0] = 0;
+  for (std::size_t g = 0; g < groups; ++g) {
+    const std::size_t n = g * kSpringSumGroup;
+    std::uint32_t longest = 0;
+    for (std::size_t k = 0; k < kSpringSumGroup; ++k) longest = std::max(longest, list_first[n + k + 1] - list_first[n + k]);
+    for (std::uint32_t e = 0; e < longest; ++e) {
+      for (std::size_t k = 0; k < kSpringSumGroup; ++k) {
+        const std::uint32_t at = list_first[n + k] + e;
+        entries.push_back(at < list_first[n + k + 1] ? spring_at(at) : padding);
+      }
+    }
+    offsets[g + 1] = offsets[g] + longest;
+  }
+}
+
 }  // namespace
 
 SpringForces::SpringForces(const SpringNetwork& network) {
@@ -34,6 +61,8 @@ SpringForces::SpringForces(const SpringNetwork& network) {
   arrays_.k.assign(count, 0.0);
   arrays_.c.assign(count, 0.0);
   arrays_.f.assign(count, SpringForce{});
+  arrays_.f.push_back(kPlusZeroRow);
+  arrays_.f.push_back(kMinusZeroRow);
   arrays_.compressed.assign(count, 0);
   for (std::size_t s = 0; s < count; ++s) {
     arrays_.i[s] = network.spring_nodes[2 * s];
@@ -48,11 +77,16 @@ void SpringForces::reserve(std::size_t spring_capacity, std::size_t node_capacit
   arrays_.rest_m.reserve(spring_capacity);
   arrays_.k.reserve(spring_capacity);
   arrays_.c.reserve(spring_capacity);
-  arrays_.f.reserve(spring_capacity);
+  arrays_.f.reserve(spring_capacity + kPaddingRows);
   arrays_.compressed.reserve(spring_capacity);
   incidence_.second_springs.reserve(spring_capacity);
   incidence_.second_first.reserve(node_capacity + 1);
   incidence_.first_first.reserve(node_capacity + 1);
+  // A group's padded list is no longer than its four lists together: at most four entries a spring.
+  incidence_.group_second.reserve(kSpringSumGroup * spring_capacity);
+  incidence_.group_first.reserve(kSpringSumGroup * spring_capacity);
+  incidence_.group_second_first.reserve(node_capacity / kSpringSumGroup + 1);
+  incidence_.group_first_first.reserve(node_capacity / kSpringSumGroup + 1);
   fill_.reserve(node_capacity + 1);
   listed_per_chunk_.reserve(chunks_covering(spring_capacity, kSpringsPerChunk));
 }
@@ -83,7 +117,7 @@ void SpringForces::append(std::uint32_t i, std::uint32_t j, double rest_m) {
   arrays_.rest_m.push_back(rest_m);
   arrays_.k.push_back(0.0);
   arrays_.c.push_back(0.0);
-  arrays_.f.push_back(SpringForce{});
+  arrays_.f.insert(arrays_.f.end() - kPaddingRows, SpringForce{});  // before the padding rows
   arrays_.compressed.push_back(0);
 }
 
@@ -104,6 +138,14 @@ void SpringForces::rebuild_incidence(std::size_t nodes) {
   in.second_springs.resize(count);
   fill_.assign(in.second_first.begin(), in.second_first.end() - 1);
   for (std::size_t s = 0; s < count; ++s) in.second_springs[fill_[arrays_.j[s]]++] = static_cast<std::uint32_t>(s);
+  rebuild_groups();
+}
+
+void SpringForces::rebuild_groups() {
+  SpringIncidence& in = incidence_;
+  const auto plus_zero = static_cast<std::uint32_t>(spring_count());
+  interleave_groups(in.second_first, [&](std::uint32_t at) { return in.second_springs[at]; }, plus_zero, in.group_second_first, in.group_second);
+  interleave_groups(in.first_first, [](std::uint32_t at) { return at; }, plus_zero + 1, in.group_first_first, in.group_first);
 }
 
 void SpringForces::keep(std::span<const std::uint32_t> kept, std::size_t node_count) {
@@ -117,7 +159,9 @@ void SpringForces::keep(std::span<const std::uint32_t> kept, std::size_t node_co
   compact(arrays_.rest_m);
   compact(arrays_.k);
   compact(arrays_.c);
-  compact(arrays_.f);
+  compact(arrays_.f);  // the padding rows are no spring's: put back after
+  arrays_.f.push_back(kPlusZeroRow);
+  arrays_.f.push_back(kMinusZeroRow);
   arrays_.compressed.resize(kept.size());
   rebuild_incidence(node_count);
 }
@@ -128,6 +172,7 @@ void SpringForces::add_nodes(std::size_t count) {
     incidence_.first_first.push_back(incidence_.first_first.back());
     incidence_.second_first.push_back(incidence_.second_first.back());
   }
+  rebuild_groups();
 }
 
 void SpringForces::add_appended_to_incidence(std::size_t first_new) {
@@ -158,6 +203,7 @@ void SpringForces::add_appended_to_incidence(std::size_t first_new) {
     fill_[n] = static_cast<std::uint32_t>(end + shift);  // where n's appended springs go
   }
   for (std::size_t t = first_new; t < count; ++t) in.second_springs[fill_[arrays_.j[t]]++] = static_cast<std::uint32_t>(t);
+  rebuild_groups();
 }
 
 void SpringForces::add_compression_bounds(const Vec3* x, double* stiffness_bound, std::size_t count) const {

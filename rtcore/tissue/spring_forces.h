@@ -73,6 +73,9 @@ class SpringForces {
   void linearise(const Vec3* x, Vec3* direction, double* transverse_k) const;
 
  private:
+  /// Relists the incidence's interleaved groups (after any change to the lists or the spring count).
+  void rebuild_groups();
+
   SpringArrays arrays_;
   SpringIncidence incidence_;
   std::vector<std::uint32_t> fill_;  // scratch of rebuild_incidence

@@ -24,7 +24,10 @@ struct SpringArrays {
   std::vector<std::uint32_t> i, j;  ///< nodes, i < j (springs sorted by i, then j)
   std::vector<double> rest_m;       ///< rest length
   std::vector<double> k, c;         ///< stiffness (N/m), damping (N*s/m)
-  std::vector<SpringForce> f;       ///< the spring's force on node i of the last pass (node j gets minus)
+  /// The spring's force on node i of the last pass (node j gets minus), then two padding rows, +0 at
+  /// [spring count] and -0 after it, which leave any sum's every bit alone (x - (+0) = x and
+  /// x + (-0) = x for every x): the node pass adds them where a node's list is shorter than its group's.
+  std::vector<SpringForce> f;
   /// Room for every spring: the force pass lists here, ascending, the springs it found compressed
   /// below half their rest length, so the rare bound correction visits only those.
   std::vector<std::uint32_t> compressed;
@@ -38,7 +41,17 @@ struct SpringIncidence {
   std::vector<std::uint32_t> second_springs;
   /// Per node + 1: the spring range whose node i it is.
   std::vector<std::uint32_t> first_first;
+
+  /// The same lists for the AVX2 node pass, four nodes to a group (group g: nodes 4g..4g+3; a last
+  /// group of fewer nodes has none): each group's lists padded to its longest with the padding rows
+  /// and interleaved, so node 4g+k's entry e is at [4 (group_second_first[g] + e) + k]. Four sums then
+  /// run side by side, each in its node's own order.
+  std::vector<std::uint32_t> group_second_first, group_second;
+  std::vector<std::uint32_t> group_first_first, group_first;
 };
+
+/// Nodes per group of SpringIncidence's interleaved lists.
+inline constexpr std::size_t kSpringSumGroup = 4;
 
 /// Writes the force of springs [begin, end) at positions x and velocities v into f:
 /// f = (k (L - L0) + c (v_j - v_i).u) u with u = (x_j - x_i) / L (u = 0 when L = 0). Lists the

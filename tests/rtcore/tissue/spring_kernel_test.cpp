@@ -22,6 +22,13 @@ bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
 }
 
+void expect_same_groups(const SpringIncidence& a, const SpringIncidence& b) {
+  EXPECT_EQ(a.group_second_first, b.group_second_first);
+  EXPECT_EQ(a.group_second, b.group_second);
+  EXPECT_EQ(a.group_first_first, b.group_first_first);
+  EXPECT_EQ(a.group_first, b.group_first);
+}
+
 TEST(SpringKernel, Avx2PathMatchesThePortablePathBitForBit) {
   if (!cpu_has_avx2()) GTEST_SKIP() << "no AVX2 on this processor: only the portable path runs";
   const ProstateTissueModel& model = tissue_model(1296);
@@ -124,6 +131,7 @@ TEST(SpringIncidence, AppendedSpringsListedAsARebuildListsThem) {
     EXPECT_EQ(incremental.incidence().first_first, rebuilt.incidence().first_first) << "round " << round;
     EXPECT_EQ(incremental.incidence().second_first, rebuilt.incidence().second_first) << "round " << round;
     EXPECT_EQ(incremental.incidence().second_springs, rebuilt.incidence().second_springs) << "round " << round;
+    expect_same_groups(incremental.incidence(), rebuilt.incidence());
   }
   // A round adding nodes but no spring leaves them empty.
   incremental.add_nodes(3);
@@ -131,6 +139,42 @@ TEST(SpringIncidence, AppendedSpringsListedAsARebuildListsThem) {
   rebuilt.rebuild_incidence(nodes + 3);
   EXPECT_EQ(incremental.incidence().first_first, rebuilt.incidence().first_first);
   EXPECT_EQ(incremental.incidence().second_first, rebuilt.incidence().second_first);
+  expect_same_groups(incremental.incidence(), rebuilt.incidence());
+}
+
+TEST(SpringIncidence, GroupsAfterEditsSumAsThePortablePass) {
+  // The AVX2 node pass reads the interleaved groups, which every edit relists: after appended
+  // springs, new nodes and a compaction its sums must still be the portable pass's, bit for bit.
+  if (!cpu_has_avx2()) GTEST_SKIP() << "no AVX2 on this processor: only the portable path runs";
+  const ProstateTissueModel& model = tissue_model(1296);
+  const SpringNetwork network = build_spring_network(model.mesh);
+  SpringForces forces(network);
+  std::size_t nodes = network.node_volume_m3.size();
+  forces.reserve(network.spring_count() + 100, nodes + 10);
+  forces.add_nodes(5);  // five nodes, so the last group is partial and the groups move
+  const std::size_t first_new = forces.spring_count();
+  for (std::uint32_t n = static_cast<std::uint32_t>(nodes); n < nodes + 5; ++n) {
+    for (std::uint32_t j : {1u, 7u, n - 3}) forces.append(n, j, 1e-3);
+  }
+  nodes += 5;
+  forces.add_appended_to_incidence(first_new);
+  std::vector<std::uint32_t> kept;
+  for (std::uint32_t s = 0; s < forces.spring_count(); ++s) {
+    if (s % 5 != 2) kept.push_back(s);
+  }
+  std::mt19937_64 random(3);
+  std::uniform_real_distribution<double> jitter(-1e-3, 1e-3), stiffness(0.1, 500.0);
+  std::vector<Vec3> x(nodes), v(nodes, Vec3(0.01, -0.02, 0.0));
+  for (std::size_t n = 0; n < nodes; ++n) x[n] = (n < model.mesh.positions.size() ? model.mesh.positions[n] : Vec3(0.0)) + Vec3(jitter(random));
+  for (bool compacted : {false, true}) {
+    if (compacted) forces.keep(kept, nodes);
+    for (std::size_t s = 0; s < forces.spring_count(); ++s) forces.set_material(s, stiffness(random), 1e-3);
+    forces.compute(x.data(), v.data());
+    std::vector<Vec3> portable(nodes, Vec3(-0.0)), simd(nodes, Vec3(-0.0));
+    add_spring_sums_portable(forces.incidence(), forces.arrays().f.data(), portable.data(), 0, nodes);
+    add_spring_sums_avx2(forces.incidence(), forces.arrays().f.data(), simd.data(), 0, nodes);
+    EXPECT_TRUE(same_bits(portable, simd)) << (compacted ? "after compaction" : "after appends");
+  }
 }
 
 }  // namespace
