@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "rtcore/tissue/node_order.h"
+#include "rtcore/tissue/node_step_kernel.h"
 #include "rtcore/base/state_hash.h"
 
 namespace resecto {
@@ -244,25 +245,12 @@ void MassSpringTissue::step_bounded_symplectic(double h_s) {
   const std::uint32_t chunks = chunks_covering(n, kNodesPerChunk);
   fastest2_per_chunk_.resize(chunks);  // within the reserved room
   first_non_finite_per_chunk_.resize(chunks);
+  const NodeStepArrays nodes{mass_.data(), stiffness_bound_.data(), damping_bound_.data(), force_.data(), step_mass_.data(), v_.data(), x_.data()};
   auto integrate = [&](std::uint32_t chunk) {
     const std::size_t begin = chunk * kNodesPerChunk, end = std::min(n, begin + kNodesPerChunk);
-    std::size_t first_non_finite = n;
-    double fastest2 = 0.0;
-    for (std::size_t i = begin; i < end; ++i) {
-      const double d = mass_[i] + 0.5 * h_s * h_s * stiffness_bound_[i] + h_s * damping_bound_[i];
-      Vec3 v = v_[i];
-      if (d > step_mass_[i]) v *= step_mass_[i] / d;
-      step_mass_[i] = d;
-      v += (h_s / d) * force_[i];
-      const Vec3 x = x_[i] + h_s * v;
-      v_[i] = v;
-      x_[i] = x;
-      fastest2 = std::max(fastest2, glm::dot(v, v));
-      const double sum = x.x + x.y + x.z + v.x + v.y + v.z;
-      if (!std::isfinite(sum) && first_non_finite == n) first_non_finite = i;
-    }
-    fastest2_per_chunk_[chunk] = fastest2;
-    first_non_finite_per_chunk_[chunk] = first_non_finite;
+    const NodeStepSummary summary = step_nodes(nodes, h_s, begin, end);
+    fastest2_per_chunk_[chunk] = summary.fastest2;
+    first_non_finite_per_chunk_[chunk] = summary.first_non_finite == NodeStepSummary::kNone ? n : summary.first_non_finite;
   };
   for_each_chunk(helper_, chunks, integrate);
   const double fastest2 = chunks == 0 ? 0.0 : *std::max_element(fastest2_per_chunk_.begin(), fastest2_per_chunk_.end());
