@@ -4,6 +4,8 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
+#include <limits>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -26,6 +28,19 @@ inline CLI::Validator finite_range(double lo, double hi) {
       "NUMBER in [" + exact_number(lo) + ", " + exact_number(hi) + "]");
 }
 
+/// Accepts a finite number not below lo (a time into a recording, which has no upper bound of its
+/// own): CLI::NonNegativeNumber let NaN through and printed its upper bound as a 309-digit number.
+inline CLI::Validator finite_at_least(double lo) {
+  return CLI::Validator(
+      [lo](std::string& text) -> std::string {
+        const std::optional<double> value = parse_finite(text);
+        if (!value) return "'" + text + "' is not a finite number";
+        if (!(*value >= lo)) return exact_number(*value) + " is below " + exact_number(lo);
+        return std::string();
+      },
+      "NUMBER >= " + exact_number(lo));
+}
+
 /// Accepts a finite number in (0, hi]: a duration, where 0 would mean nothing at all.
 inline CLI::Validator positive_up_to(double hi) {
   return CLI::Validator(
@@ -36,6 +51,20 @@ inline CLI::Validator positive_up_to(double hi) {
         return std::string();
       },
       "NUMBER in (0, " + exact_number(hi) + "]");
+}
+
+/// Accepts a whole number in [0, hi] written in decimal digits (an index, such as a keyframe's):
+/// CLI::NonNegativeNumber printed its upper bound as a 309-digit number.
+inline CLI::Validator index_up_to(std::uint64_t hi) {
+  return CLI::Validator(
+      [hi](std::string& text) -> std::string {
+        if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos) return "'" + text + "' is not a whole number of decimal digits";
+        const std::string digits = text.substr(std::min(text.find_first_not_of('0'), text.size() - 1));
+        const std::string limit = std::to_string(hi);
+        if (digits.size() > limit.size() || (digits.size() == limit.size() && digits > limit)) return text + " is past " + limit;
+        return std::string();
+      },
+      "INDEX in [0, " + std::to_string(hi) + "]");
 }
 
 /// Accepts a whole number in [0, 2^64 - 1] written in decimal digits: the conversion underneath

@@ -43,15 +43,15 @@ void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_r
   cmd.add_flag("--lockstep", o.lockstep,
                "Step the emulated board with the core's ticks (no link thread): the state depends only on the procedure and the commands");
   cmd.add_option("--insertion-mm", o.start_insertion_mm, "--device keyboard: where the sheath starts, mm past the pivot (the apex is at 150)")
-      ->check(CLI::Range(0.0, 230.0))
+      ->check(finite_range(0.0, 230.0))
       ->capture_default_str();
   cmd.add_option("--width", o.width, "Window width, pixels")->check(CLI::Range(640, 8192))->capture_default_str();
   cmd.add_option("--height", o.height, "Window height, pixels")->check(CLI::Range(480, 8192))->capture_default_str();
   cmd.add_option("--slow-frame-ms", o.slow_frame_ms, "Make every frame this much slower (to show the core is never held back)")
-      ->check(CLI::Range(0.0, 10000.0));
+      ->check(finite_range(0.0, 10000.0));
   cmd.add_option("--view-scale", o.view_scale,
                  "Resolution of the 3-D views relative to their panels (default: 1 on a GPU, 0.5 on a software rasteriser)")
-      ->check(CLI::Range(0.1, 2.0));
+      ->check(finite_range(0.1, 2.0));
   cmd.add_flag("--no-vsync", o.no_vsync, "Draw frames as fast as possible instead of at the display's refresh");
 }
 

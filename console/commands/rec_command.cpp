@@ -2,6 +2,7 @@
 // layout). Every one reads damaged and cut files: what is intact is used, what is not is named.
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -9,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "console/commands/checked_options.h"
 #include "console/commands/command_registry.h"
 #include "recordings/recover.h"
 #include "rtcore/base/atomic_file.h"
@@ -188,8 +190,8 @@ void register_rec(CLI::App& app) {
   auto export_options = std::make_shared<ExportOptions>();
   CLI::App* export_cmd = family.add_subcommand("export", "A keyframe's surface (.drc .ply .obj .off .stl) or the per-tick inputs (.csv)");
   export_cmd->add_option("FILE", export_options->file, "Recording")->required();
-  export_cmd->add_option("--keyframe", export_options->keyframe, "Keyframe number (0-based)")->check(CLI::NonNegativeNumber);
-  export_cmd->add_option("--time", export_options->time_s, "The last keyframe at or before this simulated time, seconds")->check(CLI::NonNegativeNumber);
+  export_cmd->add_option("--keyframe", export_options->keyframe, "Keyframe number (0-based)")->check(index_up_to(std::numeric_limits<int>::max()));
+  export_cmd->add_option("--time", export_options->time_s, "The last keyframe at or before this simulated time, seconds")->check(finite_at_least(0.0));
   export_cmd->add_flag("--inputs", export_options->inputs, "Export the per-tick inputs as CSV instead");
   export_cmd->add_option("-o,--output", export_options->out, "Output file; format by extension")->required();
   export_cmd->callback([export_options] { export_recording(*export_options); });

@@ -184,6 +184,10 @@ TEST_F(HostileInput, NumericOptionsRejectNanAndZeroDurations) {
       {"tissue indent --depth-mm nan", "--depth-mm: 'nan' is not a finite number"},
       {"device monitor --device emulator --seconds 0.1 --unplug nan", "--unplug: 'nan' is not a finite number"},
       {"mesh resectoscope --loop-travel 36.0001 -o " + arg("x.off"), "--loop-travel: 36.0001 is outside [0, 36]"},
+      // The console's options are checked before any window opens.
+      {"console --view-scale nan --frames 1", "--view-scale: 'nan' is not a finite number"},
+      {"console --slow-frame-ms nan --frames 1", "--slow-frame-ms: 'nan' is not a finite number"},
+      {"console --device keyboard --insertion-mm nan --frames 1", "--insertion-mm: 'nan' is not a finite number"},
   };
   for (const auto& [arguments, expected] : cases) expect_clean_failure(run_resecto_bounded(arguments), expected, arguments);
 }

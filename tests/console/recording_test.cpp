@@ -197,6 +197,18 @@ TEST(RecordingCommands, ExportsKeyframesAndInputsThatOtherProgramsRead) {
   EXPECT_EQ(run_resecto("rec export " + file.string() + " --time 0.55 -o " + (dir / "t.off").string()).exit_code, 0);
   EXPECT_EQ(testing::read_text(dir / "t.off"), testing::read_text(dir / "k5.off"));  // keyframe 5 is at 0.5 s
   EXPECT_NE(run_resecto("rec export " + file.string() + " --keyframe 999 -o " + (dir / "x.off").string()).exit_code, 0);
+  // A time or keyframe that is no time or keyframe at all is named as such, with nothing written.
+  for (auto [option, says] : {std::pair<const char*, const char*>{"--time nan", "'nan' is not a finite number"},
+                              {"--time -1", "-1 is below 0"},
+                              {"--time inf", "'inf' is not a finite number"},
+                              {"--keyframe -1", "'-1' is not a whole number"},
+                              {"--keyframe 99999999999", "99999999999 is past 2147483647"}}) {
+    const testing::CommandOutput refused = run_resecto("rec export " + file.string() + " " + option + " -o " + (dir / "bad.off").string());
+    EXPECT_NE(refused.exit_code, 0) << option;
+    EXPECT_NE(refused.err.find(says), std::string::npos) << option << ": " << refused.err;
+    EXPECT_LT(refused.err.size(), 200u) << option << ": " << refused.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad.off")) << option;
+  }
   ASSERT_EQ(run_resecto("rec export " + file.string() + " --inputs -o " + (dir / "inputs.csv").string()).exit_code, 0);
   const std::string csv = testing::read_text(dir / "inputs.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 961);  // header + 960 ticks
