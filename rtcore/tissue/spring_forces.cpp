@@ -96,9 +96,10 @@ std::size_t SpringForces::compute(const Vec3* x, const Vec3* v, LoopHelper* help
   const std::uint32_t chunks = chunks_covering(count, kSpringsPerChunk);
   listed_per_chunk_.resize(chunks);  // within the reserved room
   std::uint32_t* compressed = arrays_.compressed.data();
+  const std::size_t nodes = incidence_.first_first.size() - 1;
   auto chunk_pass = [&](std::uint32_t chunk) {
     const std::size_t begin = chunk * kSpringsPerChunk, end = std::min(count, begin + kSpringsPerChunk);
-    listed_per_chunk_[chunk] = static_cast<std::uint32_t>(spring_forces(arrays_, x, v, begin, end, compressed + begin));
+    listed_per_chunk_[chunk] = static_cast<std::uint32_t>(spring_forces(arrays_, x, v, nodes, begin, end, compressed + begin));
   };
   for_each_chunk(helper, chunks, chunk_pass);
   // Each chunk listed its springs at its own start; close the gaps, in chunk order (so ascending).

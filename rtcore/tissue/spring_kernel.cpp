@@ -20,11 +20,15 @@ using avx2::load_point;
 
 /// Node j's row minus node i's row of `p` for four springs, as columns: the same subtractions the
 /// portable loop does per component, done before the transpose (gathers are slow on this class of
-/// processor, and rows subtract with one instruction).
-__attribute__((target("avx2"), always_inline)) inline Columns differences(const Vec3* p, const std::uint32_t* i, const std::uint32_t* j) {
-  return avx2::points_of(_mm256_sub_pd(load_point(p[j[0]]), load_point(p[i[0]])), _mm256_sub_pd(load_point(p[j[1]]), load_point(p[i[1]])),
-                         _mm256_sub_pd(load_point(p[j[2]]), load_point(p[i[2]])), _mm256_sub_pd(load_point(p[j[3]]), load_point(p[i[3]])));
+/// processor, and rows subtract with one instruction). Load is load_point, or a plain 32-byte load
+/// where the node is not the last: its fourth lane (the next node's x) is never used.
+template <class Load>
+__attribute__((target("avx2"), always_inline)) inline Columns differences(const Vec3* p, const std::uint32_t* i, const std::uint32_t* j, Load load) {
+  return avx2::points_of(_mm256_sub_pd(load(p[j[0]]), load(p[i[0]])), _mm256_sub_pd(load(p[j[1]]), load(p[i[1]])),
+                         _mm256_sub_pd(load(p[j[2]]), load(p[i[2]])), _mm256_sub_pd(load(p[j[3]]), load(p[i[3]])));
 }
+
+__attribute__((target("avx2"), always_inline)) inline __m256d load_row_and_next(const Vec3& p) { return _mm256_loadu_pd(&p.x); }
 
 /// Four springs' force columns back to rows (x, y, z, 0), stored at f[0..3]: pure moves.
 __attribute__((target("avx2"), always_inline)) inline void store_rows(SpringForce* f, __m256d fx, __m256d fy, __m256d fz) {
@@ -60,13 +64,19 @@ std::size_t spring_forces_portable(SpringArrays& springs, const Vec3* x, const V
   return compressed;
 }
 
-__attribute__((target("avx2"))) std::size_t spring_forces_avx2(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin,
-                                                               std::size_t end, std::uint32_t* compressed_out) {
+__attribute__((target("avx2"))) std::size_t spring_forces_avx2(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t node_count,
+                                                               std::size_t begin, std::size_t end, std::uint32_t* compressed_out) {
   const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), two = _mm256_set1_pd(2.0);
   std::size_t compressed = 0;
   std::size_t s = begin;
+  // A masked load costs a second micro-op on the ports the arithmetic needs; only a spring that
+  // holds the last node needs it (node j is the larger, so its j is the last).
+  const std::uint32_t last_node = node_count == 0 ? 0 : static_cast<std::uint32_t>(node_count - 1);
   for (; s + 4 <= end; s += 4) {
-    const Columns d = differences(x, springs.i.data() + s, springs.j.data() + s);
+    const std::uint32_t* i = springs.i.data() + s;
+    const std::uint32_t* j = springs.j.data() + s;
+    const bool whole_rows = std::max(std::max(j[0], j[1]), std::max(j[2], j[3])) < last_node;
+    const Columns d = whole_rows ? differences(x, i, j, load_row_and_next) : differences(x, i, j, load_point);
     const __m256d dx = d.x, dy = d.y, dz = d.z;
     const __m256d length =
         _mm256_sqrt_pd(_mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)), _mm256_mul_pd(dz, dz)));
@@ -78,7 +88,7 @@ __attribute__((target("avx2"))) std::size_t spring_forces_avx2(SpringArrays& spr
     const __m256d uz = _mm256_mul_pd(dz, inverse_length);
     const __m256d rest = _mm256_loadu_pd(springs.rest_m.data() + s);
     const __m256d stretch = _mm256_sub_pd(length, rest);
-    const Columns dv = differences(v, springs.i.data() + s, springs.j.data() + s);
+    const Columns dv = whole_rows ? differences(v, i, j, load_row_and_next) : differences(v, i, j, load_point);
     const __m256d dvx = dv.x, dvy = dv.y, dvz = dv.z;
     const __m256d along = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dvx, ux), _mm256_mul_pd(dvy, uy)), _mm256_mul_pd(dvz, uz));
     const __m256d magnitude = _mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(springs.k.data() + s), stretch),
@@ -157,8 +167,10 @@ __attribute__((target("avx2"))) void add_spring_sums_avx2(const SpringIncidence&
   for (; n < end; ++n) add_node_sum_avx2(incidence, f, force, n);
 }
 
-std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end, std::uint32_t* compressed) {
-  return cpu_has_avx2() ? spring_forces_avx2(springs, x, v, begin, end, compressed) : spring_forces_portable(springs, x, v, begin, end, compressed);
+std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t node_count, std::size_t begin, std::size_t end,
+                          std::uint32_t* compressed) {
+  return cpu_has_avx2() ? spring_forces_avx2(springs, x, v, node_count, begin, end, compressed)
+                        : spring_forces_portable(springs, x, v, begin, end, compressed);
 }
 
 void add_spring_sums(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t begin, std::size_t end) {

@@ -59,8 +59,10 @@ inline constexpr std::size_t kSpringSumGroup = 4;
 /// and returns how many there are.
 std::size_t spring_forces_portable(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end,
                                    std::uint32_t* compressed);
-/// The same with four springs per instruction; call only where cpu_has_avx2().
-std::size_t spring_forces_avx2(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end,
+/// The same with four springs per instruction; call only where cpu_has_avx2(). x and v hold
+/// `node_count` nodes: a node's row is read with one 32-byte load, which reaches into the next node,
+/// so the last node's is read masked.
+std::size_t spring_forces_avx2(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t node_count, std::size_t begin, std::size_t end,
                                std::uint32_t* compressed);
 
 /// For nodes [begin, end): force[n] = force[n] - (n's forces as node j, ascending) + (its forces as
@@ -71,7 +73,8 @@ void add_spring_sums_avx2(const SpringIncidence& incidence, const SpringForce* f
 
 /// The fastest kernel this processor runs, over springs [begin, end) (listing the compressed ones at
 /// `compressed`, room for end - begin).
-std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end, std::uint32_t* compressed);
+std::size_t spring_forces(SpringArrays& springs, const Vec3* x, const Vec3* v, std::size_t node_count, std::size_t begin, std::size_t end,
+                          std::uint32_t* compressed);
 /// The fastest node sums this processor runs, over nodes [begin, end).
 void add_spring_sums(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t begin, std::size_t end);
 

@@ -52,7 +52,7 @@ TEST(SpringKernel, Avx2PathMatchesThePortablePathBitForBit) {
   for (auto [begin, end] : {std::pair<std::size_t, std::size_t>{0, count}, {1, count - 2}, {5, 7}}) {
     SpringArrays portable = springs, simd = springs;
     const std::size_t compressed_portable = spring_forces_portable(portable, x.data(), v.data(), begin, end, portable.compressed.data());
-    const std::size_t compressed_simd = spring_forces_avx2(simd, x.data(), v.data(), begin, end, simd.compressed.data());
+    const std::size_t compressed_simd = spring_forces_avx2(simd, x.data(), v.data(), x.size(), begin, end, simd.compressed.data());
     ASSERT_EQ(compressed_portable, compressed_simd);
     for (std::size_t k = 0; k < compressed_portable; ++k) EXPECT_EQ(portable.compressed[k], simd.compressed[k]) << "listed " << k;
     EXPECT_TRUE(same_bits(portable.f, simd.f)) << begin << ".." << end;
