@@ -69,13 +69,14 @@ __attribute__((target("avx2"))) std::size_t spring_forces_avx2(SpringArrays& spr
   const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), two = _mm256_set1_pd(2.0);
   std::size_t compressed = 0;
   std::size_t s = begin;
-  // A masked load costs a second micro-op on the ports the arithmetic needs; only a spring that
-  // holds the last node needs it (node j is the larger, so its j is the last).
-  const std::uint32_t last_node = node_count == 0 ? 0 : static_cast<std::uint32_t>(node_count - 1);
+  // A masked load costs a second micro-op on the ports the arithmetic needs; only four springs that
+  // hold the last node need it (as i or j: refinement's springs have i > j).
+  const __m128i last_node = _mm_set1_epi32(node_count == 0 ? 0 : static_cast<int>(node_count - 1));
   for (; s + 4 <= end; s += 4) {
     const std::uint32_t* i = springs.i.data() + s;
     const std::uint32_t* j = springs.j.data() + s;
-    const bool whole_rows = std::max(std::max(j[0], j[1]), std::max(j[2], j[3])) < last_node;
+    const __m128i larger = _mm_max_epu32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(i)), _mm_loadu_si128(reinterpret_cast<const __m128i*>(j)));
+    const bool whole_rows = _mm_movemask_epi8(_mm_cmplt_epi32(larger, last_node)) == 0xFFFF;
     const Columns d = whole_rows ? differences(x, i, j, load_row_and_next) : differences(x, i, j, load_point);
     const __m256d dx = d.x, dy = d.y, dz = d.z;
     const __m256d length =

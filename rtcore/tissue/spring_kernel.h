@@ -21,7 +21,7 @@ struct alignas(32) SpringForce {
 
 /// Per-spring inputs and outputs, one array per field, in the network's spring order.
 struct SpringArrays {
-  std::vector<std::uint32_t> i, j;  ///< nodes, i < j (springs sorted by i, then j)
+  std::vector<std::uint32_t> i, j;  ///< nodes (sorted by i; i < j for the mesh's springs, i > j for refinement's)
   std::vector<double> rest_m;       ///< rest length
   std::vector<double> k, c;         ///< stiffness (N/m), damping (N*s/m)
   /// The spring's force on node i of the last pass (node j gets minus), then two padding rows, +0 at
