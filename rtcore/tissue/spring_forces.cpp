@@ -69,6 +69,7 @@ SpringForces::SpringForces(const SpringNetwork& network) {
     arrays_.j[s] = network.spring_nodes[2 * s + 1];
   }
   rebuild_incidence(nodes);
+  refresh_groups();
 }
 
 void SpringForces::reserve(std::size_t spring_capacity, std::size_t node_capacity) {
@@ -92,6 +93,7 @@ void SpringForces::reserve(std::size_t spring_capacity, std::size_t node_capacit
 }
 
 std::size_t SpringForces::compute(const Vec3* x, const Vec3* v, LoopHelper* helper) {
+  refresh_groups();  // normally done by the edits' end already (MassSpringTissue): then free
   const std::size_t count = spring_count();
   const std::uint32_t chunks = chunks_covering(count, kSpringsPerChunk);
   listed_per_chunk_.resize(chunks);  // within the reserved room
@@ -119,6 +121,7 @@ void SpringForces::append(std::uint32_t i, std::uint32_t j, double rest_m) {
   arrays_.k.push_back(0.0);
   arrays_.c.push_back(0.0);
   arrays_.f.insert(arrays_.f.end() - kPaddingRows, SpringForce{});  // before the padding rows
+  groups_stale_ = true;  // the padding rows' indices moved
   arrays_.compressed.push_back(0);
 }
 
@@ -139,7 +142,13 @@ void SpringForces::rebuild_incidence(std::size_t nodes) {
   in.second_springs.resize(count);
   fill_.assign(in.second_first.begin(), in.second_first.end() - 1);
   for (std::size_t s = 0; s < count; ++s) in.second_springs[fill_[arrays_.j[s]]++] = static_cast<std::uint32_t>(s);
+  groups_stale_ = true;
+}
+
+void SpringForces::refresh_groups() {
+  if (!groups_stale_) return;
   rebuild_groups();
+  groups_stale_ = false;
 }
 
 void SpringForces::rebuild_groups() {
@@ -173,7 +182,7 @@ void SpringForces::add_nodes(std::size_t count) {
     incidence_.first_first.push_back(incidence_.first_first.back());
     incidence_.second_first.push_back(incidence_.second_first.back());
   }
-  rebuild_groups();
+  groups_stale_ = true;
 }
 
 void SpringForces::add_appended_to_incidence(std::size_t first_new) {
@@ -204,7 +213,7 @@ void SpringForces::add_appended_to_incidence(std::size_t first_new) {
     fill_[n] = static_cast<std::uint32_t>(end + shift);  // where n's appended springs go
   }
   for (std::size_t t = first_new; t < count; ++t) in.second_springs[fill_[arrays_.j[t]]++] = static_cast<std::uint32_t>(t);
-  rebuild_groups();
+  groups_stale_ = true;
 }
 
 void SpringForces::add_compression_bounds(const Vec3* x, double* stiffness_bound, std::size_t count) const {

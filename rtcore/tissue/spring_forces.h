@@ -69,15 +69,21 @@ class SpringForces {
   /// `count` springs the last compute() listed.
   void add_compression_bounds(const Vec3* x, double* stiffness_bound, std::size_t count) const;
 
+  /// Relists the incidence's interleaved groups if an edit has changed the lists or the spring count
+  /// since: once per batch of edits (a refinement adds nodes, then springs), not once per edit.
+  /// compute() does it too, so the node pass never reads stale groups; the editor calls it at the
+  /// end of its edits so that the cost falls on the edit, not on a physics step.
+  void refresh_groups();
+
   /// Implicit Euler's linearisation: each spring's unit direction and transverse stiffness.
   void linearise(const Vec3* x, Vec3* direction, double* transverse_k) const;
 
  private:
-  /// Relists the incidence's interleaved groups (after any change to the lists or the spring count).
   void rebuild_groups();
 
   SpringArrays arrays_;
   SpringIncidence incidence_;
+  bool groups_stale_ = false;
   std::vector<std::uint32_t> fill_;  // scratch of rebuild_incidence
   std::vector<std::uint32_t> listed_per_chunk_;  // compute(): compressed springs each chunk listed
 };

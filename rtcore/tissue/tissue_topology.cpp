@@ -455,6 +455,7 @@ TopologyChange MassSpringTissue::edit_tetrahedra(std::span<const std::uint32_t> 
     ++topology_version_;
     surface_tree_edited_ = true;  // the search's refit judges its quality (refit_surface_tree)
   }
+  springs_.refresh_groups();  // for this edit and the nodes added before it, here rather than in a physics step
   return change;
 }
 
@@ -494,6 +495,7 @@ void MassSpringTissue::compact_springs() {
   kept.clear();
   dead_springs_ = 0;
   ++spring_compactions_;
+  springs_.refresh_groups();
 }
 
 void MassSpringTissue::replay(const TissueEditLog& log) {
