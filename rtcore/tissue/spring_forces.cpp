@@ -28,25 +28,33 @@ constexpr SpringForce kMinusZeroRow{-0.0, -0.0, -0.0, -0.0};
 constexpr std::size_t kPaddingRows = 2;
 
 /// A node list of every group, padded to the group's longest and interleaved (SpringIncidence).
-/// `spring_at(p)` is the spring at position p of `list_first`'s lists.
+/// `spring_at(p)` is the spring at position p of `list_first`'s lists. Offsets first, then each
+/// node's list copied into its lane and padded: no test per entry (this runs once per batch of edits
+/// on the collision job, where the topology update's time counts).
 template <class SpringAt>
 void interleave_groups(const std::vector<std::uint32_t>& list_first, SpringAt spring_at, std::uint32_t padding, std::vector<std::uint32_t>& offsets,
                        std::vector<std::uint32_t>& entries) {
   const std::size_t groups = (list_first.size() - 1) / kSpringSumGroup;
   offsets.resize(groups + 1);
-  entries.clear();
   offsets[0] = 0;
   for (std::size_t g = 0; g < groups; ++g) {
     const std::size_t n = g * kSpringSumGroup;
     std::uint32_t longest = 0;
     for (std::size_t k = 0; k < kSpringSumGroup; ++k) longest = std::max(longest, list_first[n + k + 1] - list_first[n + k]);
-    for (std::uint32_t e = 0; e < longest; ++e) {
-      for (std::size_t k = 0; k < kSpringSumGroup; ++k) {
-        const std::uint32_t at = list_first[n + k] + e;
-        entries.push_back(at < list_first[n + k + 1] ? spring_at(at) : padding);
-      }
-    }
     offsets[g + 1] = offsets[g] + longest;
+  }
+  entries.resize(kSpringSumGroup * offsets[groups]);  // within the reserved room
+  std::uint32_t* out = entries.data();
+  for (std::size_t g = 0; g < groups; ++g) {
+    const std::uint32_t longest = offsets[g + 1] - offsets[g];
+    std::uint32_t* group = out + kSpringSumGroup * offsets[g];
+    for (std::size_t k = 0; k < kSpringSumGroup; ++k) {
+      const std::size_t n = g * kSpringSumGroup + k;
+      const std::uint32_t first = list_first[n], count = list_first[n + 1] - first;
+      std::uint32_t e = 0;
+      for (; e < count; ++e) group[kSpringSumGroup * e + k] = spring_at(first + e);
+      for (; e < longest; ++e) group[kSpringSumGroup * e + k] = padding;
+    }
   }
 }
 
