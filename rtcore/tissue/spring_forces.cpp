@@ -161,6 +161,13 @@ void SpringForces::refresh_groups() {
 
 void SpringForces::rebuild_groups() {
   SpringIncidence& in = incidence_;
+  if (!spring_sums_in_groups()) {  // the node pass goes node by node: no groups to keep
+    in.group_second_first.clear();
+    in.group_first_first.clear();
+    in.group_second.clear();
+    in.group_first.clear();
+    return;
+  }
   const auto plus_zero = static_cast<std::uint32_t>(spring_count());
   interleave_groups(in.second_first, [&](std::uint32_t at) { return in.second_springs[at]; }, plus_zero, in.group_second_first, in.group_second);
   interleave_groups(in.first_first, [](std::uint32_t at) { return at; }, plus_zero + 1, in.group_first_first, in.group_first);

@@ -53,6 +53,17 @@ struct SpringIncidence {
 /// Nodes per group of SpringIncidence's interleaved lists.
 inline constexpr std::size_t kSpringSumGroup = 4;
 
+/// Whether the AVX2 node pass sums four nodes side by side (SpringIncidence's groups) on this
+/// processor, or node by node (no groups are built). Same bits either way; only the speed differs, and
+/// it differs by processor (benchmarks/results/README.md, "Tissue mechanics"): on the Intel Xeon
+/// (Cascade Lake) vCPU one node's chain of adds stalled the pass, and the groups made the whole step
+/// 13-15% faster; on the AMD EPYC (Zen 5) vCPU, whose out-of-order window overlaps the chains by
+/// itself, an earlier lockstep version with the same padding was 20% slower.
+inline bool spring_sums_in_groups() {
+  static const bool in_groups = cpu_has_avx2() && __builtin_cpu_is("intel");
+  return in_groups;
+}
+
 /// Writes the force of springs [begin, end) at positions x and velocities v into f:
 /// f = (k (L - L0) + c (v_j - v_i).u) u with u = (x_j - x_i) / L (u = 0 when L = 0). Lists the
 /// springs compressed below half their rest length, ascending, at `compressed` (room for end - begin)

@@ -147,7 +147,8 @@ TEST(SpringIncidence, AppendedSpringsListedAsARebuildListsThem) {
 }
 
 TEST(SpringIncidence, GroupsAfterEditsSumAsThePortablePass) {
-  // The AVX2 node pass reads the interleaved groups, which compute() relists after edits: after appended
+  // The AVX2 node pass reads the interleaved groups (on processors that use them: spring_sums_in_groups),
+  // which compute() relists after edits: after appended
   // springs, new nodes and a compaction its sums must still be the portable pass's, bit for bit.
   if (!cpu_has_avx2()) GTEST_SKIP() << "no AVX2 on this processor: only the portable path runs";
   const ProstateTissueModel& model = tissue_model(1296);
@@ -174,6 +175,8 @@ TEST(SpringIncidence, GroupsAfterEditsSumAsThePortablePass) {
     if (compacted) forces.keep(kept, nodes);
     for (std::size_t s = 0; s < forces.spring_count(); ++s) forces.set_material(s, stiffness(random), 1e-3);
     forces.compute(x.data(), v.data());
+    // Where the groups are used, they are there: the grouped pass is what this compares.
+    EXPECT_EQ(forces.incidence().group_second_first.empty(), !spring_sums_in_groups());
     std::vector<Vec3> portable(nodes, Vec3(-0.0)), simd(nodes, Vec3(-0.0));
     add_spring_sums_portable(forces.incidence(), forces.arrays().f.data(), portable.data(), 0, nodes);
     add_spring_sums_avx2(forces.incidence(), forces.arrays().f.data(), simd.data(), 0, nodes);
