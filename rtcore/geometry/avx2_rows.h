@@ -41,6 +41,26 @@ __attribute__((target("avx2"), always_inline)) inline Points4 points_of(__m256d 
   return {_mm256_permute2f128_pd(xz01, xz23, 0x20), _mm256_permute2f128_pd(y01, y23, 0x20), _mm256_permute2f128_pd(xz01, xz23, 0x31)};
 }
 
+/// Four consecutive packed (x, y, z) triples, twelve doubles (rows r0 = x0 y0 z0 x1, r1 = y1 z1 x2 y2,
+/// r2 = z2 x3 y3 z3), as three columns, and back: three unaligned loads or stores and six shuffles.
+__attribute__((target("avx2"), always_inline)) inline Points4 load_packed_points(const Vec3* p) {
+  const double* d = &p->x;
+  const __m256d r0 = _mm256_loadu_pd(d), r1 = _mm256_loadu_pd(d + 4), r2 = _mm256_loadu_pd(d + 8);
+  const __m256d x0y0x2y2 = _mm256_permute2f128_pd(r0, r1, 0x30);
+  const __m256d z0x1z2x3 = _mm256_permute2f128_pd(r0, r2, 0x21);
+  const __m256d y1z1y3z3 = _mm256_permute2f128_pd(r1, r2, 0x30);
+  return {_mm256_shuffle_pd(x0y0x2y2, z0x1z2x3, 0xA), _mm256_shuffle_pd(x0y0x2y2, y1z1y3z3, 0x5), _mm256_shuffle_pd(z0x1z2x3, y1z1y3z3, 0xA)};
+}
+__attribute__((target("avx2"), always_inline)) inline void store_packed_points(Vec3* p, const Points4& c) {
+  const __m256d x0y0x2y2 = _mm256_shuffle_pd(c.x, c.y, 0x0);
+  const __m256d z0x1z2x3 = _mm256_shuffle_pd(c.z, c.x, 0xA);
+  const __m256d y1z1y3z3 = _mm256_shuffle_pd(c.y, c.z, 0xF);
+  double* d = &p->x;
+  _mm256_storeu_pd(d, _mm256_permute2f128_pd(x0y0x2y2, z0x1z2x3, 0x20));
+  _mm256_storeu_pd(d + 4, _mm256_permute2f128_pd(y1z1y3z3, x0y0x2y2, 0x30));
+  _mm256_storeu_pd(d + 8, _mm256_permute2f128_pd(z0x1z2x3, y1z1y3z3, 0x31));
+}
+
 /// Corner `corner` of four triangles (corner indices into `positions`), one triangle per lane.
 __attribute__((target("avx2"), always_inline)) inline Points4 triangle_corners(const Vec3* positions, const std::array<std::uint32_t, 3>* const* t,
                                                                                int corner) {

@@ -10,34 +10,16 @@
 #include <cmath>
 
 #include "rtcore/base/cpu_features.h"
+#include "rtcore/geometry/avx2_rows.h"
 
 namespace resecto {
 namespace {
 
-struct Columns {
-  __m256d x, y, z;
-};
+using Columns = avx2::Points4;
+using avx2::load_packed_points;
+using avx2::store_packed_points;
 
-// Four consecutive Vec3 (twelve doubles: rows r0 = x0 y0 z0 x1, r1 = y1 z1 x2 y2, r2 = z2 x3 y3 z3)
-// as columns and back: pure moves.
-__attribute__((target("avx2"), always_inline)) inline Columns load_columns(const Vec3* p) {
-  const double* d = &p->x;
-  const __m256d r0 = _mm256_loadu_pd(d), r1 = _mm256_loadu_pd(d + 4), r2 = _mm256_loadu_pd(d + 8);
-  const __m256d x0y0x2y2 = _mm256_permute2f128_pd(r0, r1, 0x30);
-  const __m256d z0x1z2x3 = _mm256_permute2f128_pd(r0, r2, 0x21);
-  const __m256d y1z1y3z3 = _mm256_permute2f128_pd(r1, r2, 0x30);
-  return {_mm256_shuffle_pd(x0y0x2y2, z0x1z2x3, 0xA), _mm256_shuffle_pd(x0y0x2y2, y1z1y3z3, 0x5), _mm256_shuffle_pd(z0x1z2x3, y1z1y3z3, 0xA)};
-}
-
-__attribute__((target("avx2"), always_inline)) inline void store_columns(Vec3* p, const Columns& c) {
-  const __m256d x0y0x2y2 = _mm256_shuffle_pd(c.x, c.y, 0x0);
-  const __m256d z0x1z2x3 = _mm256_shuffle_pd(c.z, c.x, 0xA);
-  const __m256d y1z1y3z3 = _mm256_shuffle_pd(c.y, c.z, 0xF);
-  double* d = &p->x;
-  _mm256_storeu_pd(d, _mm256_permute2f128_pd(x0y0x2y2, z0x1z2x3, 0x20));
-  _mm256_storeu_pd(d + 4, _mm256_permute2f128_pd(y1z1y3z3, x0y0x2y2, 0x30));
-  _mm256_storeu_pd(d + 8, _mm256_permute2f128_pd(z0x1z2x3, y1z1y3z3, 0x31));
-}
+static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 arrays are packed (x, y, z) triples");
 
 }  // namespace
 
@@ -70,7 +52,7 @@ __attribute__((target("avx2"))) NodeStepSummary step_nodes_avx2(const NodeStepAr
     const __m256d d = _mm256_add_pd(_mm256_add_pd(_mm256_loadu_pd(nodes.mass + i), _mm256_mul_pd(half_h2, _mm256_loadu_pd(nodes.stiffness_bound + i))),
                                     _mm256_mul_pd(h, _mm256_loadu_pd(nodes.damping_bound + i)));
     const __m256d old_d = _mm256_loadu_pd(nodes.step_mass + i);
-    Columns v = load_columns(nodes.v + i);
+    Columns v = load_packed_points(nodes.v + i);
     // A rise keeps the momentum (v *= D_old / D); elsewhere v stays as it is, bit for bit.
     const __m256d rise = _mm256_cmp_pd(d, old_d, _CMP_GT_OQ);
     const __m256d keep = _mm256_div_pd(old_d, d);
@@ -79,16 +61,16 @@ __attribute__((target("avx2"))) NodeStepSummary step_nodes_avx2(const NodeStepAr
     v.z = _mm256_blendv_pd(v.z, _mm256_mul_pd(v.z, keep), rise);
     _mm256_storeu_pd(nodes.step_mass + i, d);
     const __m256d a = _mm256_div_pd(h, d);
-    const Columns f = load_columns(nodes.force + i);
+    const Columns f = load_packed_points(nodes.force + i);
     v.x = _mm256_add_pd(v.x, _mm256_mul_pd(a, f.x));
     v.y = _mm256_add_pd(v.y, _mm256_mul_pd(a, f.y));
     v.z = _mm256_add_pd(v.z, _mm256_mul_pd(a, f.z));
-    Columns x = load_columns(nodes.x + i);
+    Columns x = load_packed_points(nodes.x + i);
     x.x = _mm256_add_pd(x.x, _mm256_mul_pd(h, v.x));
     x.y = _mm256_add_pd(x.y, _mm256_mul_pd(h, v.y));
     x.z = _mm256_add_pd(x.z, _mm256_mul_pd(h, v.z));
-    store_columns(nodes.v + i, v);
-    store_columns(nodes.x + i, x);
+    store_packed_points(nodes.v + i, v);
+    store_packed_points(nodes.x + i, x);
     // std::max(fastest, |v|^2) keeps `fastest` when |v|^2 is NaN; so does max_pd with it second.
     const __m256d speed2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(v.x, v.x), _mm256_mul_pd(v.y, v.y)), _mm256_mul_pd(v.z, v.z));
     fastest2 = _mm256_max_pd(speed2, fastest2);

@@ -27,6 +27,11 @@ constexpr SpringForce kPlusZeroRow{0.0, 0.0, 0.0, 0.0};
 constexpr SpringForce kMinusZeroRow{-0.0, -0.0, -0.0, -0.0};
 constexpr std::size_t kPaddingRows = 2;
 
+void add_padding_rows(std::vector<SpringForce>& f) {
+  f.push_back(kPlusZeroRow);
+  f.push_back(kMinusZeroRow);
+}
+
 /// A node list of every group, padded to the group's longest and interleaved (SpringIncidence).
 /// `spring_at(p)` is the spring at position p of `list_first`'s lists. Offsets first, then each
 /// node's list copied into its lane and padded: no test per entry (this runs once per batch of edits
@@ -69,8 +74,7 @@ SpringForces::SpringForces(const SpringNetwork& network) {
   arrays_.k.assign(count, 0.0);
   arrays_.c.assign(count, 0.0);
   arrays_.f.assign(count, SpringForce{});
-  arrays_.f.push_back(kPlusZeroRow);
-  arrays_.f.push_back(kMinusZeroRow);
+  add_padding_rows(arrays_.f);
   arrays_.compressed.assign(count, 0);
   for (std::size_t s = 0; s < count; ++s) {
     arrays_.i[s] = network.spring_nodes[2 * s];
@@ -91,11 +95,13 @@ void SpringForces::reserve(std::size_t spring_capacity, std::size_t node_capacit
   incidence_.second_springs.reserve(spring_capacity);
   incidence_.second_first.reserve(node_capacity + 1);
   incidence_.first_first.reserve(node_capacity + 1);
-  // A group's padded list is no longer than its four lists together: at most four entries a spring.
-  incidence_.group_second.reserve(kSpringSumGroup * spring_capacity);
-  incidence_.group_first.reserve(kSpringSumGroup * spring_capacity);
-  incidence_.group_second_first.reserve(node_capacity / kSpringSumGroup + 1);
-  incidence_.group_first_first.reserve(node_capacity / kSpringSumGroup + 1);
+  if (spring_sums_in_groups()) {
+    // A group's padded list is no longer than its four lists together: at most four entries a spring.
+    incidence_.group_second.reserve(kSpringSumGroup * spring_capacity);
+    incidence_.group_first.reserve(kSpringSumGroup * spring_capacity);
+    incidence_.group_second_first.reserve(node_capacity / kSpringSumGroup + 1);
+    incidence_.group_first_first.reserve(node_capacity / kSpringSumGroup + 1);
+  }
   fill_.reserve(node_capacity + 1);
   listed_per_chunk_.reserve(chunks_covering(spring_capacity, kSpringsPerChunk));
 }
@@ -185,8 +191,7 @@ void SpringForces::keep(std::span<const std::uint32_t> kept, std::size_t node_co
   compact(arrays_.k);
   compact(arrays_.c);
   compact(arrays_.f);  // the padding rows are no spring's: put back after
-  arrays_.f.push_back(kPlusZeroRow);
-  arrays_.f.push_back(kMinusZeroRow);
+  add_padding_rows(arrays_.f);
   arrays_.compressed.resize(kept.size());
   rebuild_incidence(node_count);
 }

@@ -128,6 +128,27 @@ __attribute__((target("avx2"), always_inline)) inline void add_node_sum_avx2(con
   _mm256_maskstore_pd(&force[n].x, xyz, sum);
 }
 
+struct SubtractRow {
+  __attribute__((target("avx2"), always_inline)) __m256d operator()(__m256d sum, __m256d row) const { return _mm256_sub_pd(sum, row); }
+};
+struct AddRow {
+  __attribute__((target("avx2"), always_inline)) __m256d operator()(__m256d sum, __m256d row) const { return _mm256_add_pd(sum, row); }
+};
+
+/// s_k = op(s_k, row of entry e, lane k) for group entries [first, last), lane by lane in entry order.
+template <class Op>
+__attribute__((target("avx2"), always_inline)) inline void add_group_rows(const SpringForce* f, const std::uint32_t* entries, std::uint32_t first,
+                                                                          std::uint32_t last, Op op, __m256d& s0, __m256d& s1, __m256d& s2,
+                                                                          __m256d& s3) {
+  for (std::uint32_t e = first; e < last; ++e) {
+    const std::uint32_t* row = entries + kSpringSumGroup * e;
+    s0 = op(s0, _mm256_load_pd(&f[row[0]].x));
+    s1 = op(s1, _mm256_load_pd(&f[row[1]].x));
+    s2 = op(s2, _mm256_load_pd(&f[row[2]].x));
+    s3 = op(s3, _mm256_load_pd(&f[row[3]].x));
+  }
+}
+
 }  // namespace
 
 __attribute__((target("avx2"))) void add_spring_sums_avx2(const SpringIncidence& incidence, const SpringForce* f, Vec3* force, std::size_t begin,
@@ -144,22 +165,9 @@ __attribute__((target("avx2"))) void add_spring_sums_avx2(const SpringIncidence&
     const std::size_t g = n / kSpringSumGroup;
     __m256d s0 = _mm256_maskload_pd(&force[n].x, xyz), s1 = _mm256_maskload_pd(&force[n + 1].x, xyz);
     __m256d s2 = _mm256_maskload_pd(&force[n + 2].x, xyz), s3 = _mm256_maskload_pd(&force[n + 3].x, xyz);
-    const std::uint32_t* second = incidence.group_second.data();
-    for (std::uint32_t e = incidence.group_second_first[g]; e < incidence.group_second_first[g + 1]; ++e) {
-      const std::uint32_t* row = second + kSpringSumGroup * e;
-      s0 = _mm256_sub_pd(s0, _mm256_load_pd(&f[row[0]].x));
-      s1 = _mm256_sub_pd(s1, _mm256_load_pd(&f[row[1]].x));
-      s2 = _mm256_sub_pd(s2, _mm256_load_pd(&f[row[2]].x));
-      s3 = _mm256_sub_pd(s3, _mm256_load_pd(&f[row[3]].x));
-    }
-    const std::uint32_t* first = incidence.group_first.data();
-    for (std::uint32_t e = incidence.group_first_first[g]; e < incidence.group_first_first[g + 1]; ++e) {
-      const std::uint32_t* row = first + kSpringSumGroup * e;
-      s0 = _mm256_add_pd(s0, _mm256_load_pd(&f[row[0]].x));
-      s1 = _mm256_add_pd(s1, _mm256_load_pd(&f[row[1]].x));
-      s2 = _mm256_add_pd(s2, _mm256_load_pd(&f[row[2]].x));
-      s3 = _mm256_add_pd(s3, _mm256_load_pd(&f[row[3]].x));
-    }
+    // Every node's springs as node j first (subtracted), then as node i (added), as the portable pass.
+    add_group_rows(f, incidence.group_second.data(), incidence.group_second_first[g], incidence.group_second_first[g + 1], SubtractRow{}, s0, s1, s2, s3);
+    add_group_rows(f, incidence.group_first.data(), incidence.group_first_first[g], incidence.group_first_first[g + 1], AddRow{}, s0, s1, s2, s3);
     _mm256_maskstore_pd(&force[n].x, xyz, s0);
     _mm256_maskstore_pd(&force[n + 1].x, xyz, s1);
     _mm256_maskstore_pd(&force[n + 2].x, xyz, s2);

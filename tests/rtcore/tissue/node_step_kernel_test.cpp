@@ -11,14 +11,12 @@
 
 #include "rtcore/base/cpu_features.h"
 #include "rtcore/tissue/node_step_kernel.h"
+#include "tests/support/same_bits.h"
 
 namespace resecto {
 namespace {
 
-template <class T>
-bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
+using testing::same_bits;
 
 struct Nodes {
   std::vector<double> mass, stiffness_bound, damping_bound, step_mass;

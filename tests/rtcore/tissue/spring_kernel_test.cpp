@@ -5,22 +5,19 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <random>
 
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/scenes/prostate_tissue.h"
 #include "rtcore/tissue/spring_forces.h"
+#include "tests/support/same_bits.h"
 #include "tests/support/tissue_models.h"
 
 namespace resecto {
 namespace {
 
-template <class T>
-bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
+using testing::same_bits;
 
 void expect_same_groups(const SpringIncidence& a, const SpringIncidence& b) {
   EXPECT_EQ(a.group_second_first, b.group_second_first);
