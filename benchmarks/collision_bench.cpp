@@ -518,7 +518,7 @@ void refit_case(benchmark::State& state, bool slabs) {
 void BM_Refit(benchmark::State& state) { refit_case(state, false); }
 void BM_RefitWithSlabs(benchmark::State& state) { refit_case(state, true); }
 BENCHMARK(BM_RefitWithSlabs)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_Refit)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Refit)->Arg(1296)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
 
 void BM_FclAabbRefit(benchmark::State& state) {
   ProstateModel gland = generate_prostate(static_cast<int>(state.range(0)));
@@ -535,7 +535,7 @@ void BM_FclAabbRefit(benchmark::State& state) {
     benchmark::DoNotOptimize(model.get());
   }
 }
-BENCHMARK(BM_FclAabbRefit)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FclAabbRefit)->Arg(1296)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

@@ -29,6 +29,7 @@ Result<Recording> Recording::open(const std::filesystem::path& path) {
 
 Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::string name) {
   Recording r;
+  r.name_ = name;
   r.bytes_ = std::move(bytes);
   r.scan_ = scan_chunks(r.bytes_);
   if (!r.scan_.signature_ok) return Error{name + ": not a Resecto recording (bad signature)"};
@@ -135,14 +136,23 @@ std::span<const std::uint8_t> Recording::keyframe_draco(std::size_t k) const {
   return record ? record->draco : std::span<const std::uint8_t>();
 }
 
+std::string Recording::keyframe_place(std::size_t k) const {
+  const ChunkLocation& chunk = scan_.chunks[keyframes_[k].chunk];
+  return name_ + ": keyframe " + std::to_string(k) + " (chunk " + std::to_string(chunk.sequence) + " at byte " + std::to_string(chunk.offset) + ")";
+}
+
 Result<SurfaceFrame> Recording::decode_keyframe(std::size_t k) const {
-  if (k >= keyframes_.size()) return Error{"keyframe " + std::to_string(k) + " does not exist (" + std::to_string(keyframes_.size()) + " recorded)"};
-  Result<SurfaceFrame> frame = rec::decode_keyframe(keyframe_draco(k));
-  if (!frame) return Error{"keyframe " + std::to_string(k) + ": " + frame.error()};
-  if (frame->positions.size() != keyframes_[k].vertex_count || frame->triangles.size() != keyframes_[k].triangle_count) {
-    return Error{"keyframe " + std::to_string(k) + ": decoded counts differ from the recorded ones"};
+  if (k >= keyframes_.size()) {
+    return Error{name_ + ": keyframe " + std::to_string(k) + " does not exist (" + std::to_string(keyframes_.size()) + " recorded)"};
   }
-  if (frame->node_ids.empty()) return Error{"keyframe " + std::to_string(k) + ": carries no node ids"};
+  Result<SurfaceFrame> frame = rec::decode_keyframe(keyframe_draco(k));
+  if (!frame) return Error{keyframe_place(k) + ": " + frame.error()};
+  if (frame->positions.size() != keyframes_[k].vertex_count || frame->triangles.size() != keyframes_[k].triangle_count) {
+    return Error{keyframe_place(k) + ": decoded " + std::to_string(frame->positions.size()) + " vertices and " +
+                 std::to_string(frame->triangles.size()) + " triangles, the chunk says " + std::to_string(keyframes_[k].vertex_count) + " and " +
+                 std::to_string(keyframes_[k].triangle_count)};
+  }
+  if (frame->node_ids.empty()) return Error{keyframe_place(k) + ": carries no node ids"};
   return frame;
 }
 

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -74,8 +75,14 @@ class Recording {
   std::array<std::uint64_t, kChunkTypeCount> chunks_by_type() const;
   std::span<const std::uint8_t> payload(const ChunkLocation& chunk) const;
   std::span<const std::uint8_t> bytes() const { return bytes_; }
+  /// The name errors give the recording by (its path when opened from a file).
+  const std::string& name() const { return name_; }
 
  private:
+  /// Where keyframe k's errors point: the file, the keyframe and its chunk's place in the file.
+  std::string keyframe_place(std::size_t k) const;
+
+  std::string name_;
   std::vector<std::uint8_t> bytes_;
   ChunkScan scan_;
   SessionHeader header_;

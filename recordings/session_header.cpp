@@ -5,32 +5,39 @@
 #include <string>
 
 #include "recordings/chunk_format.h"
+#include "recordings/json_fields.h"
 
 namespace resecto::rec {
 namespace {
 
 using nlohmann::ordered_json;
 
+/// Element i of the array j (named `where`), which must be a number.
+double number_at(const ordered_json& j, std::size_t i, const std::string& where) {
+  const ordered_json& value = j[i];
+  if (!value.is_number()) JsonFields::fail(where + "[" + std::to_string(i) + "]", std::string("must be a number, not ") + value.type_name());
+  return value.get<double>();
+}
+
 ordered_json pose_json(const RigidPose& pose) {
   const std::array<double, 12> m = to_row_major_3x4(pose);
   return ordered_json(std::vector<double>(m.begin(), m.end()));
 }
 
-RigidPose pose_from(const ordered_json& j) {
-  const auto m = j.get<std::vector<double>>();
-  if (m.size() != 12) throw std::runtime_error("a pose needs 12 numbers");
+RigidPose pose_from(const ordered_json& j, const std::string& where) {
+  if (!j.is_array() || j.size() != 12) JsonFields::fail(where, "a pose needs 12 numbers");
   RigidPose pose;
   for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) pose.rotation[c][r] = m[static_cast<std::size_t>(r * 4 + c)];
-    pose.translation[r] = m[static_cast<std::size_t>(r * 4 + 3)];
+    for (int c = 0; c < 3; ++c) pose.rotation[c][r] = number_at(j, static_cast<std::size_t>(r * 4 + c), where);
+    pose.translation[r] = number_at(j, static_cast<std::size_t>(r * 4 + 3), where);
   }
   return pose;
 }
 
 ordered_json vec_json(const Vec3& v) { return ordered_json::array({v.x, v.y, v.z}); }
-Vec3 vec_from(const ordered_json& j) {
-  if (!j.is_array() || j.size() != 3) throw std::runtime_error("a vector needs 3 numbers");
-  return Vec3(j[0].get<double>(), j[1].get<double>(), j[2].get<double>());
+Vec3 vec_from(const ordered_json& j, const std::string& where) {
+  if (!j.is_array() || j.size() != 3) JsonFields::fail(where, "a vector needs 3 numbers");
+  return Vec3(number_at(j, 0, where), number_at(j, 1, where), number_at(j, 2, where));
 }
 
 ordered_json config_json(const SimulationConfig& c) {
@@ -65,41 +72,46 @@ ordered_json config_json(const SimulationConfig& c) {
             {"clearance_certificates", t.clearance_certificates}}}};
 }
 
-SimulationConfig config_from(const ordered_json& j) {
+SimulationConfig config_from(const JsonFields& j) {
   SimulationConfig c;
-  c.prostate_triangles = j.at("prostate_triangles").get<int>();
-  c.collision_hz = j.at("collision_hz").get<int>();
-  c.physics_per_collision = j.at("physics_per_collision").get<int>();
-  c.collision_thread = j.at("collision_thread").get<bool>();
-  for (const auto& [key, value] : j.at("parameters").items()) {
+  c.prostate_triangles = j.get<int>("prostate_triangles");
+  c.collision_hz = j.get<int>("collision_hz");
+  c.physics_per_collision = j.get<int>("physics_per_collision");
+  c.collision_thread = j.get<bool>("collision_thread");
+  const JsonFields parameters = j.object("parameters");
+  for (const auto& [key, value] : parameters.json().items()) {
     const std::optional<TissueParameter> id = find_tissue_parameter(key);
-    if (!id) throw std::runtime_error("unknown tissue parameter '" + key + "'");
-    if (Status set = c.parameters.set(*id, value.get<double>()); !set) throw std::runtime_error(set.error());
+    if (!id) JsonFields::fail(parameters.path_of(key), "unknown tissue parameter");
+    if (Status set = c.parameters.set(*id, parameters.get<double>(key.c_str())); !set) JsonFields::fail(parameters.path_of(key), set.error());
   }
-  c.gimbal.pivot_m = vec_from(j.at("gimbal").at("pivot_m"));
-  c.gimbal.device_to_world = pose_from(j.at("gimbal").at("device_to_world"));
-  c.max_tet_volume_m3 = j.at("max_tet_volume_m3").get<double>();
-  const auto& f = j.at("input_filter");
-  c.input_filter.min_cutoff_hz = f.at("min_cutoff_hz").get<double>();
-  c.input_filter.derivative_cutoff_hz = f.at("derivative_cutoff_hz").get<double>();
-  c.input_filter.linear_beta_per_m = f.at("linear_beta_per_m").get<double>();
-  c.input_filter.angular_beta_s_per_rad = f.at("angular_beta_s_per_rad").get<double>();
-  c.input_filter.enabled = f.at("enabled").get<bool>();
-  c.predict_search_pose = j.at("predict_search_pose").get<bool>();
-  const auto& t = j.at("tissue");
-  const int integrator = t.at("integrator").get<int>();
-  if (integrator < 0 || integrator > static_cast<int>(TissueIntegrator::kImplicitEuler)) throw std::runtime_error("unknown integrator");
+  const JsonFields gimbal = j.object("gimbal");
+  c.gimbal.pivot_m = vec_from(gimbal.at("pivot_m"), gimbal.path_of("pivot_m"));
+  c.gimbal.device_to_world = pose_from(gimbal.at("device_to_world"), gimbal.path_of("device_to_world"));
+  c.max_tet_volume_m3 = j.get<double>("max_tet_volume_m3");
+  const JsonFields f = j.object("input_filter");
+  c.input_filter.min_cutoff_hz = f.get<double>("min_cutoff_hz");
+  c.input_filter.derivative_cutoff_hz = f.get<double>("derivative_cutoff_hz");
+  c.input_filter.linear_beta_per_m = f.get<double>("linear_beta_per_m");
+  c.input_filter.angular_beta_s_per_rad = f.get<double>("angular_beta_s_per_rad");
+  c.input_filter.enabled = f.get<bool>("enabled");
+  c.predict_search_pose = j.get<bool>("predict_search_pose");
+  const JsonFields t = j.object("tissue");
+  const int integrator = t.get<int>("integrator");
+  if (integrator < 0 || integrator > static_cast<int>(TissueIntegrator::kImplicitEuler)) {
+    JsonFields::fail(t.path_of("integrator"), "unknown integrator " + std::to_string(integrator));
+  }
   c.tissue.integrator = static_cast<TissueIntegrator>(integrator);
-  c.tissue.max_cg_iterations = t.at("max_cg_iterations").get<int>();
-  c.tissue.cg_tolerance = t.at("cg_tolerance").get<double>();
-  c.tissue.max_substeps = t.at("max_substeps").get<int>();
-  c.tissue.contact_margin_m = t.at("contact_margin_m").get<double>();
-  c.tissue.contact_capacity.max_tissue_nodes = t.at("contact_capacity").at("max_tissue_nodes").get<std::int32_t>();
-  c.tissue.contact_capacity.max_tool_vertices = t.at("contact_capacity").at("max_tool_vertices").get<std::int32_t>();
-  c.tissue.contact_capacity.max_pair_entries = t.at("contact_capacity").at("max_pair_entries").get<std::int32_t>();
-  c.tissue.locality_order = t.at("locality_order").get<bool>();
-  c.tissue.clearance_certificates = t.at("clearance_certificates").get<bool>();
-  if (Status valid = c.validate(); !valid) throw std::runtime_error(valid.error());
+  c.tissue.max_cg_iterations = t.get<int>("max_cg_iterations");
+  c.tissue.cg_tolerance = t.get<double>("cg_tolerance");
+  c.tissue.max_substeps = t.get<int>("max_substeps");
+  c.tissue.contact_margin_m = t.get<double>("contact_margin_m");
+  const JsonFields capacity = t.object("contact_capacity");
+  c.tissue.contact_capacity.max_tissue_nodes = capacity.get<std::int32_t>("max_tissue_nodes");
+  c.tissue.contact_capacity.max_tool_vertices = capacity.get<std::int32_t>("max_tool_vertices");
+  c.tissue.contact_capacity.max_pair_entries = capacity.get<std::int32_t>("max_pair_entries");
+  c.tissue.locality_order = t.get<bool>("locality_order");
+  c.tissue.clearance_certificates = t.get<bool>("clearance_certificates");
+  if (Status valid = c.validate(); !valid) JsonFields::fail(j.path(), valid.error());
   return c;
 }
 
@@ -138,28 +150,31 @@ nlohmann::ordered_json header_to_json(const SessionHeader& h) {
 
 Result<SessionHeader> header_from_json(std::string_view text) {
   try {
-    const ordered_json j = ordered_json::parse(text);
+    const ordered_json document = ordered_json::parse(text);
+    const JsonFields j(document, "");
     SessionHeader h;
-    h.format_version = j.at("format_version").get<std::uint32_t>();
+    h.format_version = j.get<std::uint32_t>("format_version");
     if (h.format_version != kFormatVersion) {
       return Error{"format version " + std::to_string(h.format_version) + " (this build reads " + std::to_string(kFormatVersion) + ")"};
     }
-    h.build = j.at("build").get<std::string>();
-    h.procedure = j.at("procedure").get<std::string>();
-    h.mode = j.at("mode").get<std::string>();
-    h.seed = j.at("seed").get<std::uint64_t>();
-    h.start_tick = j.at("start_tick").get<std::int64_t>();
-    h.surface_triangles = j.at("surface_triangles").get<std::uint32_t>();
-    h.nodes = j.at("nodes").get<std::uint32_t>();
-    h.metric_words = j.at("metric_words").get<std::uint32_t>();
-    h.keyframe_every_steps = j.at("keyframe_every_steps").get<int>();
-    if (h.keyframe_every_steps < 1) throw std::runtime_error("keyframe_every_steps must be at least 1");
-    const auto& q = j.at("quantisation");
-    for (int i = 0; i < 3; ++i) h.grid.origin[i] = q.at("origin_m").at(static_cast<std::size_t>(i)).get<float>();
-    h.grid.range = q.at("range_m").get<float>();
-    h.grid.bits = q.at("bits").get<int>();
-    if (h.grid.bits < 1 || h.grid.bits > 30 || !(h.grid.range > 0.0f)) throw std::runtime_error("bad quantisation grid");
-    h.simulation = config_from(j.at("simulation"));
+    h.build = j.get<std::string>("build");
+    h.procedure = j.get<std::string>("procedure");
+    h.mode = j.get<std::string>("mode");
+    h.seed = j.get<std::uint64_t>("seed");
+    h.start_tick = j.get<std::int64_t>("start_tick");
+    h.surface_triangles = j.get<std::uint32_t>("surface_triangles");
+    h.nodes = j.get<std::uint32_t>("nodes");
+    h.metric_words = j.get<std::uint32_t>("metric_words");
+    h.keyframe_every_steps = j.get<int>("keyframe_every_steps");
+    if (h.keyframe_every_steps < 1) JsonFields::fail("keyframe_every_steps", "must be at least 1");
+    const JsonFields q = j.object("quantisation");
+    const ordered_json& origin = q.at("origin_m");
+    if (!origin.is_array() || origin.size() != 3) JsonFields::fail(q.path_of("origin_m"), "needs 3 numbers");
+    for (std::size_t i = 0; i < 3; ++i) h.grid.origin[i] = static_cast<float>(number_at(origin, i, q.path_of("origin_m")));
+    h.grid.range = q.get<float>("range_m");
+    h.grid.bits = q.get<int>("bits");
+    if (h.grid.bits < 1 || h.grid.bits > 30 || !(h.grid.range > 0.0f)) JsonFields::fail("quantisation", "bad grid (bits 1 to 30, a positive range)");
+    h.simulation = config_from(j.object("simulation"));
     h.calibration = j.contains("calibration") ? j.at("calibration") : ordered_json(nullptr);
     return h;
   } catch (const std::exception& e) {

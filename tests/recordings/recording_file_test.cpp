@@ -220,11 +220,83 @@ TEST(SessionHeaderJson, RefusesBoundsNoReplayCouldBuild) {
   EXPECT_NE(refused("tissue.contact_capacity.max_tissue_nodes", 1 << 30).find("max_tissue_nodes"), std::string::npos);
 }
 
+// A hand-edited or damaged header is refused with the path of the field at fault: absent, of the
+// wrong type, or out of its type's range (a negative count would otherwise wrap to four billion).
+TEST(SessionHeaderJson, NamesTheFieldAtFault) {
+  SessionHeader header;
+  header.format_version = kFormatVersion;
+  header.grid.bits = 11;
+  header.grid.range = 0.1f;
+  const nlohmann::ordered_json good = header_to_json(header);
+  ASSERT_TRUE(header_from_json(good.dump()));
+  const auto error_of = [](const nlohmann::ordered_json& json) {
+    const Result<SessionHeader> parsed = header_from_json(json.dump());
+    return parsed ? std::string("accepted") : parsed.error();
+  };
+  nlohmann::ordered_json json = good;
+  json["simulation"]["tissue"]["max_substeps"] = "eight";
+  EXPECT_EQ(error_of(json), "header: simulation.tissue.max_substeps: must be a whole number, not string");
+  json = good;
+  json["nodes"] = -1;
+  EXPECT_EQ(error_of(json), "header: nodes: -1 is too small");
+  json["nodes"] = 1.5;
+  EXPECT_EQ(error_of(json), "header: nodes: must be a whole number, not 1.5");
+  json["nodes"] = 4294967296.0;
+  EXPECT_EQ(error_of(json), "header: nodes: 4294967296.0 is too large");
+  json["nodes"] = 4096.0;  // JSON has one number type
+  EXPECT_EQ(header_from_json(json.dump())->nodes, 4096u);
+  json = good;
+  json["simulation"]["input_filter"].erase("enabled");
+  EXPECT_EQ(error_of(json), "header: simulation.input_filter.enabled: is missing");
+  json = good;
+  json["simulation"]["gimbal"]["pivot_m"][1] = nullptr;
+  EXPECT_EQ(error_of(json), "header: simulation.gimbal.pivot_m[1]: must be a number, not null");
+  json = good;
+  json["simulation"]["parameters"]["stiffness"] = true;
+  EXPECT_EQ(error_of(json), "header: simulation.parameters.stiffness: must be a number, not boolean");
+  json = good;
+  json["quantisation"] = 3;
+  EXPECT_EQ(error_of(json), "header: quantisation: must be an object, not number");
+}
+
 }  // namespace
 }  // namespace resecto::rec
 
 namespace resecto::rec {
 namespace {
+
+// A keyframe whose chunk is intact (its CRC recomputed over the damage) but whose Draco bytes do not
+// decode is refused by file, keyframe and chunk, so a user can find it; the others still decode.
+TEST(RecordingFile, AKeyframeThatDoesNotDecodeIsNamedByFileAndChunk) {
+  const std::vector<std::uint8_t>& file = testing::short_recording().file;
+  Result<Recording> intact = Recording::from_bytes(file, "session.rrec");
+  ASSERT_TRUE(intact) << intact.error();
+  ASSERT_GE(intact->keyframes().size(), 3u);
+  EXPECT_EQ(intact->decode_keyframe(999).error(), "session.rrec: keyframe 999 does not exist (" + std::to_string(intact->keyframes().size()) + " recorded)");
+  const std::size_t k = 1;
+  const std::span<const std::uint8_t> draco = intact->keyframe_draco(k);
+  const auto draco_at = static_cast<std::size_t>(draco.data() - intact->bytes().data());
+  std::vector<std::uint8_t> damaged = file;
+  std::fill(damaged.begin() + static_cast<std::ptrdiff_t>(draco_at + draco.size() / 4), damaged.begin() + static_cast<std::ptrdiff_t>(draco_at + draco.size()), 0xA5);
+  // The same chunks with the damaged payload and fresh CRCs, then the trailer as it was.
+  const ChunkScan scan = scan_chunks(file);
+  std::vector<std::uint8_t> rebuilt(file.begin(), file.begin() + static_cast<std::ptrdiff_t>(scan.chunks.front().offset));
+  for (const ChunkLocation& chunk : scan.chunks) {
+    append_chunk(rebuilt, static_cast<ChunkType>(chunk.type), chunk.sequence,
+                 std::span<const std::uint8_t>(damaged.data() + chunk.payload_offset(), chunk.payload_bytes));
+  }
+  rebuilt.insert(rebuilt.end(), file.begin() + static_cast<std::ptrdiff_t>(scan.chunks.back().end()), file.end());
+  Result<Recording> r = Recording::from_bytes(rebuilt, "session.rrec");
+  ASSERT_TRUE(r) << r.error();
+  ASSERT_TRUE(r->damaged().empty());
+  const ChunkLocation& chunk = r->chunks()[r->keyframes()[k].chunk];
+  const Result<SurfaceFrame> frame = r->decode_keyframe(k);
+  ASSERT_FALSE(frame);
+  const std::string place = "session.rrec: keyframe 1 (chunk " + std::to_string(chunk.sequence) + " at byte " + std::to_string(chunk.offset) + "): ";
+  EXPECT_EQ(frame.error().substr(0, place.size()), place) << frame.error();
+  EXPECT_TRUE(r->decode_keyframe(0));
+  EXPECT_TRUE(r->decode_keyframe(2));
+}
 
 // Two recordings joined (`cat a b > c`): the second's chunks would pass for the first's, so the file
 // reads as the first recording with a content error, and recovering it keeps only the first.
