@@ -325,6 +325,8 @@ void ToolContacts::publish_candidates() {
   node_count_ = search_.node_count;
   vertex_count_ = search_.vertex_count;
   pair_count_ = search_.pair_count;
+  std::swap(searched_corners_, search_.corners);
+  corner_count_ = search_.corner_count;
   std::swap(node_clearance_, search_.node_clearance);
   std::swap(vertex_clearance_, search_.vertex_clearance);
   // `penetrating` belongs to the physics step that last ran, not to the search.
@@ -340,6 +342,7 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
   if (near_triangles_.capacity() < surface.triangle_count()) near_triangles_.reserve(surface.triangle_count());
   if (near_boxes_.capacity() < surface.triangle_count()) near_boxes_.reserve(surface.triangle_count());
   if (stack_.capacity() < 4 * surface.triangle_count()) stack_.reserve(4 * surface.triangle_count());
+  if (search_.corners.size() < surface.vertex_count()) search_.corners.resize(surface.vertex_count());
   if (stamp_ > 0xfff00000u) {  // keep the stamps from wrapping
     std::fill(node_stamp_.begin(), node_stamp_.end(), 0u);
     std::fill(tissue_triangle_stamp_.begin(), tissue_triangle_stamp_.end(), 0u);
@@ -352,6 +355,7 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
     search_tissue_nodes(static_cast<std::uint16_t>(pi), tissue_tree, surface);
     search_tool_vertices(static_cast<std::uint16_t>(pi), tissue_tree, surface);
   }
+  collect_searched_corners(surface);
   // The points were found in the order of the tissue tree's shape, which edits, rebuilds and the copy
   // searched (Simulation's two copies of the tissue) change; in (part, point) order the forces'
   // sums, and so the state, do not depend on them.
@@ -361,6 +365,32 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
   out.stats.tissue_nodes = static_cast<std::int32_t>(out.node_count);
   out.stats.tool_vertices = static_cast<std::int32_t>(out.vertex_count);
   out.stats.pair_entries = static_cast<std::int32_t>(out.pair_count);
+}
+
+void ToolContacts::collect_searched_corners(const TriangleMesh& surface) {
+  CandidateSet& out = search_;
+  out.corner_count = 0;
+  const std::uint32_t mark = ++stamp_;
+  for (std::size_t i = 0; i < out.vertex_count; ++i) {
+    const PointCandidates& pc = out.vertices[i];
+    for (std::uint32_t e = pc.first; e < pc.first + pc.count; ++e) {
+      for (const std::uint32_t n : surface.triangles[out.pair_triangles[e]]) {
+        if (node_stamp_[n] == mark) continue;
+        node_stamp_[n] = mark;
+        out.corners[out.corner_count++] = {n, surface.positions[n]};
+      }
+    }
+  }
+}
+
+double ToolContacts::corners_moved(std::span<const Vec3> x) const {
+  double largest2 = 0.0;
+  for (std::size_t k = 0; k < corner_count_; ++k) {
+    const Vec3 d = x[searched_corners_[k].node] - searched_corners_[k].at;
+    largest2 = std::max(largest2, glm::dot(d, d));
+  }
+  // Rounded up for the subtraction's and the square root's rounding, as the tissue's travel is.
+  return std::sqrt(largest2) * (1.0 + 1e-9) + 1e-15;
 }
 
 void ToolContacts::search_tissue_nodes(std::uint16_t part_index, const SphereTree& tissue_tree, const TriangleMesh& surface) {
@@ -505,6 +535,12 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
     reaction.torque_nm += glm::cross(surface_world - part.pose.translation, -f);
     ++penetrating;
   }
+  // How much nearer a tool vertex's candidate faces can have come since the search: at most as far
+  // as their corners have moved from where the search saw them. That displacement is far smaller
+  // than the tissue's travel since the search, a sum over steps of the fastest node anywhere, which
+  // counts every oscillation; the scans below stop sooner with it, and choose the same faces.
+  double faces_moved = tissue_travel_m - candidates_travel_m_;
+  if (clearance_skipping_ && distances_valid_ && vertex_count_ > 0) faces_moved = std::min(faces_moved, corners_moved(x));
   for (std::size_t i = 0; i < vertex_count_; ++i) {
     const PointCandidates& pc = vertex_candidates_[i];
     const Part& part = parts_[pc.part];
@@ -514,10 +550,10 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
       ++skipped;
       continue;
     }
-    // The vertex's own motion and, for the faces' corners, the tissue's travel since the search.
+    // The vertex's own motion and its faces' since the search.
     const double* searched = clearance_skipping_ && distances_valid_ ? &pair_distance_[pc.first] : nullptr;
     const Closest best = nearest_tissue_face(x.data(), surface_triangles, w, &pair_triangles_[pc.first], pc.count, searched,
-                                             glm::length(w - pc.searched_at) + (tissue_travel_m - candidates_travel_m_));
+                                             glm::length(w - pc.searched_at) + faces_moved);
     clearance = certify(best, w, tissue_travel_m);
     if (!(best.side < 0.0)) continue;
     const Triangle& t = surface_triangles[best.triangle];
@@ -572,6 +608,9 @@ void ToolContacts::reserve_tissue(std::size_t max_nodes, std::size_t max_faces) 
   if (tissue_triangle_stamp_.size() < max_faces) tissue_triangle_stamp_.assign(max_faces, 0);
   near_triangles_.reserve(max_faces);
   near_boxes_.reserve(max_faces);
+  // Both buffers: publishing swaps them.
+  if (search_.corners.size() < max_nodes) search_.corners.resize(max_nodes);
+  if (searched_corners_.size() < max_nodes) searched_corners_.resize(max_nodes);
   // A tissue tree has about two nodes per leaf and a leaf or two per face: a depth-first stack never
   // holds more than the tree's nodes.
   stack_.reserve(4 * max_faces);

@@ -168,6 +168,11 @@ class ToolContacts {
     std::uint32_t count;
     Vec3 searched_at;  // where the search found it (tool frame for a tissue node, world for a tool vertex)
   };
+  /// A tissue node at a corner of a tool vertex's candidate face, and where the search saw it.
+  struct SearchedCorner {
+    std::uint32_t node;
+    Vec3 at;
+  };
   /// A search's result, built in the back buffer and swapped in by publish_candidates().
   struct CandidateSet {
     std::vector<PointCandidates> nodes, vertices;
@@ -175,7 +180,8 @@ class ToolContacts {
     std::vector<double> pair_distance;  // per pair, its face's distance from the point at the search
     std::vector<std::pair<double, std::uint32_t>> kept;  // scratch: a point's kept faces with their distance², for the order
     std::vector<Clearance> node_clearance, vertex_clearance;  // per point, at the searched positions
-    std::size_t node_count = 0, vertex_count = 0, pair_count = 0;
+    std::vector<SearchedCorner> corners;  // every corner of the tool vertices' candidate faces, each once
+    std::size_t node_count = 0, vertex_count = 0, pair_count = 0, corner_count = 0;
     ToolContactStats stats;
     std::vector<std::pair<PointCandidates, Clearance>> sorting;  // scratch of order_points()
   };
@@ -192,6 +198,10 @@ class ToolContacts {
   /// The part's vertices within the margin of the tissue, with their candidate tissue faces.
   void search_tool_vertices(std::uint16_t part_index, const SphereTree& tissue_tree, const TriangleMesh& surface);
   bool push_pair(std::uint32_t triangle);
+  /// Lists the corners of the tool vertices' candidate faces with their searched positions.
+  void collect_searched_corners(const TriangleMesh& surface);
+  /// The largest distance any listed corner has moved from where the search saw it (rounded up).
+  double corners_moved(std::span<const Vec3> x) const;
   /// Drops the pairs from `first` on whose triangle is further than the margin from `p`, and orders
   /// the rest nearest first (ties by triangle index), so the closest-face search's exact prune
   /// discards most of them after the first test.
@@ -212,6 +222,10 @@ class ToolContacts {
   double candidates_travel_m_ = 0.0;  // the tissue's travel at the published search (its latched one)
   bool distances_valid_ = false;      // false from a topology edit until the next publish
   std::size_t node_count_ = 0, vertex_count_ = 0, pair_count_ = 0;
+  // The published search's corners of the tool vertices' candidate faces: how far they have moved
+  // bounds how much nearer a vertex's faces can have come since the search.
+  std::vector<SearchedCorner> searched_corners_;
+  std::size_t corner_count_ = 0;
   // Per published candidate point, its clearance certificate (the search's, renewed by add_forces()).
   std::vector<Clearance> node_clearance_, vertex_clearance_;
   double query_tissue_travel_m_ = 0.0;  // latched with the query poses
