@@ -59,22 +59,19 @@ inline FourIndices padded_tail(std::span<const std::int32_t> items, std::size_t 
 
 }  // namespace
 
-void centroid_spheres_portable(const Vec3* positions, const Triangle* triangles, const LeafPiece* pieces, std::span<const std::int32_t> leaves,
-                               Sphere* spheres) {
-  for (const std::int32_t leaf : leaves) {
-    const Triangle& t = triangles[pieces[leaf].triangle];
-    spheres[leaf] = centroid_sphere(positions[t[0]], positions[t[1]], positions[t[2]]);
+void centroid_spheres_portable(const Vec3* positions, const Triangle* corners, std::span<const std::int32_t> leaves, Sphere* spheres) {
+  for (std::size_t i = 0; i < leaves.size(); ++i) {
+    const Triangle& t = corners[i];
+    spheres[leaves[i]] = centroid_sphere(positions[t[0]], positions[t[1]], positions[t[2]]);
   }
 }
 
 namespace {
 
 /// Four leaves' centroid spheres, lane by lane as centroid_sphere() makes them.
-__attribute__((target("avx2"), always_inline)) inline void centroid4(const Vec3* positions, const Triangle* triangles, const LeafPiece* pieces,
-                                                                     const std::int32_t* leaf, Sphere* spheres) {
+__attribute__((target("avx2"), always_inline)) inline void centroid4(const Vec3* positions, const Triangle* const* t, const std::int32_t* leaf,
+                                                                     Sphere* spheres) {
   const __m256d third = _mm256_set1_pd(1.0 / 3.0);
-  const Triangle* t[4] = {&triangles[pieces[leaf[0]].triangle], &triangles[pieces[leaf[1]].triangle], &triangles[pieces[leaf[2]].triangle],
-                          &triangles[pieces[leaf[3]].triangle]};
   const Points4 a = avx2::triangle_corners(positions, t, 0), b = avx2::triangle_corners(positions, t, 1), c = avx2::triangle_corners(positions, t, 2);
   // (a + b + c) * (1/3), per coordinate.
   const __m256d cx = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(a.x, b.x), c.x), third);
@@ -87,41 +84,43 @@ __attribute__((target("avx2"), always_inline)) inline void centroid4(const Vec3*
   store_spheres(spheres, leaf, {cx, cy, cz, inflated_radius(cx, cy, cz, radius)});
 }
 
+/// Entries i .. i+3 of an array of `count`, the last repeated past its end (as padded_tail() repeats the indices).
+template <class T>
+std::array<const T*, 4> padded_four(const T* items, std::size_t i, std::size_t count) {
+  std::array<const T*, 4> four{};
+  for (std::size_t k = 0; k < 4; ++k) four[k] = items + std::min(i + k, count - 1);
+  return four;
+}
+
 }  // namespace
 
-__attribute__((target("avx2"))) void centroid_spheres_avx2(const Vec3* positions, const Triangle* triangles, const LeafPiece* pieces,
-                                                           std::span<const std::int32_t> leaves, Sphere* spheres) {
+__attribute__((target("avx2"))) void centroid_spheres_avx2(const Vec3* positions, const Triangle* corners, std::span<const std::int32_t> leaves,
+                                                           Sphere* spheres) {
   const std::size_t count = leaves.size();
   const std::int32_t* leaf = leaves.data();
-  // A leaf's corners lie three loads deep (piece, triangle, positions), scattered over large arrays:
-  // each level is started some leaves ahead.
-  constexpr std::size_t kPieceAhead = 24, kTriangleAhead = 16, kCornersAhead = 8;
+  // The corners come in order; the positions they index lie scattered, loaded some leaves ahead.
+  constexpr std::size_t kCornersAhead = 8;
   std::size_t i = 0;
   for (; i + 4 <= count; i += 4) {
-    for (std::size_t k = i; k < i + 4; ++k) {
-      if (k + kPieceAhead < count) __builtin_prefetch(pieces + leaf[k + kPieceAhead]);
-      if (k + kTriangleAhead < count) __builtin_prefetch(triangles + pieces[leaf[k + kTriangleAhead]].triangle);
-      if (k + kCornersAhead < count) {
-        const Triangle& ahead = triangles[pieces[leaf[k + kCornersAhead]].triangle];
-        __builtin_prefetch(positions + ahead[0]);
-        __builtin_prefetch(positions + ahead[1]);
-        __builtin_prefetch(positions + ahead[2]);
-      }
+    for (std::size_t k = i + kCornersAhead; k < std::min(i + 4 + kCornersAhead, count); ++k) {
+      __builtin_prefetch(positions + corners[k][0]);
+      __builtin_prefetch(positions + corners[k][1]);
+      __builtin_prefetch(positions + corners[k][2]);
     }
-    centroid4(positions, triangles, pieces, leaf + i, spheres);
+    const Triangle* t[4] = {corners + i, corners + i + 1, corners + i + 2, corners + i + 3};
+    centroid4(positions, t, leaf + i, spheres);
   }
   if (i < count) {
     const FourIndices tail = padded_tail(leaves, i);
-    centroid4(positions, triangles, pieces, tail.data(), spheres);
+    centroid4(positions, padded_four(corners, i, count).data(), tail.data(), spheres);
   }
 }
 
-void centroid_spheres(const Vec3* positions, const Triangle* triangles, const LeafPiece* pieces, std::span<const std::int32_t> leaves,
-                      Sphere* spheres) {
+void centroid_spheres(const Vec3* positions, const Triangle* corners, std::span<const std::int32_t> leaves, Sphere* spheres) {
   if (cpu_has_avx2()) {
-    centroid_spheres_avx2(positions, triangles, pieces, leaves, spheres);
+    centroid_spheres_avx2(positions, corners, leaves, spheres);
   } else {
-    centroid_spheres_portable(positions, triangles, pieces, leaves, spheres);
+    centroid_spheres_portable(positions, corners, leaves, spheres);
   }
 }
 
@@ -204,15 +203,15 @@ void sliced_piece_spheres(const TriangleMesh& mesh, const LeafPiece* pieces, std
   }
 }
 
-void merge_children_portable(const SphereTreeLinks* links, std::span<const std::int32_t> nodes, Sphere* spheres) {
-  for (const std::int32_t node : nodes) spheres[node] = enclosing_sphere(spheres[links[node].left], spheres[links[node].right]);
+void merge_children_portable(const ChildPair* children, std::span<const std::int32_t> nodes, Sphere* spheres) {
+  for (std::size_t i = 0; i < nodes.size(); ++i) spheres[nodes[i]] = enclosing_sphere(spheres[children[i].left], spheres[children[i].right]);
 }
 
 namespace {
 
 /// Four nodes' merges, lane by lane as enclosing_sphere() makes them.
-__attribute__((target("avx2"), always_inline)) inline void merge4(const SphereTreeLinks* links, const std::int32_t* node, Sphere* spheres) {
-  const SphereTreeLinks &l0 = links[node[0]], &l1 = links[node[1]], &l2 = links[node[2]], &l3 = links[node[3]];
+__attribute__((target("avx2"), always_inline)) inline void merge4(const ChildPair* const* children, const std::int32_t* node, Sphere* spheres) {
+  const ChildPair &l0 = *children[0], &l1 = *children[1], &l2 = *children[2], &l3 = *children[3];
   const Columns4 a = transpose4(load_sphere(spheres[l0.left]), load_sphere(spheres[l1.left]), load_sphere(spheres[l2.left]),
                                 load_sphere(spheres[l3.left]));
   const Columns4 b = transpose4(load_sphere(spheres[l0.right]), load_sphere(spheres[l1.right]), load_sphere(spheres[l2.right]),
@@ -235,20 +234,23 @@ __attribute__((target("avx2"), always_inline)) inline void merge4(const SphereTr
 
 }  // namespace
 
-__attribute__((target("avx2"))) void merge_children_avx2(const SphereTreeLinks* links, std::span<const std::int32_t> nodes, Sphere* spheres) {
+__attribute__((target("avx2"))) void merge_children_avx2(const ChildPair* children, std::span<const std::int32_t> nodes, Sphere* spheres) {
   std::size_t i = 0;
-  for (; i + 4 <= nodes.size(); i += 4) merge4(links, nodes.data() + i, spheres);
+  for (; i + 4 <= nodes.size(); i += 4) {
+    const ChildPair* four[4] = {children + i, children + i + 1, children + i + 2, children + i + 3};
+    merge4(four, nodes.data() + i, spheres);
+  }
   if (i < nodes.size()) {
     const FourIndices tail = padded_tail(nodes, i);
-    merge4(links, tail.data(), spheres);
+    merge4(padded_four(children, i, nodes.size()).data(), tail.data(), spheres);
   }
 }
 
-void merge_children(const SphereTreeLinks* links, std::span<const std::int32_t> nodes, Sphere* spheres) {
+void merge_children(const ChildPair* children, std::span<const std::int32_t> nodes, Sphere* spheres) {
   if (cpu_has_avx2()) {
-    merge_children_avx2(links, nodes, spheres);
+    merge_children_avx2(children, nodes, spheres);
   } else {
-    merge_children_portable(links, nodes, spheres);
+    merge_children_portable(children, nodes, spheres);
   }
 }
 

@@ -40,15 +40,14 @@ inline Sphere centroid_sphere(const Vec3& a, const Vec3& b, const Vec3& c) {
   return inflated_sphere(center, std::sqrt(r2));
 }
 
-/// spheres[leaf] = the centroid sphere of the leaf's triangle, for every leaf of `leaves` (each a
-/// whole-triangle piece: LeafPiece::slices == 1). Finite corners give the same bits on both paths.
-void centroid_spheres(const Vec3* positions, const Triangle* triangles, const LeafPiece* pieces, std::span<const std::int32_t> leaves,
-                      Sphere* spheres);
-void centroid_spheres_portable(const Vec3* positions, const Triangle* triangles, const LeafPiece* pieces, std::span<const std::int32_t> leaves,
-                               Sphere* spheres);
+/// spheres[leaves[i]] = the centroid sphere of triangle corners[i], for every leaf of `leaves` (each a
+/// whole-triangle piece: LeafPiece::slices == 1), its triangle's corners read from an array in the
+/// leaves' order rather than through the piece and the mesh's triangles: two dependent loads fewer a
+/// leaf. Finite corners give the same bits on both paths.
+void centroid_spheres(const Vec3* positions, const Triangle* corners, std::span<const std::int32_t> leaves, Sphere* spheres);
+void centroid_spheres_portable(const Vec3* positions, const Triangle* corners, std::span<const std::int32_t> leaves, Sphere* spheres);
 /// The same four leaves per instruction; call only where cpu_has_avx2().
-void centroid_spheres_avx2(const Vec3* positions, const Triangle* triangles, const LeafPiece* pieces, std::span<const std::int32_t> leaves,
-                           Sphere* spheres);
+void centroid_spheres_avx2(const Vec3* positions, const Triangle* corners, std::span<const std::int32_t> leaves, Sphere* spheres);
 
 /// spheres[leaf] = SphereTree::piece_sphere of the leaf's piece, for every leaf of `leaves` (each a
 /// slice of a long thin triangle: LeafPiece::slices > 1). Finite corners give the same bits on both paths.
@@ -57,11 +56,12 @@ void sliced_piece_spheres_portable(const TriangleMesh& mesh, const LeafPiece* pi
 /// The same four leaves per instruction; call only where cpu_has_avx2().
 void sliced_piece_spheres_avx2(const TriangleMesh& mesh, const LeafPiece* pieces, std::span<const std::int32_t> leaves, Sphere* spheres);
 
-/// spheres[n] = the enclosing sphere of n's children, for every internal node n of `nodes`, none of
-/// which may be a child of another (one height's nodes, say): the AVX2 path merges four at once.
-void merge_children(const SphereTreeLinks* links, std::span<const std::int32_t> nodes, Sphere* spheres);
-void merge_children_portable(const SphereTreeLinks* links, std::span<const std::int32_t> nodes, Sphere* spheres);
+/// spheres[nodes[i]] = the enclosing sphere of children[i]'s two spheres, for every internal node of
+/// `nodes`, none of which may be a child of another (one height's nodes, say): the AVX2 path merges
+/// four at once. The children come in the nodes' order, not through the links: one load chain fewer.
+void merge_children(const ChildPair* children, std::span<const std::int32_t> nodes, Sphere* spheres);
+void merge_children_portable(const ChildPair* children, std::span<const std::int32_t> nodes, Sphere* spheres);
 /// The same four nodes per instruction; call only where cpu_has_avx2().
-void merge_children_avx2(const SphereTreeLinks* links, std::span<const std::int32_t> nodes, Sphere* spheres);
+void merge_children_avx2(const ChildPair* children, std::span<const std::int32_t> nodes, Sphere* spheres);
 
 }  // namespace resecto

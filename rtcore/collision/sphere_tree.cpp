@@ -215,6 +215,8 @@ void SphereTree::reserve(std::int32_t max_nodes, std::uint32_t max_triangles) {
   refit_leaves_.reserve(nodes);
   refit_internal_.reserve(nodes);
   for (auto* list : {&whole_leaves_, &sliced_leaves_, &merge_order_, &block_top_, &block_nodes_, &block_walk_}) list->reserve(nodes);
+  whole_corners_.reserve(nodes);
+  merge_children_.reserve(nodes);
   refit_blocks_.reserve(nodes);
   merge_group_ends_.reserve(nodes);
   height_slots_.reserve(64);
@@ -491,6 +493,8 @@ void SphereTree::update_sphere_refit_blocks() {
   merge_order_.clear();
   merge_group_ends_.clear();
   block_top_.clear();
+  merge_children_.clear();
+  corners_stale_ = true;
   if (root_ == kNoNode) return;
   const auto add_by_height = [this](std::span<const std::int32_t> nodes, std::int32_t tallest) {  // a counting sort
     std::vector<std::size_t>& next = height_slots_;
@@ -537,6 +541,8 @@ void SphereTree::update_sphere_refit_blocks() {
     add_by_height(block_top_, links_[root_].height);
     end_block();
   }
+  merge_children_.resize(merge_order_.size());
+  for (std::size_t i = 0; i < merge_order_.size(); ++i) merge_children_[i] = {links_[merge_order_[i]].left, links_[merge_order_[i]].right};
 }
 
 void SphereTree::refit_leaf(const TriangleMesh& mesh, std::int32_t leaf) {
@@ -608,15 +614,21 @@ void SphereTree::refit(const TriangleMesh& mesh) {
     return;
   }
   // Spheres alone: the same bounds as refit_leaf and refit_internal give, block by block, four at a time.
+  if (corners_stale_) {
+    // The leaves' triangles keep their corners until a removal or insertion changes the order.
+    whole_corners_.resize(whole_leaves_.size());
+    for (std::size_t i = 0; i < whole_leaves_.size(); ++i) whole_corners_[i] = mesh.triangles[pieces_[whole_leaves_[i]].triangle];
+    corners_stale_ = false;
+  }
   const std::span<const std::int32_t> whole(whole_leaves_), sliced(sliced_leaves_), merges(merge_order_);
   RefitBlock begin{0, 0, 0};
   std::size_t merged = 0;  // merge_order_'s entries done
   for (const RefitBlock& block : refit_blocks_) {
-    centroid_spheres(mesh.positions.data(), mesh.triangles.data(), pieces_.data(), whole.subspan(begin.whole_end, block.whole_end - begin.whole_end),
+    centroid_spheres(mesh.positions.data(), whole_corners_.data() + begin.whole_end, whole.subspan(begin.whole_end, block.whole_end - begin.whole_end),
                      spheres_.data());
     sliced_piece_spheres(mesh, pieces_.data(), sliced.subspan(begin.sliced_end, block.sliced_end - begin.sliced_end), spheres_.data());
     for (std::size_t g = begin.groups_end; g < block.groups_end; ++g) {
-      merge_children(links_.data(), merges.subspan(merged, merge_group_ends_[g] - merged), spheres_.data());
+      merge_children(merge_children_.data() + merged, merges.subspan(merged, merge_group_ends_[g] - merged), spheres_.data());
       merged = merge_group_ends_[g];
     }
     begin = block;

@@ -76,6 +76,12 @@ struct SphereTreeLinks {
   std::int32_t height = 0;  ///< 0 for a leaf, 1 + the taller child's height otherwise
 };
 
+/// An internal node's two children, as the refit's merges read them.
+struct ChildPair {
+  std::int32_t left = -1;
+  std::int32_t right = -1;
+};
+
 /// A snapshot of a tree's shape for the rebuild policy.
 struct SphereTreeQuality {
   std::int32_t leaves = 0;
@@ -116,7 +122,8 @@ class SphereTree {
   void rebuild(const TriangleMesh& mesh);
 
   /// Recomputes every sphere bottom-up from the mesh's current vertex positions (section 3.4).
-  /// Allocates nothing once the tree's size has been seen before.
+  /// Allocates nothing once the tree's size has been seen before. The vertices may move; a triangle
+  /// whose corners change must be removed and inserted again (the tree keeps its leaves' corners).
   void refit(const TriangleMesh& mesh);
 
   /// Adds the leaves of triangle `t` of `mesh`, each descending by the principal direction of the
@@ -212,6 +219,12 @@ class SphereTree {
   std::vector<RefitBlock> refit_blocks_;
   std::vector<std::int32_t> whole_leaves_, sliced_leaves_, merge_order_;
   std::vector<std::size_t> merge_group_ends_;  // merge_order_'s end of each group
+  // The same orders' operands in their order, so a refit follows no index chain: each whole leaf's
+  // triangle corners (taken from the mesh at the first refit after the order changed) and each merge's
+  // children.
+  std::vector<Triangle> whole_corners_;
+  std::vector<ChildPair> merge_children_;
+  bool corners_stale_ = true;
   std::vector<std::int32_t> block_top_, block_nodes_, block_walk_;  // scratch
   std::vector<std::size_t> height_slots_;                           // scratch
   std::vector<std::int32_t> stack_;        // scratch for update_refit_order and update_sphere_refit_blocks

@@ -18,6 +18,13 @@ namespace {
 
 bool same_bits(const Sphere& a, const Sphere& b) { return std::memcmp(&a, &b, sizeof(Sphere)) == 0; }
 
+/// The children of `nodes`, in their order, as the tree hands them to the merges.
+std::vector<ChildPair> children_of(const std::vector<ChildPair>& by_node, std::span<const std::int32_t> nodes) {
+  std::vector<ChildPair> children;
+  for (const std::int32_t n : nodes) children.push_back(by_node[static_cast<std::size_t>(n)]);
+  return children;
+}
+
 TriangleMesh jittered_gland(std::uint64_t seed) {
   TriangleMesh mesh = generate_prostate(1296).surface;
   std::mt19937_64 random(seed);
@@ -38,9 +45,11 @@ TEST(SphereRefitKernel, Avx2CentroidSpheresMatchThePortableOnesBitForBit) {
   // Every remainder of four, and a span that starts inside the array.
   for (const std::size_t count : {std::size_t{0}, std::size_t{1}, std::size_t{3}, std::size_t{7}, leaves.size()}) {
     const std::span<const std::int32_t> span(leaves.data() + (count < 8 ? 5 : 0), count);
+    std::vector<Triangle> corners;  // in the span's order, as the tree keeps them
+    for (const std::int32_t leaf : span) corners.push_back(mesh.triangles[pieces[static_cast<std::size_t>(leaf)].triangle]);
     std::vector<Sphere> portable(leaves.size()), simd(leaves.size());
-    centroid_spheres_portable(mesh.positions.data(), mesh.triangles.data(), pieces.data(), span, portable.data());
-    centroid_spheres_avx2(mesh.positions.data(), mesh.triangles.data(), pieces.data(), span, simd.data());
+    centroid_spheres_portable(mesh.positions.data(), corners.data(), span, portable.data());
+    centroid_spheres_avx2(mesh.positions.data(), corners.data(), span, simd.data());
     for (std::size_t n = 0; n < leaves.size(); ++n) ASSERT_TRUE(same_bits(portable[n], simd[n])) << "leaf " << n << " of a span of " << count;
   }
 }
@@ -74,7 +83,7 @@ TEST(SphereRefitKernel, Avx2MergesMatchThePortableOnesInEveryCase) {
   std::uniform_real_distribution<double> coordinate(-0.05, 0.05), radius(1e-4, 0.02);
   const std::int32_t pairs = 403;
   std::vector<Sphere> spheres(static_cast<std::size_t>(3 * pairs));
-  std::vector<SphereTreeLinks> links(spheres.size());
+  std::vector<ChildPair> links(spheres.size());  // by node
   std::vector<std::int32_t> parents;
   for (std::int32_t k = 0; k < pairs; ++k) {
     const std::int32_t parent = 3 * k, left = parent + 1, right = parent + 2;
@@ -85,20 +94,22 @@ TEST(SphereRefitKernel, Avx2MergesMatchThePortableOnesInEveryCase) {
     if (k % 5 == 1) b = {a.center + Vec3(0.1 * a.radius, 0.0, 0.0), 0.5 * a.radius};  // a holds b
     if (k % 5 == 2) a = {b.center - Vec3(0.0, 0.1 * b.radius, 0.0), 0.5 * b.radius};  // b holds a
     if (k % 5 == 3) b = a;                                                             // the same sphere
-    links[static_cast<std::size_t>(parent)] = {-1, left, right, 1};
+    links[static_cast<std::size_t>(parent)] = {left, right};
     parents.push_back(parent);
   }
   // Spans of every remainder of four: the last one to three merges run as padded lanes.
   for (const std::size_t count : {std::size_t{1}, std::size_t{2}, std::size_t{6}}) {
     const std::span<const std::int32_t> span(parents.data() + 7, count);
+    const std::vector<ChildPair> children = children_of(links, span);
     std::vector<Sphere> portable = spheres, simd = spheres;
-    merge_children_portable(links.data(), span, portable.data());
-    merge_children_avx2(links.data(), span, simd.data());
+    merge_children_portable(children.data(), span, portable.data());
+    merge_children_avx2(children.data(), span, simd.data());
     for (std::size_t n = 0; n < spheres.size(); ++n) ASSERT_TRUE(same_bits(portable[n], simd[n])) << "sphere " << n << " of a span of " << count;
   }
+  const std::vector<ChildPair> children = children_of(links, parents);
   std::vector<Sphere> portable = spheres, simd = spheres;
-  merge_children_portable(links.data(), parents, portable.data());
-  merge_children_avx2(links.data(), parents, simd.data());
+  merge_children_portable(children.data(), parents, portable.data());
+  merge_children_avx2(children.data(), parents, simd.data());
   for (const std::int32_t parent : parents) {
     const auto p = static_cast<std::size_t>(parent);
     ASSERT_TRUE(same_bits(portable[p], simd[p])) << "pair " << parent / 3;
