@@ -124,18 +124,18 @@ void centroid_spheres(const Vec3* positions, const Triangle* corners, std::span<
   }
 }
 
-void sliced_piece_spheres_portable(const TriangleMesh& mesh, const LeafPiece* pieces, std::span<const std::int32_t> leaves, Sphere* spheres) {
-  for (const std::int32_t leaf : leaves) spheres[leaf] = SphereTree::piece_sphere(mesh, pieces[leaf]);
+void sliced_piece_spheres_portable(const Vec3* positions, const SliceOperands* operands, std::span<const std::int32_t> leaves, Sphere* spheres) {
+  for (std::size_t i = 0; i < leaves.size(); ++i) {
+    const SliceOperands& o = operands[i];
+    spheres[leaves[i]] = SphereTree::slice_sphere(positions[o.corners[0]], positions[o.corners[1]], positions[o.corners[2]], o.t0, o.t1);
+  }
 }
 
 namespace {
 
-__attribute__((target("avx2"), always_inline)) inline Points4 corner_of(const TriangleMesh& mesh, const LeafPiece* const* piece, int offset) {
-  const auto at = [&](int lane) -> const Vec3& {
-    const Triangle& t = mesh.triangles[piece[lane]->triangle];
-    return mesh.positions[t[(piece[lane]->apex + offset) % 3]];
-  };
-  return avx2::points_of(avx2::load_point(at(0)), avx2::load_point(at(1)), avx2::load_point(at(2)), avx2::load_point(at(3)));
+__attribute__((target("avx2"), always_inline)) inline Points4 corner_of(const Vec3* positions, const SliceOperands* const* o, int k) {
+  return avx2::points_of(avx2::load_point(positions[o[0]->corners[k]]), avx2::load_point(positions[o[1]->corners[k]]),
+                         avx2::load_point(positions[o[2]->corners[k]]), avx2::load_point(positions[o[3]->corners[k]]));
 }
 /// x * (1 - t) + b * t per coordinate (glm's order).
 __attribute__((target("avx2"), always_inline)) inline Points4 lerp(const Points4& x, const Points4& b, __m256d t) {
@@ -153,14 +153,11 @@ __attribute__((target("avx2"), always_inline)) inline __m256d reach2(const std::
   return r2;
 }
 
-/// Four sliced pieces' spheres, lane by lane as SphereTree::piece_sphere() makes them.
-__attribute__((target("avx2"), always_inline)) inline void slice4(const TriangleMesh& mesh, const LeafPiece* pieces, const std::int32_t* leaf,
+/// Four sliced pieces' spheres, lane by lane as SphereTree::slice_sphere() makes them.
+__attribute__((target("avx2"), always_inline)) inline void slice4(const Vec3* positions, const SliceOperands* const* o, const std::int32_t* leaf,
                                                                   Sphere* spheres) {
-  const LeafPiece* piece[4] = {&pieces[leaf[0]], &pieces[leaf[1]], &pieces[leaf[2]], &pieces[leaf[3]]};
-  const Points4 b = corner_of(mesh, piece, 0), x = corner_of(mesh, piece, 1), y = corner_of(mesh, piece, 2);
-  const __m256d slice = _mm256_set_pd(piece[3]->slice, piece[2]->slice, piece[1]->slice, piece[0]->slice);
-  const __m256d slices = _mm256_set_pd(piece[3]->slices, piece[2]->slices, piece[1]->slices, piece[0]->slices);
-  const __m256d t0 = _mm256_div_pd(slice, slices), t1 = _mm256_div_pd(_mm256_add_pd(slice, _mm256_set1_pd(1.0)), slices);
+  const Points4 b = corner_of(positions, o, 0), x = corner_of(positions, o, 1), y = corner_of(positions, o, 2);
+  const __m256d t0 = _mm256_set_pd(o[3]->t0, o[2]->t0, o[1]->t0, o[0]->t0), t1 = _mm256_set_pd(o[3]->t1, o[2]->t1, o[1]->t1, o[0]->t1);
   // sphere_around() of the slab's four corners: the box centre's sphere, or the centroid's if smaller.
   const std::array<Points4, 4> p{lerp(x, b, t0), lerp(y, b, t0), lerp(x, b, t1), lerp(y, b, t1)};
   Points4 low = p[0], high = p[0];
@@ -170,10 +167,11 @@ __attribute__((target("avx2"), always_inline)) inline void slice4(const Triangle
     high = {_mm256_max_pd(q.x, high.x), _mm256_max_pd(q.y, high.y), _mm256_max_pd(q.z, high.z)};
     sum = {_mm256_add_pd(sum.x, q.x), _mm256_add_pd(sum.y, q.y), _mm256_add_pd(sum.z, q.z)};
   }
-  const __m256d half = _mm256_set1_pd(0.5), four = _mm256_set1_pd(4.0);
+  const __m256d half = _mm256_set1_pd(0.5), quarter = _mm256_set1_pd(0.25);
   const Points4 box{_mm256_mul_pd(half, _mm256_add_pd(low.x, high.x)), _mm256_mul_pd(half, _mm256_add_pd(low.y, high.y)),
                     _mm256_mul_pd(half, _mm256_add_pd(low.z, high.z))};
-  const Points4 centroid{_mm256_div_pd(sum.x, four), _mm256_div_pd(sum.y, four), _mm256_div_pd(sum.z, four)};
+  // sum / 4 as sphere_around() divides: a power of two scales exactly, so the product has its bits.
+  const Points4 centroid{_mm256_mul_pd(sum.x, quarter), _mm256_mul_pd(sum.y, quarter), _mm256_mul_pd(sum.z, quarter)};
   const __m256d infinity = _mm256_set1_pd(INFINITY);
   const __m256d box_r = _mm256_sqrt_pd(reach2(p, box)), centroid_r = _mm256_sqrt_pd(reach2(p, centroid));
   const __m256d best_r = _mm256_blendv_pd(infinity, box_r, _mm256_cmp_pd(box_r, infinity, _CMP_LT_OQ));
@@ -185,21 +183,24 @@ __attribute__((target("avx2"), always_inline)) inline void slice4(const Triangle
 
 }  // namespace
 
-__attribute__((target("avx2"))) void sliced_piece_spheres_avx2(const TriangleMesh& mesh, const LeafPiece* pieces, std::span<const std::int32_t> leaves,
+__attribute__((target("avx2"))) void sliced_piece_spheres_avx2(const Vec3* positions, const SliceOperands* operands, std::span<const std::int32_t> leaves,
                                                                Sphere* spheres) {
   std::size_t i = 0;
-  for (; i + 4 <= leaves.size(); i += 4) slice4(mesh, pieces, leaves.data() + i, spheres);
+  for (; i + 4 <= leaves.size(); i += 4) {
+    const SliceOperands* four[4] = {operands + i, operands + i + 1, operands + i + 2, operands + i + 3};
+    slice4(positions, four, leaves.data() + i, spheres);
+  }
   if (i < leaves.size()) {
     const FourIndices tail = padded_tail(leaves, i);
-    slice4(mesh, pieces, tail.data(), spheres);
+    slice4(positions, padded_four(operands, i, leaves.size()).data(), tail.data(), spheres);
   }
 }
 
-void sliced_piece_spheres(const TriangleMesh& mesh, const LeafPiece* pieces, std::span<const std::int32_t> leaves, Sphere* spheres) {
+void sliced_piece_spheres(const Vec3* positions, const SliceOperands* operands, std::span<const std::int32_t> leaves, Sphere* spheres) {
   if (cpu_has_avx2()) {
-    sliced_piece_spheres_avx2(mesh, pieces, leaves, spheres);
+    sliced_piece_spheres_avx2(positions, operands, leaves, spheres);
   } else {
-    sliced_piece_spheres_portable(mesh, pieces, leaves, spheres);
+    sliced_piece_spheres_portable(positions, operands, leaves, spheres);
   }
 }
 

@@ -49,12 +49,13 @@ void centroid_spheres_portable(const Vec3* positions, const Triangle* corners, s
 /// The same four leaves per instruction; call only where cpu_has_avx2().
 void centroid_spheres_avx2(const Vec3* positions, const Triangle* corners, std::span<const std::int32_t> leaves, Sphere* spheres);
 
-/// spheres[leaf] = SphereTree::piece_sphere of the leaf's piece, for every leaf of `leaves` (each a
-/// slice of a long thin triangle: LeafPiece::slices > 1). Finite corners give the same bits on both paths.
-void sliced_piece_spheres(const TriangleMesh& mesh, const LeafPiece* pieces, std::span<const std::int32_t> leaves, Sphere* spheres);
-void sliced_piece_spheres_portable(const TriangleMesh& mesh, const LeafPiece* pieces, std::span<const std::int32_t> leaves, Sphere* spheres);
+/// spheres[leaves[i]] = SphereTree::slice_sphere of operands[i], for every leaf of `leaves` (each a
+/// slice of a long thin triangle: LeafPiece::slices > 1), its operands in the leaves' order. Finite
+/// corners give the same bits on both paths.
+void sliced_piece_spheres(const Vec3* positions, const SliceOperands* operands, std::span<const std::int32_t> leaves, Sphere* spheres);
+void sliced_piece_spheres_portable(const Vec3* positions, const SliceOperands* operands, std::span<const std::int32_t> leaves, Sphere* spheres);
 /// The same four leaves per instruction; call only where cpu_has_avx2().
-void sliced_piece_spheres_avx2(const TriangleMesh& mesh, const LeafPiece* pieces, std::span<const std::int32_t> leaves, Sphere* spheres);
+void sliced_piece_spheres_avx2(const Vec3* positions, const SliceOperands* operands, std::span<const std::int32_t> leaves, Sphere* spheres);
 
 /// spheres[nodes[i]] = the enclosing sphere of children[i]'s two spheres, for every internal node of
 /// `nodes`, none of which may be a child of another (one height's nodes, say): the AVX2 path merges

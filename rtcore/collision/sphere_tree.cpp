@@ -136,11 +136,20 @@ Sphere SphereTree::piece_sphere(const TriangleMesh& mesh, const LeafPiece& piece
   const Vec3& x = mesh.positions[tri[(piece.apex + 1) % 3]];
   const Vec3& y = mesh.positions[tri[(piece.apex + 2) % 3]];
   if (piece.slices == 1) return triangle_sphere(b, x, y);
+  const SliceOperands operands = slice_operands(mesh, piece);
+  return slice_sphere(b, x, y, operands.t0, operands.t1);
+}
+
+Sphere SphereTree::slice_sphere(const Vec3& b, const Vec3& x, const Vec3& y, double t0, double t1) {
   // The slab between the lines at t0 and t1 (t: the weight of the apex) is the hull of these four.
-  const double t0 = static_cast<double>(piece.slice) / piece.slices;
-  const double t1 = static_cast<double>(piece.slice + 1) / piece.slices;
-  return sphere_around(std::array<Vec3, 4>{x * (1.0 - t0) + b * t0, y * (1.0 - t0) + b * t0,
-                                           x * (1.0 - t1) + b * t1, y * (1.0 - t1) + b * t1});
+  return sphere_around(std::array<Vec3, 4>{x * (1.0 - t0) + b * t0, y * (1.0 - t0) + b * t0, x * (1.0 - t1) + b * t1, y * (1.0 - t1) + b * t1});
+}
+
+SliceOperands SphereTree::slice_operands(const TriangleMesh& mesh, const LeafPiece& piece) {
+  const Triangle& tri = mesh.triangles[piece.triangle];
+  return {{tri[piece.apex], tri[(piece.apex + 1) % 3], tri[(piece.apex + 2) % 3]},
+          static_cast<double>(piece.slice) / piece.slices,
+          static_cast<double>(piece.slice + 1) / piece.slices};
 }
 
 std::int32_t SphereTree::allocate_node() {
@@ -216,6 +225,7 @@ void SphereTree::reserve(std::int32_t max_nodes, std::uint32_t max_triangles) {
   refit_internal_.reserve(nodes);
   for (auto* list : {&whole_leaves_, &sliced_leaves_, &merge_order_, &block_top_, &block_nodes_, &block_walk_}) list->reserve(nodes);
   whole_corners_.reserve(nodes);
+  sliced_operands_.reserve(nodes);
   merge_children_.reserve(nodes);
   refit_blocks_.reserve(nodes);
   merge_group_ends_.reserve(nodes);
@@ -618,6 +628,8 @@ void SphereTree::refit(const TriangleMesh& mesh) {
     // The leaves' triangles keep their corners until a removal or insertion changes the order.
     whole_corners_.resize(whole_leaves_.size());
     for (std::size_t i = 0; i < whole_leaves_.size(); ++i) whole_corners_[i] = mesh.triangles[pieces_[whole_leaves_[i]].triangle];
+    sliced_operands_.resize(sliced_leaves_.size());
+    for (std::size_t i = 0; i < sliced_leaves_.size(); ++i) sliced_operands_[i] = slice_operands(mesh, pieces_[sliced_leaves_[i]]);
     corners_stale_ = false;
   }
   const std::span<const std::int32_t> whole(whole_leaves_), sliced(sliced_leaves_), merges(merge_order_);
@@ -626,7 +638,8 @@ void SphereTree::refit(const TriangleMesh& mesh) {
   for (const RefitBlock& block : refit_blocks_) {
     centroid_spheres(mesh.positions.data(), whole_corners_.data() + begin.whole_end, whole.subspan(begin.whole_end, block.whole_end - begin.whole_end),
                      spheres_.data());
-    sliced_piece_spheres(mesh, pieces_.data(), sliced.subspan(begin.sliced_end, block.sliced_end - begin.sliced_end), spheres_.data());
+    sliced_piece_spheres(mesh.positions.data(), sliced_operands_.data() + begin.sliced_end, sliced.subspan(begin.sliced_end, block.sliced_end - begin.sliced_end),
+                         spheres_.data());
     for (std::size_t g = begin.groups_end; g < block.groups_end; ++g) {
       merge_children(merge_children_.data() + merged, merges.subspan(merged, merge_group_ends_[g] - merged), spheres_.data());
       merged = merge_group_ends_[g];

@@ -82,6 +82,15 @@ struct ChildPair {
   std::int32_t right = -1;
 };
 
+/// A sliced leaf's operands, as the refit reads them: its triangle's corners from the piece's apex on
+/// (the apex, then the two ends of the edge the slabs run along) and the slab's bounds as weights of
+/// the apex (SphereTree::piece_sphere's t0 and t1).
+struct SliceOperands {
+  Triangle corners{};
+  double t0 = 0.0;
+  double t1 = 0.0;
+};
+
 /// A snapshot of a tree's shape for the rebuild policy.
 struct SphereTreeQuality {
   std::int32_t leaves = 0;
@@ -173,6 +182,11 @@ class SphereTree {
   /// The sphere of one leaf piece of the mesh's current geometry (inflated a hair so rounding can
   /// never leave a point of the piece outside it).
   static Sphere piece_sphere(const TriangleMesh& mesh, const LeafPiece& piece);
+  /// The sphere of the slab of triangle (b, x, y) between the lines at apex weights t0 and t1 (the
+  /// lines run parallel to the edge x-y; b is the apex), as piece_sphere() gives it for a sliced piece.
+  static Sphere slice_sphere(const Vec3& b, const Vec3& x, const Vec3& y, double t0, double t1);
+  /// A sliced piece's operands for the refit (the corners' indices in the mesh and the weights).
+  static SliceOperands slice_operands(const TriangleMesh& mesh, const LeafPiece& piece);
   /// The slab of a triangle: its plane, widened by rounding (a degenerate triangle gets the slab of
   /// its sphere along z).
   static Slab triangle_slab(const TriangleMesh& mesh, std::uint32_t t, const Sphere& sphere);
@@ -220,9 +234,10 @@ class SphereTree {
   std::vector<std::int32_t> whole_leaves_, sliced_leaves_, merge_order_;
   std::vector<std::size_t> merge_group_ends_;  // merge_order_'s end of each group
   // The same orders' operands in their order, so a refit follows no index chain: each whole leaf's
-  // triangle corners (taken from the mesh at the first refit after the order changed) and each merge's
-  // children.
+  // triangle corners and each sliced leaf's (taken from the mesh at the first refit after the order
+  // changed), and each merge's children.
   std::vector<Triangle> whole_corners_;
+  std::vector<SliceOperands> sliced_operands_;
   std::vector<ChildPair> merge_children_;
   bool corners_stale_ = true;
   std::vector<std::int32_t> block_top_, block_nodes_, block_walk_;  // scratch

@@ -69,10 +69,16 @@ TEST(SphereRefitKernel, Avx2SlicedPieceSpheresMatchThePortableOnesBitForBit) {
   for (std::size_t n = 0; n < leaves.size(); ++n) leaves[n] = static_cast<std::int32_t>(n);
   for (const std::size_t count : {std::size_t{3}, std::size_t{6}, leaves.size()}) {
     const std::span<const std::int32_t> span(leaves.data() + (count < 8 ? 9 : 0), count);
+    std::vector<SliceOperands> operands;  // in the span's order, as the tree keeps them
+    for (const std::int32_t leaf : span) operands.push_back(SphereTree::slice_operands(mesh, pieces[static_cast<std::size_t>(leaf)]));
     std::vector<Sphere> portable(leaves.size()), simd(leaves.size());
-    sliced_piece_spheres_portable(mesh, pieces.data(), span, portable.data());
-    sliced_piece_spheres_avx2(mesh, pieces.data(), span, simd.data());
+    sliced_piece_spheres_portable(mesh.positions.data(), operands.data(), span, portable.data());
+    sliced_piece_spheres_avx2(mesh.positions.data(), operands.data(), span, simd.data());
     for (std::size_t n = 0; n < leaves.size(); ++n) ASSERT_TRUE(same_bits(portable[n], simd[n])) << "piece " << n << " of a span of " << count;
+    for (const std::int32_t leaf : span) {
+      const auto n = static_cast<std::size_t>(leaf);
+      ASSERT_TRUE(same_bits(portable[n], SphereTree::piece_sphere(mesh, pieces[n]))) << "piece " << n << ": not piece_sphere's bits";
+    }
   }
 }
 
