@@ -4,7 +4,13 @@
 namespace resecto::rec {
 
 Result<std::unique_ptr<Replayer>> Replayer::create(const Recording& recording) {
-  if (recording.header().start_tick != 0) return Error{"replay: the recording starts at tick " + std::to_string(recording.header().start_tick) + ", not 0"};
+  if (recording.header().start_tick != 0) {
+    // Re-simulation needs every input from the first tick: a recording started mid-session holds no
+    // state to start from (its keyframes are surfaces, not the core's whole state).
+    return Error{"replay: " + recording.name() + " starts at tick " + std::to_string(recording.header().start_tick) +
+                 " (recorded from mid-session): re-simulation needs the session from tick 0; its keyframes can still be browsed " +
+                 "and exported (`rec export`), and `resecto console --record FILE` records a session from its first tick"};
+  }
   Result<std::unique_ptr<Simulation>> sim = Simulation::create(recording.header().simulation);
   if (!sim) return Error{"replay: " + sim.error()};
   std::unique_ptr<Replayer> replayer(new Replayer(recording));

@@ -298,6 +298,32 @@ TEST(RecordingFile, AKeyframeThatDoesNotDecodeIsNamedByFileAndChunk) {
   EXPECT_TRUE(r->decode_keyframe(2));
 }
 
+// A recording whose header starts past tick 0 (the console's record button, mid-session) holds no
+// state to re-simulate from: replay refuses it by name and says what still works.
+TEST(RecordingFile, ReplayRefusesARecordingStartedMidSessionAndSaysWhy) {
+  const std::vector<std::uint8_t>& file = testing::short_recording().file;
+  const ChunkScan scan = scan_chunks(file);
+  std::vector<std::uint8_t> rebuilt(file.begin(), file.begin() + static_cast<std::ptrdiff_t>(scan.chunks.front().offset));
+  for (const ChunkLocation& chunk : scan.chunks) {
+    std::vector<std::uint8_t> payload(file.begin() + static_cast<std::ptrdiff_t>(chunk.payload_offset()),
+                                      file.begin() + static_cast<std::ptrdiff_t>(chunk.payload_offset() + chunk.payload_bytes));
+    if (chunk.type == static_cast<std::uint16_t>(ChunkType::kHeader)) {
+      nlohmann::ordered_json header = nlohmann::ordered_json::parse(payload.begin(), payload.end());
+      header["start_tick"] = 480;
+      const std::string text = header.dump();
+      payload.assign(text.begin(), text.end());
+    }
+    append_chunk(rebuilt, static_cast<ChunkType>(chunk.type), chunk.sequence, payload);
+  }
+  Result<Recording> r = Recording::from_bytes(rebuilt, "mid.rsrec");
+  ASSERT_TRUE(r) << r.error();
+  ASSERT_EQ(r->header().start_tick, 480);
+  const Result<std::unique_ptr<Replayer>> replayer = Replayer::create(*r);
+  ASSERT_FALSE(replayer);
+  EXPECT_NE(replayer.error().find("mid.rsrec starts at tick 480 (recorded from mid-session)"), std::string::npos) << replayer.error();
+  EXPECT_NE(replayer.error().find("--record"), std::string::npos) << replayer.error();
+}
+
 // Two recordings joined (`cat a b > c`): the second's chunks would pass for the first's, so the file
 // reads as the first recording with a content error, and recovering it keeps only the first.
 TEST(RecordingFile, ASecondRecordingJoinedOnIsLeftOutAndNamed) {
