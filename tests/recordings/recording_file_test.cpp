@@ -269,10 +269,10 @@ namespace {
 // decode is refused by file, keyframe and chunk, so a user can find it; the others still decode.
 TEST(RecordingFile, AKeyframeThatDoesNotDecodeIsNamedByFileAndChunk) {
   const std::vector<std::uint8_t>& file = testing::short_recording().file;
-  Result<Recording> intact = Recording::from_bytes(file, "session.rrec");
+  Result<Recording> intact = Recording::from_bytes(file, "session.rsrec");
   ASSERT_TRUE(intact) << intact.error();
   ASSERT_GE(intact->keyframes().size(), 3u);
-  EXPECT_EQ(intact->decode_keyframe(999).error(), "session.rrec: keyframe 999 does not exist (" + std::to_string(intact->keyframes().size()) + " recorded)");
+  EXPECT_EQ(intact->decode_keyframe(999).error(), "session.rsrec: keyframe 999 does not exist (" + std::to_string(intact->keyframes().size()) + " recorded)");
   const std::size_t k = 1;
   const std::span<const std::uint8_t> draco = intact->keyframe_draco(k);
   const auto draco_at = static_cast<std::size_t>(draco.data() - intact->bytes().data());
@@ -286,13 +286,13 @@ TEST(RecordingFile, AKeyframeThatDoesNotDecodeIsNamedByFileAndChunk) {
                  std::span<const std::uint8_t>(damaged.data() + chunk.payload_offset(), chunk.payload_bytes));
   }
   rebuilt.insert(rebuilt.end(), file.begin() + static_cast<std::ptrdiff_t>(scan.chunks.back().end()), file.end());
-  Result<Recording> r = Recording::from_bytes(rebuilt, "session.rrec");
+  Result<Recording> r = Recording::from_bytes(rebuilt, "session.rsrec");
   ASSERT_TRUE(r) << r.error();
   ASSERT_TRUE(r->damaged().empty());
   const ChunkLocation& chunk = r->chunks()[r->keyframes()[k].chunk];
   const Result<SurfaceFrame> frame = r->decode_keyframe(k);
   ASSERT_FALSE(frame);
-  const std::string place = "session.rrec: keyframe 1 (chunk " + std::to_string(chunk.sequence) + " at byte " + std::to_string(chunk.offset) + "): ";
+  const std::string place = "session.rsrec: keyframe 1 (chunk " + std::to_string(chunk.sequence) + " at byte " + std::to_string(chunk.offset) + "): ";
   EXPECT_EQ(frame.error().substr(0, place.size()), place) << frame.error();
   EXPECT_TRUE(r->decode_keyframe(0));
   EXPECT_TRUE(r->decode_keyframe(2));
