@@ -4,6 +4,7 @@
 // negative number silently; a header read from a damaged or hand-edited recording needs both named.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -60,6 +61,20 @@ class JsonFields {
       if (!value.is_string()) fail(where, std::string("must be a string, not ") + value.type_name());
       return value.get<std::string>();
     }
+  }
+
+  /// The field `key`, an array of exactly N numbers.
+  template <std::size_t N>
+  std::array<double, N> numbers(const char* key) const {
+    const nlohmann::ordered_json& value = at(key);
+    const std::string where = path_of(key);
+    if (!value.is_array() || value.size() != N) fail(where, "must be an array of " + std::to_string(N) + " numbers");
+    std::array<double, N> out{};
+    for (std::size_t i = 0; i < N; ++i) {
+      if (!value[i].is_number()) fail(where + "[" + std::to_string(i) + "]", std::string("must be a number, not ") + value[i].type_name());
+      out[i] = value[i].get<double>();
+    }
+    return out;
   }
 
   /// The field `key`, itself an object.

@@ -2,6 +2,7 @@
 // config without a line here shows up as a replay mismatch in the end-to-end test, never silently.
 #include "recordings/session_header.h"
 
+#include <array>
 #include <string>
 
 #include "recordings/chunk_format.h"
@@ -12,33 +13,21 @@ namespace {
 
 using nlohmann::ordered_json;
 
-/// Element i of the array j (named `where`), which must be a number.
-double number_at(const ordered_json& j, std::size_t i, const std::string& where) {
-  const ordered_json& value = j[i];
-  if (!value.is_number()) JsonFields::fail(where + "[" + std::to_string(i) + "]", std::string("must be a number, not ") + value.type_name());
-  return value.get<double>();
-}
-
 ordered_json pose_json(const RigidPose& pose) {
   const std::array<double, 12> m = to_row_major_3x4(pose);
   return ordered_json(std::vector<double>(m.begin(), m.end()));
 }
 
-RigidPose pose_from(const ordered_json& j, const std::string& where) {
-  if (!j.is_array() || j.size() != 12) JsonFields::fail(where, "a pose needs 12 numbers");
+RigidPose pose_from(const std::array<double, 12>& m) {
   RigidPose pose;
   for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) pose.rotation[c][r] = number_at(j, static_cast<std::size_t>(r * 4 + c), where);
-    pose.translation[r] = number_at(j, static_cast<std::size_t>(r * 4 + 3), where);
+    for (int c = 0; c < 3; ++c) pose.rotation[c][r] = m[static_cast<std::size_t>(r * 4 + c)];
+    pose.translation[r] = m[static_cast<std::size_t>(r * 4 + 3)];
   }
   return pose;
 }
 
 ordered_json vec_json(const Vec3& v) { return ordered_json::array({v.x, v.y, v.z}); }
-Vec3 vec_from(const ordered_json& j, const std::string& where) {
-  if (!j.is_array() || j.size() != 3) JsonFields::fail(where, "a vector needs 3 numbers");
-  return Vec3(number_at(j, 0, where), number_at(j, 1, where), number_at(j, 2, where));
-}
 
 ordered_json config_json(const SimulationConfig& c) {
   ordered_json parameters = ordered_json::object();
@@ -85,8 +74,9 @@ SimulationConfig config_from(const JsonFields& j) {
     if (Status set = c.parameters.set(*id, parameters.get<double>(key.c_str())); !set) JsonFields::fail(parameters.path_of(key), set.error());
   }
   const JsonFields gimbal = j.object("gimbal");
-  c.gimbal.pivot_m = vec_from(gimbal.at("pivot_m"), gimbal.path_of("pivot_m"));
-  c.gimbal.device_to_world = pose_from(gimbal.at("device_to_world"), gimbal.path_of("device_to_world"));
+  const std::array<double, 3> pivot = gimbal.numbers<3>("pivot_m");
+  c.gimbal.pivot_m = Vec3(pivot[0], pivot[1], pivot[2]);
+  c.gimbal.device_to_world = pose_from(gimbal.numbers<12>("device_to_world"));
   c.max_tet_volume_m3 = j.get<double>("max_tet_volume_m3");
   const JsonFields f = j.object("input_filter");
   c.input_filter.min_cutoff_hz = f.get<double>("min_cutoff_hz");
@@ -168,9 +158,8 @@ Result<SessionHeader> header_from_json(std::string_view text) {
     h.keyframe_every_steps = j.get<int>("keyframe_every_steps");
     if (h.keyframe_every_steps < 1) JsonFields::fail("keyframe_every_steps", "must be at least 1");
     const JsonFields q = j.object("quantisation");
-    const ordered_json& origin = q.at("origin_m");
-    if (!origin.is_array() || origin.size() != 3) JsonFields::fail(q.path_of("origin_m"), "needs 3 numbers");
-    for (std::size_t i = 0; i < 3; ++i) h.grid.origin[i] = static_cast<float>(number_at(origin, i, q.path_of("origin_m")));
+    const std::array<double, 3> origin = q.numbers<3>("origin_m");
+    for (std::size_t i = 0; i < 3; ++i) h.grid.origin[i] = static_cast<float>(origin[i]);
     h.grid.range = q.get<float>("range_m");
     h.grid.bits = q.get<int>("bits");
     if (h.grid.bits < 1 || h.grid.bits > 30 || !(h.grid.range > 0.0f)) JsonFields::fail("quantisation", "bad grid (bits 1 to 30, a positive range)");

@@ -539,8 +539,9 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
   // as their corners have moved from where the search saw them. That displacement is far smaller
   // than the tissue's travel since the search, a sum over steps of the fastest node anywhere, which
   // counts every oscillation; the scans below stop sooner with it, and choose the same faces.
-  double faces_moved = tissue_travel_m - candidates_travel_m_;
-  if (clearance_skipping_ && distances_valid_ && vertex_count_ > 0) faces_moved = std::min(faces_moved, corners_moved(x));
+  // Measured at the first vertex its certificate does not skip: a step where all are skipped scans none.
+  double faces_moved = 0.0;
+  bool faces_measured = false;
   for (std::size_t i = 0; i < vertex_count_; ++i) {
     const PointCandidates& pc = vertex_candidates_[i];
     const Part& part = parts_[pc.part];
@@ -552,6 +553,11 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
     }
     // The vertex's own motion and its faces' since the search.
     const double* searched = clearance_skipping_ && distances_valid_ ? &pair_distance_[pc.first] : nullptr;
+    if (!faces_measured) {
+      faces_moved = tissue_travel_m - candidates_travel_m_;
+      if (searched != nullptr) faces_moved = std::min(faces_moved, corners_moved(x));
+      faces_measured = true;
+    }
     const Closest best = nearest_tissue_face(x.data(), surface_triangles, w, &pair_triangles_[pc.first], pc.count, searched,
                                              glm::length(w - pc.searched_at) + faces_moved);
     clearance = certify(best, w, tissue_travel_m);

@@ -265,6 +265,22 @@ TEST(SessionHeaderJson, NamesTheFieldAtFault) {
 namespace resecto::rec {
 namespace {
 
+/// The file with every chunk's payload passed through `rewrite` and framed afresh (new lengths and
+/// CRCs), then the trailer as it was: damage or edits that the chunk layer cannot see.
+template <class Rewrite>
+std::vector<std::uint8_t> with_payloads_rewritten(const std::vector<std::uint8_t>& file, Rewrite rewrite) {
+  const ChunkScan scan = scan_chunks(file);
+  std::vector<std::uint8_t> out(file.begin(), file.begin() + static_cast<std::ptrdiff_t>(scan.chunks.front().offset));
+  for (const ChunkLocation& chunk : scan.chunks) {
+    std::vector<std::uint8_t> payload(file.begin() + static_cast<std::ptrdiff_t>(chunk.payload_offset()),
+                                      file.begin() + static_cast<std::ptrdiff_t>(chunk.payload_offset() + chunk.payload_bytes));
+    rewrite(chunk, payload);
+    append_chunk(out, static_cast<ChunkType>(chunk.type), chunk.sequence, payload);
+  }
+  out.insert(out.end(), file.begin() + static_cast<std::ptrdiff_t>(scan.chunks.back().end()), file.end());
+  return out;
+}
+
 // A keyframe whose chunk is intact (its CRC recomputed over the damage) but whose Draco bytes do not
 // decode is refused by file, keyframe and chunk, so a user can find it; the others still decode.
 TEST(RecordingFile, AKeyframeThatDoesNotDecodeIsNamedByFileAndChunk) {
@@ -276,16 +292,11 @@ TEST(RecordingFile, AKeyframeThatDoesNotDecodeIsNamedByFileAndChunk) {
   const std::size_t k = 1;
   const std::span<const std::uint8_t> draco = intact->keyframe_draco(k);
   const auto draco_at = static_cast<std::size_t>(draco.data() - intact->bytes().data());
-  std::vector<std::uint8_t> damaged = file;
-  std::fill(damaged.begin() + static_cast<std::ptrdiff_t>(draco_at + draco.size() / 4), damaged.begin() + static_cast<std::ptrdiff_t>(draco_at + draco.size()), 0xA5);
-  // The same chunks with the damaged payload and fresh CRCs, then the trailer as it was.
-  const ChunkScan scan = scan_chunks(file);
-  std::vector<std::uint8_t> rebuilt(file.begin(), file.begin() + static_cast<std::ptrdiff_t>(scan.chunks.front().offset));
-  for (const ChunkLocation& chunk : scan.chunks) {
-    append_chunk(rebuilt, static_cast<ChunkType>(chunk.type), chunk.sequence,
-                 std::span<const std::uint8_t>(damaged.data() + chunk.payload_offset(), chunk.payload_bytes));
-  }
-  rebuilt.insert(rebuilt.end(), file.begin() + static_cast<std::ptrdiff_t>(scan.chunks.back().end()), file.end());
+  const std::vector<std::uint8_t> rebuilt = with_payloads_rewritten(file, [&](const ChunkLocation& chunk, std::vector<std::uint8_t>& payload) {
+    if (draco_at < chunk.payload_offset() || draco_at >= chunk.payload_offset() + chunk.payload_bytes) return;
+    const std::size_t from = draco_at - chunk.payload_offset();
+    std::fill(payload.begin() + static_cast<std::ptrdiff_t>(from + draco.size() / 4), payload.begin() + static_cast<std::ptrdiff_t>(from + draco.size()), 0xA5);
+  });
   Result<Recording> r = Recording::from_bytes(rebuilt, "session.rsrec");
   ASSERT_TRUE(r) << r.error();
   ASSERT_TRUE(r->damaged().empty());
@@ -301,20 +312,14 @@ TEST(RecordingFile, AKeyframeThatDoesNotDecodeIsNamedByFileAndChunk) {
 // A recording whose header starts past tick 0 (the console's record button, mid-session) holds no
 // state to re-simulate from: replay refuses it by name and says what still works.
 TEST(RecordingFile, ReplayRefusesARecordingStartedMidSessionAndSaysWhy) {
-  const std::vector<std::uint8_t>& file = testing::short_recording().file;
-  const ChunkScan scan = scan_chunks(file);
-  std::vector<std::uint8_t> rebuilt(file.begin(), file.begin() + static_cast<std::ptrdiff_t>(scan.chunks.front().offset));
-  for (const ChunkLocation& chunk : scan.chunks) {
-    std::vector<std::uint8_t> payload(file.begin() + static_cast<std::ptrdiff_t>(chunk.payload_offset()),
-                                      file.begin() + static_cast<std::ptrdiff_t>(chunk.payload_offset() + chunk.payload_bytes));
-    if (chunk.type == static_cast<std::uint16_t>(ChunkType::kHeader)) {
-      nlohmann::ordered_json header = nlohmann::ordered_json::parse(payload.begin(), payload.end());
-      header["start_tick"] = 480;
-      const std::string text = header.dump();
-      payload.assign(text.begin(), text.end());
-    }
-    append_chunk(rebuilt, static_cast<ChunkType>(chunk.type), chunk.sequence, payload);
-  }
+  const std::vector<std::uint8_t> rebuilt =
+      with_payloads_rewritten(testing::short_recording().file, [](const ChunkLocation& chunk, std::vector<std::uint8_t>& payload) {
+        if (chunk.type != static_cast<std::uint16_t>(ChunkType::kHeader)) return;
+        nlohmann::ordered_json header = nlohmann::ordered_json::parse(payload.begin(), payload.end());
+        header["start_tick"] = 480;
+        const std::string text = header.dump();
+        payload.assign(text.begin(), text.end());
+      });
   Result<Recording> r = Recording::from_bytes(rebuilt, "mid.rsrec");
   ASSERT_TRUE(r) << r.error();
   ASSERT_EQ(r->header().start_tick, 480);
