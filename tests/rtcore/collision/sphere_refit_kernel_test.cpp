@@ -156,8 +156,9 @@ std::vector<Sphere> reference_refit(const SphereTree& tree, const TriangleMesh& 
   return spheres;
 }
 
-TEST(SphereRefitKernel, SpheresOnlyRefitGivesTheChildrenFirstSpheresThroughInsertionsAndRemovals) {
-  TriangleMesh mesh = jittered_gland(5);
+/// Removes and inserts random triangles, moves every vertex and refits, `rounds` times: each refit
+/// gives the spheres that a children-first pass of the one-at-a-time functions gives.
+void expect_refit_through_edits(TriangleMesh mesh, int rounds) {
   const std::vector<Vec3> rest = mesh.positions;
   SphereTree tree;
   tree.set_slabs(false);
@@ -169,7 +170,7 @@ TEST(SphereRefitKernel, SpheresOnlyRefitGivesTheChildrenFirstSpheresThroughInser
   int sliced = 0;
   for (const LeafPiece& piece : tree.pieces()) sliced += piece.slices > 1;
   EXPECT_GT(sliced, 0) << "the gland's long thin triangles make sliced leaves, which the refit takes one at a time";
-  for (int round = 0; round < 40; ++round) {
+  for (int round = 0; round < rounds; ++round) {
     for (int edit = 0; edit < 25; ++edit) {
       const std::uint32_t t = pick(random);
       if (in_tree[t]) {
@@ -190,6 +191,24 @@ TEST(SphereRefitKernel, SpheresOnlyRefitGivesTheChildrenFirstSpheresThroughInser
     testing::expect_tree_invariants(tree);
     if (::testing::Test::HasFatalFailure()) return;
   }
+}
+
+TEST(SphereRefitKernel, SpheresOnlyRefitGivesTheChildrenFirstSpheresThroughInsertionsAndRemovals) {
+  const TriangleMesh mesh = jittered_gland(5);
+  SphereTree probe;
+  probe.set_slabs(false);
+  probe.build(mesh);
+  ASSERT_LE(probe.live_node_count(), SphereTree::kRefitWholeTreeNodes) << "a tree refitted whole, a height at a time";
+  expect_refit_through_edits(mesh, 40);
+}
+
+TEST(SphereRefitKernel, ABlockedRefitGivesTheChildrenFirstSpheresThroughInsertionsAndRemovals) {
+  TriangleMesh mesh = generate_prostate(20000).surface;
+  SphereTree probe;
+  probe.set_slabs(false);
+  probe.build(mesh);
+  ASSERT_GT(probe.live_node_count(), SphereTree::kRefitWholeTreeNodes) << "a tree refitted in cache-sized subtrees first";
+  expect_refit_through_edits(std::move(mesh), 6);
 }
 
 }  // namespace
