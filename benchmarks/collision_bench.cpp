@@ -23,6 +23,7 @@
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/base/quantile.h"
 #include "rtcore/collision/collide.h"
+#include "rtcore/collision/parallel_collider.h"
 #include "rtcore/scenes/collision_poses.h"
 
 namespace {
@@ -73,6 +74,8 @@ BenchTool make_bench_tool() {
 }
 
 double elapsed_us(double start_us) { return Clock::now() - start_us; }
+// Wall time, for a query shared by two threads: one thread's CPU time would leave out the other's.
+double wall_now_us() { return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 // Writes poses in the `resecto collide` format, in millimetres (the unit `resecto mesh` writes).
 void write_poses(const std::string& path, const std::vector<RigidPose>& poses) {
@@ -153,6 +156,8 @@ struct Row {
   std::size_t fcl_missing = 0;  // pairs we found that FCL did not
   std::size_t fcl_extra = 0;    // pairs FCL reported that we did not
   std::size_t brute_mismatch = 0;
+  double shared_us = 0;             // the same query on two threads (ParallelCollider), wall time
+  std::size_t shared_mismatch = 0;  // poses whose two-thread pairs differ from the one-thread ones
   double refit_us = 0;
   double fcl_refit_us = 0;
   double insert_us = 0;
@@ -180,12 +185,16 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
   tissue_tree.build(tissue);
   Collider collider = collider_for(tool);
   collider.reserve(1 << 16, 1 << 16);
+  ParallelCollider shared(2);
+  shared.set_method(g_method);
+  shared.prepare_tool(tool);
+  shared.reserve(1 << 16, 1 << 16);
 
-  // Our query and FCL OBBRSS (all contacts), every pose `repetitions` times, alternated pose by pose
+  // Our query (alone, and shared by two threads) and FCL OBBRSS (all contacts), every pose `repetitions` times, alternated pose by pose
   // so that both see the same machine load; the median over all.
   fcl::CollisionObjectd fcl_tissue(fcl_model<fcl::OBBRSSd>(tissue));
   fcl::CollisionObjectd fcl_tool(fcl_model<fcl::OBBRSSd>(tool));
-  std::vector<double> ours, fcl_times;
+  std::vector<double> ours, fcl_times, shared_times;
   std::vector<std::vector<TrianglePair>> ours_found(poses.size());
   double sphere_tests = 0, triangle_tests = 0, leaf_pairs = 0;
   for (int r = 0; r < repetitions; ++r) {
@@ -196,8 +205,12 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
       double t = 0;
       const auto found = fcl_pairs<fcl::OBBRSSd>(fcl_tissue, fcl_tool, poses[p], &t);
       fcl_times.push_back(t);
+      const double shared_start = wall_now_us();
+      shared.collide(tissue_tree, tissue, tool_tree, tool, poses[p]);
+      shared_times.push_back(wall_now_us() - shared_start);
       if (r > 0) continue;
       ours_found[p].assign(collider.pairs().begin(), collider.pairs().end());
+      if (!std::equal(shared.pairs().begin(), shared.pairs().end(), ours_found[p].begin(), ours_found[p].end())) ++row.shared_mismatch;
       sphere_tests += static_cast<double>(collider.stats().sphere_tests);
       triangle_tests += static_cast<double>(collider.stats().triangle_tests);
       leaf_pairs += static_cast<double>(collider.stats().leaf_pairs);
@@ -212,6 +225,7 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
   }
   row.ours_us = quantile(ours, 0.5);
   row.fcl_us = quantile(fcl_times, 0.5);
+  row.shared_us = quantile(shared_times, 0.5);
   row.sphere_tests = sphere_tests / static_cast<double>(poses.size());
   row.triangle_tests = triangle_tests / static_cast<double>(poses.size());
   row.leaf_pairs = leaf_pairs / static_cast<double>(poses.size());
@@ -433,6 +447,15 @@ int run_table(int repetitions, int only_size) {
   }
   std::printf("pairs: summed over the poses; FCL miss/extra: pairs we found that FCL did not / the reverse; brute diff: "
               "poses where our pairs differ from brute force (before and after the deformation refit; must be 0).\n");
+  std::printf("\nthe same poses, alternated with the above: our query shared by two threads (ParallelCollider: the caller's and a "
+              "helper claim the tree's top 64 subtrees), wall time, against the one-thread CPU times above\n");
+  std::printf("%8s | %9s %11s | %9s %7s | %5s\n", "tissue", "ours 1 thr", "ours 2 thr", "FCL", "FCL/", "diff");
+  std::printf("%8s | %9s %11s | %9s %7s | %5s\n", "tris", "CPU us", "wall us", "OBBRSS us", "ours 2", "");
+  for (const Row& row : rows) {
+    std::printf("%8d | %9.1f %11.1f | %9.1f %7.1f | %5zu\n", row.triangles, row.ours_us, row.shared_us, row.fcl_us, row.fcl_us / row.shared_us,
+                row.shared_mismatch);
+  }
+  std::printf("diff: poses whose two-thread pairs differ from the one-thread ones (must be 0).\n");
   std::printf("\nafter a smooth deformation of up to 1.5 mm and a refit (ours: SphereTree::refit; FCL: OBBRSS built at rest, "
               "endUpdateModel(refit, bottom-up)), pairs vs brute force on the deformed surface, summed over the poses:\n");
   std::printf("%8s | %8s | %12s | %12s %10s\n", "tissue", "brute", "ours missing", "FCL missing", "FCL extra");
@@ -481,6 +504,24 @@ void BM_QueryPaperSpheres(benchmark::State& state) { query_case(state, Collision
 BENCHMARK(BM_QueryPaperSpheres)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_QueryDualDescent)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Query)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
+// The tool field's query shared by the caller's thread and a helper (wall time: UseRealTime).
+void BM_QueryTwoThreads(benchmark::State& state) {
+  const ProstateModel gland = generate_prostate(static_cast<int>(state.range(0)));
+  const TriangleMesh tool = combined_resectoscope_mesh(generate_resectoscope());
+  SphereTree tissue_tree, tool_tree;
+  tissue_tree.set_slabs(false);
+  tissue_tree.build(gland.surface);
+  tool_tree.build(tool);
+  const auto poses = pressing_poses();
+  ParallelCollider shared(2);
+  shared.prepare_tool(tool);
+  std::size_t p = 0;
+  for (auto _ : state) {
+    shared.collide(tissue_tree, gland.surface, tool_tree, tool, poses[p++ % poses.size()]);
+    benchmark::DoNotOptimize(shared.pairs().data());
+  }
+}
+BENCHMARK(BM_QueryTwoThreads)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 // The 60 Hz trajectory as a sequence (collide_sequence), frame after frame, looping.
 void BM_Sequence8640(benchmark::State& state) {

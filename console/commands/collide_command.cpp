@@ -19,6 +19,7 @@
 #include "rtcore/base/quantile.h"
 #include "rtcore/base/text_file.h"
 #include "rtcore/collision/collide.h"
+#include "rtcore/collision/parallel_collider.h"
 #include "rtcore/mesh/mesh_io.h"
 
 namespace resecto::cli {
@@ -32,6 +33,7 @@ struct CollideOptions {
   int repeat = 1;
   bool json = false;
   bool sequence = false;  // the poses are consecutive frames: each query reuses the previous one's work
+  int threads = 1;        // 2: each independent query is shared with a helper thread
   std::string method = "field";
 };
 
@@ -68,35 +70,51 @@ void run_collide(const CollideOptions& options) {
   tool_tree.build(tool);
   const double build_ms = std::chrono::duration<double, std::milli>(Clock::now() - build_start).count();
 
+  const CollisionMethod method = dual ? CollisionMethod::kDualDescent : CollisionMethod::kToolField;
   Collider collider;
-  collider.set_method(dual ? CollisionMethod::kDualDescent : CollisionMethod::kToolField);
+  collider.set_method(method);
+  std::unique_ptr<ParallelCollider> shared;  // --threads 2
+  if (options.threads > 1) {
+    shared = std::make_unique<ParallelCollider>(options.threads);
+    shared->set_method(method);
+  }
   double field_ms = 0.0;  // the dual descent builds no field
   if (!dual) {
     const auto field_start = Clock::now();
-    collider.prepare_tool(tool);
+    if (shared) {
+      shared->prepare_tool(tool);
+    } else {
+      collider.prepare_tool(tool);
+    }
     field_ms = std::chrono::duration<double, std::milli>(Clock::now() - field_start).count();
   }
-  collider.reserve(1 << 16, 1 << 18);
+  const auto reserve = [&](std::size_t pairs) {
+    collider.reserve(static_cast<std::int32_t>(pairs), static_cast<std::int32_t>(4 * pairs));
+    if (shared) shared->reserve(static_cast<std::int32_t>(pairs), static_cast<std::int32_t>(4 * pairs));
+  };
+  reserve(1 << 16);
   std::vector<std::vector<TrianglePair>> found(poses.size());
   std::vector<double> times_us;
   times_us.reserve(poses.size() * static_cast<std::size_t>(options.repeat));
   std::size_t most_pairs = 1 << 16;
   const auto query = [&](const RigidPose& pose) {
+    if (shared) return shared->collide(tissue_tree, tissue, tool_tree, tool, pose);
     return options.sequence ? collider.collide_sequence(tissue_tree, tissue, tool_tree, tool, pose)
                             : collider.collide(tissue_tree, tissue, tool_tree, tool, pose);
   };
+  const auto pairs = [&] { return shared ? shared->pairs() : collider.pairs(); };
   for (int r = 0; r < options.repeat; ++r) {
     collider.reset_sequence();  // every repeat runs the sequence from its first frame
     for (std::size_t p = 0; p < poses.size(); ++p) {
       auto start = Clock::now();
       while (!query(poses[p])) {
         most_pairs *= 4;  // more pairs than room: grow (off the timed path) and run this pose again
-        collider.reserve(static_cast<std::int32_t>(most_pairs), static_cast<std::int32_t>(4 * most_pairs));
+        reserve(most_pairs);
         collider.reset_sequence();
         start = Clock::now();
       }
       times_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
-      if (r == 0) found[p].assign(collider.pairs().begin(), collider.pairs().end());
+      if (r == 0) found[p].assign(pairs().begin(), pairs().end());
     }
   }
   std::size_t total_pairs = 0;
@@ -122,6 +140,7 @@ void run_collide(const CollideOptions& options) {
         {"poses", poses.size()},
         {"repeat", options.repeat},
         {"sequence", options.sequence},
+        {"threads", options.threads},
         {"method", options.method},
         {"pairs", total_pairs},
         {"build_ms", build_ms},
@@ -136,7 +155,7 @@ void run_collide(const CollideOptions& options) {
   std::printf("poses             %zu x %d repeats%s\n", poses.size(), options.repeat,
               options.sequence ? " (consecutive frames: --sequence)" : "");
   std::printf("pairs             %zu (over all poses)\n", total_pairs);
-  std::printf("method            %s\n", dual ? "dual descent (the paper's)" : "tool field");
+  std::printf("method            %s%s\n", dual ? "dual descent (the paper's)" : "tool field", shared ? ", shared by two threads" : "");
   std::printf("tree build        %.3f ms\n", build_ms);
   if (!dual) std::printf("tool field build  %.3f ms (once per tool)\n", field_ms);
   std::printf("query             median %.1f us, p95 %.1f us\n", median, p95);
@@ -155,13 +174,21 @@ void register_collide(CLI::App& app) {
   cmd->add_flag("--sequence", options->sequence,
                 "Treat the poses as consecutive frames of one motion and reuse each query's work in the next "
                 "(same pairs; without it every pose is independent)");
+  cmd->add_option("--threads", options->threads,
+                  "1: every query on one thread (the default); 2: each independent query shared with a helper thread "
+                  "(same pairs; not with --sequence, whose reuse runs on one thread)")
+      ->check(CLI::Range(1, 2))
+      ->capture_default_str();
   cmd->add_option("--method", options->method,
                   "field: the tissue's sphere tree against the tool's precomputed field (the default); "
                   "dual-descent: the paper's descent of both sphere trees (same pairs)")
       ->check(CLI::IsMember({"field", "dual-descent"}))
       ->capture_default_str();
   cmd->add_flag("--json", options->json, "Print one JSON object instead of text");
-  cmd->callback([options] { run_collide(*options); });
+  cmd->callback([options] {
+    if (options->sequence && options->threads > 1) fail("collide: --threads 2 shares independent queries; --sequence reuses one thread's work, so use one or the other");
+    run_collide(*options);
+  });
 }
 
 const RegisterCommand kRegister{"collide", &register_collide};

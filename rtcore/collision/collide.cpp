@@ -600,6 +600,24 @@ bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue
   return !overflowed_;
 }
 
+bool Collider::collide_claimed(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
+                               const TriangleMesh& tool, const RigidPose& tool_pose, std::span<const std::int32_t> starts,
+                               std::atomic<std::uint32_t>& next) {
+  if (!begin_query(tissue_tree, tool_tree, tool, tool_pose)) return true;
+  tissue_mesh_ = &tissue;
+  // A subtree's leaves are visited as soon as it is walked, so a claim is the whole of its work.
+  for (std::uint32_t k = next.fetch_add(1, std::memory_order_relaxed); k < starts.size(); k = next.fetch_add(1, std::memory_order_relaxed)) {
+    if (method_ == CollisionMethod::kToolField) {
+      descend_field<false>(starts[k]);
+      visit_field_leaves();
+    } else {
+      descend<false>({starts[k], tool_tree.root()});
+    }
+  }
+  finish_query();
+  return !overflowed_;
+}
+
 void Collider::reserve_front(std::int32_t max_front) {
   front_pairs_.resize(static_cast<std::size_t>(std::max(max_front, 1)));
   front_expiry_.resize(front_pairs_.size());

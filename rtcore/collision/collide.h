@@ -6,6 +6,7 @@
 // reads. Runs in the 60 Hz core step, so a query allocates nothing.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -66,6 +67,19 @@ class Collider {
   /// refitted). Pairs come out sorted by (tissue, tool), each once. False on overflow.
   bool collide(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
                const TriangleMesh& tool, const RigidPose& tool_pose);
+
+  /// collide() over part of the tissue tree, so that several Colliders, one per thread, share a
+  /// query: the subtrees under the nodes of `starts`, each run by whichever sharer claims its index
+  /// from `next` first (fetch_add; none is left once it reaches starts.size()). The pairs are those
+  /// of the subtrees this one ran, sorted, each once; the union over the sharers is collide()'s,
+  /// whoever ran which. The same for the leaf lists. False on overflow.
+  bool collide_claimed(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree, const TriangleMesh& tool,
+                       const RigidPose& tool_pose, std::span<const std::int32_t> starts, std::atomic<std::uint32_t>& next);
+  /// Takes the tool field `prepared` built (prepare_tool) rather than building its own.
+  void share_tool(const Collider& prepared) {
+    field_ = prepared.field_;
+    field_tool_ = prepared.field_tool_;
+  }
 
   /// The same pairs as collide() for consecutive poses of one tool against one tissue tree, reusing
   /// the previous call's work (temporal coherence). Every node pair (the field method: every tissue

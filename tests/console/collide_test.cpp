@@ -157,6 +157,26 @@ TEST(CollideCommand, BothMethodsWriteTheSamePairs) {
   EXPECT_NE(unknown.err.find("--method"), std::string::npos) << unknown.err;
 }
 
+// --threads 2: each pose's query shared with a helper thread writes the one thread's pairs, with
+// either method; with --sequence it is refused, saying why.
+TEST(CollideCommand, TwoThreadsWriteTheOneThreadPairs) {
+  const Files f = make_files("collide_threads");
+  const auto one = f.dir / "one.csv";
+  const auto two = f.dir / "two.csv";
+  const auto two_dual = f.dir / "two_dual.csv";
+  ASSERT_EQ(run_resecto(common_args(f) + " --pairs " + one.string()).exit_code, 0);
+  const auto run = run_resecto(common_args(f) + " --threads 2 --repeat 3 --json --pairs " + two.string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(nlohmann::json::parse(run.out)["threads"], 2);
+  EXPECT_EQ(read_text(two), read_text(one));
+  ASSERT_EQ(run_resecto(common_args(f) + " --threads 2 --method dual-descent --pairs " + two_dual.string()).exit_code, 0);
+  EXPECT_EQ(read_text(two_dual), read_text(one));
+  const auto with_sequence = run_resecto(common_args(f) + " --threads 2 --sequence");
+  EXPECT_NE(with_sequence.exit_code, 0);
+  EXPECT_NE(with_sequence.err.find("--sequence"), std::string::npos) << with_sequence.err;
+  EXPECT_NE(run_resecto(common_args(f) + " --threads 3").exit_code, 0);
+}
+
 TEST(CollideCommand, MalformedPosesLineIsNamed) {
   const Files f = make_files("collide_bad_poses");
   std::ofstream(f.poses) << "# header\n1 0 0 0 0 1 0 0 0 0 1 0\n\n1 0 0 0 0 1 zero 0 0 0 1 0\n";

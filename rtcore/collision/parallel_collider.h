@@ -1,0 +1,69 @@
+// One collision query on two threads. The tissue tree's top is cut into a few dozen subtrees; the
+// caller's thread and a helper each run a Collider of their own and claim the subtrees from a shared
+// counter, whole (walk and exact tests), until none is left; their sorted pairs are merged. A rigid
+// tool's pairs are spread over the gland along the whole sheath, so the claims even out the work
+// without a schedule worked out in advance. Which thread ran which subtree changes no pair.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "rtcore/collision/collide.h"
+#include "rtcore/concurrency/job_thread.h"
+
+namespace resecto {
+
+class ParallelCollider {
+ public:
+  /// `threads`: 1 runs every query on the caller's thread; 2 adds a helper thread that shares it.
+  explicit ParallelCollider(int threads = 2);
+  ParallelCollider(const ParallelCollider&) = delete;
+  ParallelCollider& operator=(const ParallelCollider&) = delete;
+
+  int threads() const { return helper_ ? 2 : 1; }
+  /// Collider::set_method for both threads' colliders.
+  void set_method(CollisionMethod method);
+  /// Collider::reserve for each thread's share (each may find every pair).
+  void reserve(std::int32_t max_pairs, std::int32_t max_tested_pairs);
+  /// Builds the tool's field once, for both threads (Collider::prepare_tool).
+  void prepare_tool(const TriangleMesh& tool);
+
+  /// Collider::collide's pairs: sorted by (tissue, tool), each once. False on overflow.
+  bool collide(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree, const TriangleMesh& tool,
+               const RigidPose& tool_pose);
+  std::span<const TrianglePair> pairs() const { return {pairs_.data(), pair_count_}; }
+  /// Both threads' work counters, summed.
+  const CollisionStats& stats() const { return stats_; }
+
+ private:
+  /// The nodes kSplitDepth below the root (or leaves above it), depth first: the claims.
+  void split(const SphereTree& tissue_tree);
+  void run_share(int share);
+
+  static constexpr int kSplitDepth = 6;  // up to 64 subtrees: far more than two threads need to even out
+  Collider colliders_[2];
+  std::vector<std::int32_t> starts_;
+  struct Pending {
+    std::int32_t node, depth;
+  };
+  std::vector<Pending> walk_;  // split()'s: at most one pending node per level and one more
+  std::atomic<std::uint32_t> next_{0};
+  // The query the helper shares, written before its launch.
+  struct Query {
+    const SphereTree* tissue_tree = nullptr;
+    const TriangleMesh* tissue = nullptr;
+    const SphereTree* tool_tree = nullptr;
+    const TriangleMesh* tool = nullptr;
+    RigidPose pose;
+  } query_;
+  bool share_ok_[2] = {true, true};
+  std::vector<TrianglePair> pairs_;
+  std::size_t pair_count_ = 0;
+  CollisionStats stats_;
+  std::unique_ptr<JobThread> helper_;  // last: its thread starts once the rest exists
+};
+
+}  // namespace resecto
