@@ -151,7 +151,9 @@ RaisedThreads raise_simulation_threads(Simulation& sim) {
 
 void Simulation::prepare_for_tick() {
   waited_ = true;
-  if (physics_helper_free()) physics_helper_->call_in();
+  // Called in ahead of the tick, the helper spins until the loops come: only while the collision
+  // job does not need its processor (step() calls it in for the loops alone beside the job).
+  if (physics_helper_allowed() && !collision_job_running()) physics_helper_->call_in();
 }
 
 void Simulation::place_tool(const TickInput& input) {
@@ -210,18 +212,27 @@ void Simulation::step(const TickInput& input, std::span<const ParameterCommand> 
   if (collision_tick) advance_collision_pipeline(tick, profiler);
   {
     RESECTO_PROFILE_STAGE(profiler, Stage::kPhysics, tick);
-    // The helper shares this step's loops only while the collision job is not running: on a
-    // two-core machine they would share a core, and the job must finish within its period (helping
-    // during its first ticks too only moved the slow unhelped ticks later and made jobs overrun).
-    // Who runs a loop's chunks changes no bit of the state.
+    // On a two-core machine the helper and the collision job share the second processor, and the
+    // job must finish within its period. Beside the running job the helper is called in for this
+    // step's loops alone and sent home after them: spinning at its priority before and between
+    // ticks, as it does otherwise, it held the job's processor and the job overran (session 10's
+    // and 13's runs), while steps without the helper were the ticks that missed their deadlines.
+    // In the second half of the period a job still running (a cut's topology update) has the
+    // processor to itself. Who runs a loop's chunks changes no bit of the state.
+    const bool beside_job = collision_job_running();
     if (physics_helper_) {
-      const bool helped = physics_helper_free();
+      const bool job_needs_processor = beside_job && 2 * (tick % static_cast<std::uint64_t>(config_.physics_per_collision)) >=
+                                                         static_cast<std::uint64_t>(config_.physics_per_collision);
+      const bool helped = physics_helper_allowed() && !job_needs_processor;
       waited_ticks_ = (waited_ticks_ << 1) | (waited_ ? 1u : 0u);
       waited_ = false;
+      if (helped && beside_job) physics_helper_->call_in();
       tissue_->share_loops_with(helped ? physics_helper_.get() : nullptr);
       if (!helped) physics_helper_->send_home();  // called in by prepare_for_tick(), not needed after all
     }
     reaction_ = tissue_->physics_step(config_.tick_s());
+    // The second processor goes to the collision job: the one running, or the one this tick starts.
+    if (physics_helper_ && (beside_job || (collision_tick && collision_thread_))) physics_helper_->send_home();
   }
   {
     RESECTO_PROFILE_STAGE(profiler, Stage::kResponse, tick);

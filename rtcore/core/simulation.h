@@ -302,10 +302,11 @@ class Simulation {
   std::uint64_t contact_ticks_ = 0;
   double contact_force_sum_n_ = 0.0;
   ProcedureMetrics metrics_;
-  /// Whether the next physics step may share its loops with the helper (see prepare_for_tick()).
-  bool physics_helper_free() const {
-    return physics_helper_ && (!collision_thread_ || collision_thread_->idle()) && !(paced_ && std::popcount(waited_ticks_) < 16);
-  }
+  /// Whether the next physics step may share its loops with the helper: not while the core is
+  /// overloaded (below).
+  bool physics_helper_allowed() const { return physics_helper_ && !(paced_ && std::popcount(waited_ticks_) < 16); }
+  /// Whether the collision job is running on its thread now (it then needs the second processor).
+  bool collision_job_running() const { return collision_thread_ && !collision_thread_->idle(); }
   // A paced (real-time) core that waited before fewer than half of its last 32 ticks is overloaded:
   // the model is too large for the machine (a catch-up after a stall is a few ticks). It then runs
   // without the helper, which would otherwise hold the second processor too and starve every other
