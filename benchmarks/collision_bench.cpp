@@ -323,6 +323,8 @@ struct SequenceRow {
   std::size_t pairs = 0;
   std::size_t brute_mismatch = 0, fresh_mismatch = 0, fcl_mismatch = 0;
   double kept = 0, renewed = 0;  // front pairs per frame
+  double shared_us = 0;             // the sequence on two threads (ParallelCollider), wall time, median
+  std::size_t shared_mismatch = 0;  // frames whose two-thread pairs differ from the fresh query's
 };
 
 SequenceRow measure_sequence(int target_triangles, const TriangleMesh& tool, const SphereTree& tool_tree,
@@ -338,13 +340,18 @@ SequenceRow measure_sequence(int target_triangles, const TriangleMesh& tool, con
   Collider fresh = collider_for(tool), sequence = collider_for(tool);
   fresh.reserve(1 << 16, 1 << 16);
   sequence.reserve(1 << 16, 1 << 16);
+  ParallelCollider shared(2);
+  shared.set_method(g_method);
+  shared.prepare_tool(tool);
+  shared.reserve(1 << 16, 1 << 16);
   fcl::CollisionObjectd fcl_tissue(fcl_model<fcl::OBBRSSd>(tissue));
   fcl::CollisionObjectd fcl_tool(fcl_model<fcl::OBBRSSd>(tool));
-  std::vector<double> fresh_times, sequence_times, fcl_times;
+  std::vector<double> fresh_times, sequence_times, fcl_times, shared_times;
   std::vector<std::vector<TrianglePair>> fresh_found(frames.size());
-  // Alternated frame by frame, so the three see the same machine load.
+  // Alternated frame by frame, so the four see the same machine load.
   for (int r = 0; r < repetitions; ++r) {
     sequence.reset_sequence();
+    shared.reset_sequence();
     for (std::size_t f = 0; f < frames.size(); ++f) {
       auto start = Clock::now();
       fresh.collide(tissue_tree, tissue, tool_tree, tool, frames[f]);
@@ -355,8 +362,12 @@ SequenceRow measure_sequence(int target_triangles, const TriangleMesh& tool, con
       double t = 0;
       const auto fcl_found = fcl_pairs<fcl::OBBRSSd>(fcl_tissue, fcl_tool, frames[f], &t);
       fcl_times.push_back(t);
+      const double shared_start = wall_now_us();
+      shared.collide_sequence(tissue_tree, tissue, tool_tree, tool, frames[f]);
+      shared_times.push_back(wall_now_us() - shared_start);
       if (r > 0) continue;
       fresh_found[f].assign(fresh.pairs().begin(), fresh.pairs().end());
+      if (!std::equal(shared.pairs().begin(), shared.pairs().end(), fresh_found[f].begin(), fresh_found[f].end())) ++row.shared_mismatch;
       row.pairs += fresh_found[f].size();
       if (!std::equal(sequence.pairs().begin(), sequence.pairs().end(), fresh_found[f].begin(), fresh_found[f].end())) {
         ++row.fresh_mismatch;
@@ -379,6 +390,7 @@ SequenceRow measure_sequence(int target_triangles, const TriangleMesh& tool, con
   row.sequence_mean_us = mean(sequence_times);
   row.fcl_us = quantile(fcl_times, 0.5);
   row.fcl_mean_us = mean(fcl_times);
+  row.shared_us = quantile(shared_times, 0.5);
   row.kept /= static_cast<double>(frames.size());
   row.renewed /= static_cast<double>(frames.size());
   return row;
@@ -394,9 +406,11 @@ int run_sequence_table(int repetitions, int only_size) {
               "ours seq", "FCL", "FCL", "FCL/", "FCL/", "pairs", "brute", "fresh", "FCL", "front", "front");
   std::printf("%8s | %9s | %9s %9s | %9s %9s | %7s %7s | %7s | %5s %5s %5s | %8s %8s\n", "tris", "fresh us", "median",
               "mean", "median", "mean", "seq med", "seq mean", "", "diff", "diff", "diff", "kept", "renewed");
+  std::vector<SequenceRow> rows;
   for (const int size : {1296, 8640, 34560, 138240}) {
     if (only_size > 0 && size != only_size) continue;
-    const SequenceRow row = measure_sequence(size, tool.mesh, tool.tree, frames, size > 40000 ? 3 : repetitions);
+    rows.push_back(measure_sequence(size, tool.mesh, tool.tree, frames, size > 40000 ? 3 : repetitions));
+    const SequenceRow& row = rows.back();
     std::printf("%8d | %9.1f | %9.1f %9.1f | %9.1f %9.1f | %7.1f %7.1f | %7zu | %5zu %5zu %5zu | %8.0f %8.0f\n", row.triangles,
                 row.fresh_us, row.sequence_us, row.sequence_mean_us, row.fcl_us, row.fcl_mean_us, row.fcl_us / row.sequence_us,
                 row.fcl_mean_us / row.sequence_mean_us, row.pairs, row.brute_mismatch, row.fresh_mismatch, row.fcl_mismatch,
@@ -405,6 +419,15 @@ int run_sequence_table(int repetitions, int only_size) {
   }
   std::printf("diff: frames whose sequence pairs differ from brute force / from the fresh query / FCL's (must be 0, 0, 0); "
               "front kept/renewed: cached node pairs per frame whose certificate held / that were walked again.\n");
+  std::printf("\nthe same frames, alternated with the above: the sequence shared by two threads (ParallelCollider: each keeps the "
+              "front of alternate subtrees of the tree's top 64), wall time, against the one-thread CPU times above\n");
+  std::printf("%8s | %9s %11s | %9s %7s | %5s\n", "tissue", "seq 1 thr", "seq 2 thr", "FCL", "FCL/", "diff");
+  std::printf("%8s | %9s %11s | %9s %7s | %5s\n", "tris", "CPU us", "wall us", "median", "seq 2", "");
+  for (const SequenceRow& row : rows) {
+    std::printf("%8d | %9.1f %11.1f | %9.1f %7.1f | %5zu\n", row.triangles, row.sequence_us, row.shared_us, row.fcl_us,
+                row.fcl_us / row.shared_us, row.shared_mismatch);
+  }
+  std::printf("diff: frames whose two-thread pairs differ from the fresh query's (must be 0).\n");
   return 0;
 }
 

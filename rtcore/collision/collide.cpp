@@ -625,7 +625,8 @@ void Collider::reserve_front(std::int32_t max_front) {
 }
 
 bool Collider::collide_sequence(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
-                                const TriangleMesh& tool, const RigidPose& tool_pose, double tissue_travel_m) {
+                                const TriangleMesh& tool, const RigidPose& tool_pose, double tissue_travel_m,
+                                std::span<const std::int32_t> starts) {
   if (!begin_query(tissue_tree, tool_tree, tool, tool_pose)) {
     front_valid_ = false;
     return true;
@@ -657,10 +658,13 @@ bool Collider::collide_sequence(const SphereTree& tissue_tree, const TriangleMes
     front_count_ = 0;
     front_overflowed_ = false;
     travel_ = 0.0;
-    if (field) {
-      descend_field<true>(tissue_tree.root());
-    } else {
-      descend<true>({tissue_tree.root(), tool_tree.root()});
+    const std::int32_t root = tissue_tree.root();
+    for (const std::int32_t start : starts.empty() ? std::span<const std::int32_t>(&root, 1) : starts) {
+      if (field) {
+        descend_field<true>(start);
+      } else {
+        descend<true>({start, tool_tree.root()});
+      }
     }
     fresh_front_count_ = front_count_;
   }

@@ -91,8 +91,11 @@ class Collider {
   /// certificate ran out, and leaf pairs whose bounds met, are walked again. Starts afresh when
   /// either tree's structure changed or the cached pairs grew past twice a fresh descent's. The
   /// leaf lists are those of the walked pairs (a subset of collide()'s); the pairs are the same.
+  /// `starts` (empty: the root) limits the sequence to the subtrees under those tissue nodes, the
+  /// same ones every call, as collide_claimed() limits a query: how two threads share a sequence.
   bool collide_sequence(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
-                        const TriangleMesh& tool, const RigidPose& tool_pose, double tissue_travel_m = 0.0);
+                        const TriangleMesh& tool, const RigidPose& tool_pose, double tissue_travel_m = 0.0,
+                        std::span<const std::int32_t> starts = {});
   /// Forgets the cached front: the next collide_sequence() descends from the roots.
   void reset_sequence() { front_valid_ = false; }
   /// Room for this many cached node pairs (a sequence that needs more starts afresh each call).

@@ -6,6 +6,7 @@ namespace resecto {
 
 ParallelCollider::ParallelCollider(int threads) {
   starts_.reserve(std::size_t{1} << kSplitDepth);
+  for (auto& half : halves_) half.reserve(starts_.capacity());
   walk_.reserve(2 * kSplitDepth + 2);
   if (threads >= 2) helper_ = std::make_unique<JobThread>([this] { run_share(1); });
 }
@@ -43,30 +44,58 @@ void ParallelCollider::split(const SphereTree& tissue_tree) {
   }
 }
 
+void ParallelCollider::reset_sequence() {
+  for (Collider& c : colliders_) c.reset_sequence();
+}
+
 void ParallelCollider::run_share(int share) {
-  share_ok_[share] = colliders_[share].collide_claimed(*query_.tissue_tree, *query_.tissue, *query_.tool_tree, *query_.tool, query_.pose, starts_, next_);
+  Collider& collider = colliders_[share];
+  const Query& q = query_;
+  share_ok_[share] = q.sequence ? collider.collide_sequence(*q.tissue_tree, *q.tissue, *q.tool_tree, *q.tool, q.pose, q.tissue_travel_m,
+                                                            halves_[share])
+                                : collider.collide_claimed(*q.tissue_tree, *q.tissue, *q.tool_tree, *q.tool, q.pose, starts_, next_);
 }
 
 bool ParallelCollider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree, const TriangleMesh& tool,
                                const RigidPose& tool_pose) {
   split(tissue_tree);
-  query_ = {&tissue_tree, &tissue, &tool_tree, &tool, tool_pose};
+  query_ = {&tissue_tree, &tissue, &tool_tree, &tool, tool_pose, false, 0.0};
   next_.store(0, std::memory_order_relaxed);
+  return run_shares();
+}
+
+bool ParallelCollider::collide_sequence(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
+                                        const TriangleMesh& tool, const RigidPose& tool_pose, double tissue_travel_m) {
+  split(tissue_tree);
+  // Alternate subtrees of the depth-first order: neighbours in the gland go to both threads, so a
+  // tool pressing anywhere gives both work. One thread alone runs them all.
+  for (auto& half : halves_) half.clear();
+  for (std::size_t k = 0; k < starts_.size(); ++k) halves_[helper_ ? k % 2 : 0].push_back(starts_[k]);
+  query_ = {&tissue_tree, &tissue, &tool_tree, &tool, tool_pose, true, tissue_travel_m};
+  return run_shares();
+}
+
+bool ParallelCollider::run_shares() {
   share_ok_[1] = true;
-  if (helper_) helper_->launch();  // what was written above is visible to the helper's share
+  // A sequence's second half is empty only for a tree of one node (and an empty list of starts
+  // would mean the whole tree).
+  const bool helper_runs = helper_ && !(query_.sequence && halves_[1].empty());
+  if (helper_runs) helper_->launch();  // what was written above is visible to the helper's share
   run_share(0);
-  if (helper_) helper_->wait();  // and the helper's share is visible here
+  if (helper_runs) helper_->wait();  // and the helper's share is visible here
   // Each share is sorted and holds each pair once; a sliced tissue triangle's leaves may have gone
   // to both, so the merge drops repeats.
   const std::span<const TrianglePair> a = colliders_[0].pairs();
-  const std::span<const TrianglePair> b = helper_ ? colliders_[1].pairs() : std::span<const TrianglePair>{};
+  const std::span<const TrianglePair> b = helper_runs ? colliders_[1].pairs() : std::span<const TrianglePair>{};
   if (pairs_.size() < a.size() + b.size()) pairs_.resize(a.size() + b.size());  // only past every reserve()d size
   const auto end = std::merge(a.begin(), a.end(), b.begin(), b.end(), pairs_.begin());
   pair_count_ = static_cast<std::size_t>(std::unique(pairs_.begin(), end) - pairs_.begin());
   stats_ = colliders_[0].stats();
-  if (helper_) {
+  if (helper_runs) {
     const CollisionStats& h = colliders_[1].stats();
     stats_.sphere_tests += h.sphere_tests;
+    stats_.front_kept += h.front_kept;
+    stats_.front_renewed += h.front_renewed;
     stats_.leaf_pairs += h.leaf_pairs;
     stats_.triangle_tests += h.triangle_tests;
   }

@@ -34,6 +34,12 @@ class ParallelCollider {
   /// Collider::collide's pairs: sorted by (tissue, tool), each once. False on overflow.
   bool collide(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree, const TriangleMesh& tool,
                const RigidPose& tool_pose);
+  /// Collider::collide_sequence's pairs for consecutive poses, each thread keeping the front of its
+  /// own fixed half of the subtrees (alternate ones, so both halves span the gland). False on overflow.
+  bool collide_sequence(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree, const TriangleMesh& tool,
+                        const RigidPose& tool_pose, double tissue_travel_m = 0.0);
+  /// Forgets both threads' fronts (Collider::reset_sequence).
+  void reset_sequence();
   std::span<const TrianglePair> pairs() const { return {pairs_.data(), pair_count_}; }
   /// Both threads' work counters, summed.
   const CollisionStats& stats() const { return stats_; }
@@ -42,10 +48,13 @@ class ParallelCollider {
   /// The nodes kSplitDepth below the root (or leaves above it), depth first: the claims.
   void split(const SphereTree& tissue_tree);
   void run_share(int share);
+  /// Runs both shares (the helper's on its thread) and merges their pairs.
+  bool run_shares();
 
   static constexpr int kSplitDepth = 6;  // up to 64 subtrees: far more than two threads need to even out
   Collider colliders_[2];
   std::vector<std::int32_t> starts_;
+  std::vector<std::int32_t> halves_[2];  // a sequence's: each thread's fixed subtrees
   struct Pending {
     std::int32_t node, depth;
   };
@@ -58,6 +67,8 @@ class ParallelCollider {
     const SphereTree* tool_tree = nullptr;
     const TriangleMesh* tool = nullptr;
     RigidPose pose;
+    bool sequence = false;
+    double tissue_travel_m = 0.0;
   } query_;
   bool share_ok_[2] = {true, true};
   std::vector<TrianglePair> pairs_;

@@ -1,6 +1,6 @@
 // A query shared by two threads gives one Collider's pairs, and brute force's, whoever claims which
-// subtree: both methods, random channel poses, a tree reshaped by removals and insertions, and warm
-// queries that allocate nothing.
+// subtree: both methods, random channel poses, a tree reshaped by removals and insertions, a 60 Hz
+// sequence with each thread's front, and warm queries that allocate nothing.
 #include "rtcore/collision/parallel_collider.h"
 
 #include <gtest/gtest.h>
@@ -78,13 +78,53 @@ TEST(ParallelCollider, ATreeReshapedByRemovalsAndInsertionsIsSplitAsWell) {
   expect_one_colliders_pairs(gland, CollisionMethod::kToolField, 2, 100, 10);
 }
 
+// A 60 Hz sweep along the channel wall, with the tissue's tree edited halfway (its structure then
+// changes and both fronts start afresh): every frame's pairs equal a fresh query's, with one thread
+// and with two, and brute force's now and then.
+void expect_sequence_as_fresh_queries(CollisionMethod method, int threads) {
+  Gland gland;
+  ParallelCollider shared(threads);
+  shared.set_method(method);
+  Collider fresh;
+  fresh.set_method(method);
+  std::int64_t kept = 0;
+  for (int f = 0; f < 120; ++f) {
+    if (f == 60) {
+      for (std::uint32_t t = 0; t < gland.prostate.surface.triangle_count(); t += 7) {
+        gland.tissue_tree.remove_triangle(t);
+        gland.tissue_tree.insert_triangle(gland.prostate.surface, t);
+      }
+    }
+    const RigidPose pose = channel_sweep_pose(f, 0.4);
+    ASSERT_TRUE(shared.collide_sequence(gland.tissue_tree, gland.prostate.surface, gland.tool_tree, gland.tool, pose));
+    ASSERT_TRUE(fresh.collide(gland.tissue_tree, gland.prostate.surface, gland.tool_tree, gland.tool, pose));
+    ASSERT_EQ(pairs_of(shared.pairs()), pairs_of(fresh.pairs())) << "frame " << f << ", " << threads << " threads";
+    if (f % 15 == 0) {
+      ASSERT_EQ(pairs_of(shared.pairs()), collide_brute_force(gland.prostate.surface, gland.tool, pose)) << "frame " << f;
+    }
+    kept += shared.stats().front_kept;
+  }
+  EXPECT_GT(kept, 0) << "the fronts carry certificates from frame to frame";
+}
+
+TEST(ParallelCollider, TwoThreadsFollowASequenceAsFreshQueriesDo) {
+  expect_sequence_as_fresh_queries(CollisionMethod::kToolField, 2);
+  expect_sequence_as_fresh_queries(CollisionMethod::kDualDescent, 2);
+}
+
+TEST(ParallelCollider, OneThreadFollowsASequenceAsFreshQueriesDo) {
+  expect_sequence_as_fresh_queries(CollisionMethod::kToolField, 1);
+}
+
 TEST(ParallelCollider, WarmQueriesAllocateNothing) {
   const Gland gland;
   ParallelCollider shared(2);
   shared.prepare_tool(gland.tool);
   const auto run = [&] {
+    shared.reset_sequence();
     for (int f = 0; f < 60; ++f) {
       ASSERT_TRUE(shared.collide(gland.tissue_tree, gland.prostate.surface, gland.tool_tree, gland.tool, channel_sweep_pose(f, 0.7)));
+      ASSERT_TRUE(shared.collide_sequence(gland.tissue_tree, gland.prostate.surface, gland.tool_tree, gland.tool, channel_sweep_pose(f, 0.7)));
     }
   };
   run();  // warm-up: the buffers take their sizes
