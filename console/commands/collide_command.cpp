@@ -33,7 +33,7 @@ struct CollideOptions {
   int repeat = 1;
   bool json = false;
   bool sequence = false;  // the poses are consecutive frames: each query reuses the previous one's work
-  int threads = 1;        // 2: each independent query is shared with a helper thread
+  int threads = 1;        // 2: each query (or sequence) is shared with a helper thread
   std::string method = "field";
 };
 
