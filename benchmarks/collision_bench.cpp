@@ -61,6 +61,32 @@ Collider collider_for(const TriangleMesh& tool) {
   return collider;
 }
 
+// The same query shared by two threads, set up as collider_for() sets up one.
+void prepare_shared(ParallelCollider& shared, const TriangleMesh& tool) {
+  shared.set_method(g_method);
+  shared.prepare_tool(tool);
+  shared.reserve(1 << 16, 1 << 16);
+}
+
+// One line of a two-thread block beside a table: our one-thread CPU time, the two-thread wall time,
+// FCL's, and the poses or frames whose two-thread pairs differed.
+struct TwoThreadLine {
+  int triangles;
+  double one_us, two_us, fcl_us;
+  std::size_t mismatch;
+};
+void print_two_thread_block(const char* what, const char* one_label, const char* fcl_label, const char* ratio_label,
+                            const std::vector<TwoThreadLine>& lines) {
+  std::printf("\nthe same %s, alternated with the above, shared by two threads (ParallelCollider), wall time, against the "
+              "one-thread CPU times above\n", what);
+  std::printf("%8s | %9s %11s | %9s %7s | %5s\n", "tissue", one_label, "2 threads", "FCL", "FCL/", "diff");
+  std::printf("%8s | %9s %11s | %9s %7s | %5s\n", "tris", "CPU us", "wall us", fcl_label, ratio_label, "");
+  for (const TwoThreadLine& l : lines) {
+    std::printf("%8d | %9.1f %11.1f | %9.1f %7.1f | %5zu\n", l.triangles, l.one_us, l.two_us, l.fcl_us, l.fcl_us / l.two_us, l.mismatch);
+  }
+  std::printf("diff: %s whose two-thread pairs differ from the one-thread ones (must be 0).\n", what);
+}
+
 // The resectoscope and its tree, as every table uses them.
 struct BenchTool {
   TriangleMesh mesh;
@@ -186,9 +212,7 @@ Row measure(int target_triangles, double paper_hz, const TriangleMesh& tool, con
   Collider collider = collider_for(tool);
   collider.reserve(1 << 16, 1 << 16);
   ParallelCollider shared(2);
-  shared.set_method(g_method);
-  shared.prepare_tool(tool);
-  shared.reserve(1 << 16, 1 << 16);
+  prepare_shared(shared, tool);
 
   // Our query (alone, and shared by two threads) and FCL OBBRSS (all contacts), every pose `repetitions` times, alternated pose by pose
   // so that both see the same machine load; the median over all.
@@ -341,9 +365,7 @@ SequenceRow measure_sequence(int target_triangles, const TriangleMesh& tool, con
   fresh.reserve(1 << 16, 1 << 16);
   sequence.reserve(1 << 16, 1 << 16);
   ParallelCollider shared(2);
-  shared.set_method(g_method);
-  shared.prepare_tool(tool);
-  shared.reserve(1 << 16, 1 << 16);
+  prepare_shared(shared, tool);
   fcl::CollisionObjectd fcl_tissue(fcl_model<fcl::OBBRSSd>(tissue));
   fcl::CollisionObjectd fcl_tool(fcl_model<fcl::OBBRSSd>(tool));
   std::vector<double> fresh_times, sequence_times, fcl_times, shared_times;
@@ -419,15 +441,9 @@ int run_sequence_table(int repetitions, int only_size) {
   }
   std::printf("diff: frames whose sequence pairs differ from brute force / from the fresh query / FCL's (must be 0, 0, 0); "
               "front kept/renewed: cached node pairs per frame whose certificate held / that were walked again.\n");
-  std::printf("\nthe same frames, alternated with the above: the sequence shared by two threads (ParallelCollider: each keeps the "
-              "front of alternate subtrees of the tree's top 64), wall time, against the one-thread CPU times above\n");
-  std::printf("%8s | %9s %11s | %9s %7s | %5s\n", "tissue", "seq 1 thr", "seq 2 thr", "FCL", "FCL/", "diff");
-  std::printf("%8s | %9s %11s | %9s %7s | %5s\n", "tris", "CPU us", "wall us", "median", "seq 2", "");
-  for (const SequenceRow& row : rows) {
-    std::printf("%8d | %9.1f %11.1f | %9.1f %7.1f | %5zu\n", row.triangles, row.sequence_us, row.shared_us, row.fcl_us,
-                row.fcl_us / row.shared_us, row.shared_mismatch);
-  }
-  std::printf("diff: frames whose two-thread pairs differ from the fresh query's (must be 0).\n");
+  std::vector<TwoThreadLine> lines;
+  for (const SequenceRow& row : rows) lines.push_back({row.triangles, row.sequence_us, row.shared_us, row.fcl_us, row.shared_mismatch});
+  print_two_thread_block("frames", "seq 1 thr", "median", "seq 2", lines);
   return 0;
 }
 
@@ -470,15 +486,9 @@ int run_table(int repetitions, int only_size) {
   }
   std::printf("pairs: summed over the poses; FCL miss/extra: pairs we found that FCL did not / the reverse; brute diff: "
               "poses where our pairs differ from brute force (before and after the deformation refit; must be 0).\n");
-  std::printf("\nthe same poses, alternated with the above: our query shared by two threads (ParallelCollider: the caller's and a "
-              "helper claim the tree's top 64 subtrees), wall time, against the one-thread CPU times above\n");
-  std::printf("%8s | %9s %11s | %9s %7s | %5s\n", "tissue", "ours 1 thr", "ours 2 thr", "FCL", "FCL/", "diff");
-  std::printf("%8s | %9s %11s | %9s %7s | %5s\n", "tris", "CPU us", "wall us", "OBBRSS us", "ours 2", "");
-  for (const Row& row : rows) {
-    std::printf("%8d | %9.1f %11.1f | %9.1f %7.1f | %5zu\n", row.triangles, row.ours_us, row.shared_us, row.fcl_us, row.fcl_us / row.shared_us,
-                row.shared_mismatch);
-  }
-  std::printf("diff: poses whose two-thread pairs differ from the one-thread ones (must be 0).\n");
+  std::vector<TwoThreadLine> lines;
+  for (const Row& row : rows) lines.push_back({row.triangles, row.ours_us, row.shared_us, row.fcl_us, row.shared_mismatch});
+  print_two_thread_block("poses", "ours 1 thr", "OBBRSS us", "ours 2", lines);
   std::printf("\nafter a smooth deformation of up to 1.5 mm and a refit (ours: SphereTree::refit; FCL: OBBRSS built at rest, "
               "endUpdateModel(refit, bottom-up)), pairs vs brute force on the deformed surface, summed over the poses:\n");
   std::printf("%8s | %8s | %12s | %12s %10s\n", "tissue", "brute", "ours missing", "FCL missing", "FCL extra");

@@ -590,14 +590,18 @@ bool Collider::collide(const SphereTree& tissue_tree, const TriangleMesh& tissue
                        const TriangleMesh& tool, const RigidPose& tool_pose) {
   if (!begin_query(tissue_tree, tool_tree, tool, tool_pose)) return true;
   tissue_mesh_ = &tissue;
-  if (method_ == CollisionMethod::kToolField) {
-    descend_field<false>(tissue_tree.root());
-    visit_field_leaves();
-  } else {
-    descend<false>({tissue_tree.root(), tool_tree.root()});
-  }
+  walk_subtree(tissue_tree.root());
   finish_query();
   return !overflowed_;
+}
+
+void Collider::walk_subtree(std::int32_t start) {
+  if (method_ == CollisionMethod::kToolField) {
+    descend_field<false>(start);
+    visit_field_leaves();
+  } else {
+    descend<false>({start, tool_tree_->root()});
+  }
 }
 
 bool Collider::collide_claimed(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree,
@@ -607,12 +611,7 @@ bool Collider::collide_claimed(const SphereTree& tissue_tree, const TriangleMesh
   tissue_mesh_ = &tissue;
   // A subtree's leaves are visited as soon as it is walked, so a claim is the whole of its work.
   for (std::uint32_t k = next.fetch_add(1, std::memory_order_relaxed); k < starts.size(); k = next.fetch_add(1, std::memory_order_relaxed)) {
-    if (method_ == CollisionMethod::kToolField) {
-      descend_field<false>(starts[k]);
-      visit_field_leaves();
-    } else {
-      descend<false>({starts[k], tool_tree.root()});
-    }
+    walk_subtree(starts[k]);
   }
   finish_query();
   return !overflowed_;

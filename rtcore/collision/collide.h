@@ -137,6 +137,8 @@ class Collider {
   template <bool kRecord>
   void descend(NodePair start);
   void visit_leaves(const NodePair& pair);
+  /// collide()'s walk of the subtree under tissue node `start`, its leaves' exact tests included.
+  void walk_subtree(std::int32_t start);
   // The field method: the tissue's tree alone, in the tool's frame.
   Vec3 to_tool(const Vec3& world) const { return inverse_rotation_ * (world - pose_.translation); }
   double field_gap(std::int32_t tissue_node) const;

@@ -193,21 +193,23 @@ void expect_refit_through_edits(TriangleMesh mesh, int rounds) {
   }
 }
 
-TEST(SphereRefitKernel, SpheresOnlyRefitGivesTheChildrenFirstSpheresThroughInsertionsAndRemovals) {
-  const TriangleMesh mesh = jittered_gland(5);
+/// The live nodes of a spheres-only tree over `mesh`: which refit order the tree gets.
+std::int32_t spheres_only_nodes(const TriangleMesh& mesh) {
   SphereTree probe;
   probe.set_slabs(false);
   probe.build(mesh);
-  ASSERT_LE(probe.live_node_count(), SphereTree::kRefitWholeTreeNodes) << "a tree refitted whole, a height at a time";
+  return probe.live_node_count();
+}
+
+TEST(SphereRefitKernel, SpheresOnlyRefitGivesTheChildrenFirstSpheresThroughInsertionsAndRemovals) {
+  const TriangleMesh mesh = jittered_gland(5);
+  ASSERT_LE(spheres_only_nodes(mesh), SphereTree::kRefitWholeTreeNodes) << "a tree refitted whole, a height at a time";
   expect_refit_through_edits(mesh, 40);
 }
 
 TEST(SphereRefitKernel, ABlockedRefitGivesTheChildrenFirstSpheresThroughInsertionsAndRemovals) {
   TriangleMesh mesh = generate_prostate(20000).surface;
-  SphereTree probe;
-  probe.set_slabs(false);
-  probe.build(mesh);
-  ASSERT_GT(probe.live_node_count(), SphereTree::kRefitWholeTreeNodes) << "a tree refitted in cache-sized subtrees first";
+  ASSERT_GT(spheres_only_nodes(mesh), SphereTree::kRefitWholeTreeNodes) << "a tree refitted in cache-sized subtrees first";
   expect_refit_through_edits(std::move(mesh), 6);
 }
 
