@@ -53,6 +53,7 @@ ordered_json config_json(const SimulationConfig& c) {
             {"cg_tolerance", t.cg_tolerance},
             {"max_substeps", t.max_substeps},
             {"contact_margin_m", t.contact_margin_m},
+            {"contact_reuse_m", t.contact_reuse_m},
             {"contact_capacity",
              {{"max_tissue_nodes", t.contact_capacity.max_tissue_nodes},
               {"max_tool_vertices", t.contact_capacity.max_tool_vertices},
@@ -95,6 +96,8 @@ SimulationConfig config_from(const JsonFields& j) {
   c.tissue.cg_tolerance = t.get<double>("cg_tolerance");
   c.tissue.max_substeps = t.get<int>("max_substeps");
   c.tissue.contact_margin_m = t.get<double>("contact_margin_m");
+  // Recordings made before the search kept its candidates searched at every collision step.
+  c.tissue.contact_reuse_m = t.contains("contact_reuse_m") ? t.get<double>("contact_reuse_m") : 0.0;
   const JsonFields capacity = t.object("contact_capacity");
   c.tissue.contact_capacity.max_tissue_nodes = capacity.get<std::int32_t>("max_tissue_nodes");
   c.tissue.contact_capacity.max_tool_vertices = capacity.get<std::int32_t>("max_tool_vertices");

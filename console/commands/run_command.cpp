@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "console/commands/parameter_options.h"
 #include "console/headless/headless_run.h"
 #include "rtcore/base/atomic_file.h"
+#include "rtcore/base/units.h"
 
 namespace resecto::cli {
 namespace {
@@ -35,6 +37,7 @@ struct RunOptions {
   bool inline_collision = false;
   int physics_threads = default_physics_threads();
   bool raw_input = false;
+  std::optional<double> contact_reuse_mm;  ///< unset: TissueConfig's
   std::int64_t spin_us = kDefaultRealtimeSpinUs;
   std::uint64_t seed = 1;
   std::string calibration;
@@ -89,6 +92,7 @@ void run(const RunOptions& o) {
   options.simulation.collision_thread = !o.inline_collision;
   options.simulation.physics_threads = o.physics_threads;
   options.simulation.input_filter.enabled = !o.raw_input;
+  if (o.contact_reuse_mm) options.simulation.tissue.contact_reuse_m = units::mm_to_m(*o.contact_reuse_mm);
   options.spin_us = o.spin_us;
   options.simulation.parameters = parameters_from_assignments(o.sets);
   if (!o.calibration.empty()) {
@@ -134,6 +138,10 @@ void register_run(CLI::App& app) {
       ->check(CLI::Range(1, 2))
       ->capture_default_str();
   cmd->add_flag("--raw-input", o->raw_input, "Place the tool by the device's raw readings, without the One Euro smoothing");
+  cmd->add_option("--contact-reuse-mm", o->contact_reuse_mm,
+                  "Keep the contact candidates, skipping a collision step's refit and search, while the tool and tissue have moved "
+                  "at most this far since they were searched (0: search every step; default 0.15)")
+      ->check(CLI::Range(0.0, 1.5));
   cmd->add_option("--spin-us", o->spin_us, "Real time: spin this long before each tick instead of sleeping")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();

@@ -244,6 +244,8 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   r["state_hash"] = hex_hash(result.final_hash);
   r["hash_chain"] = hex_hash(chain.value());
   r["collision_steps"] = result.collision_hashes.size();
+  // Steps that kept the candidates in use (the tool and tissue had barely moved) ran no refit or search.
+  r["contact_searches"] = {{"searched", sim.contact_searches()}, {"reused", sim.contact_searches_reused()}};
   r["mode"] = options.realtime ? "realtime" : "batch";
   r["procedure"] = options.procedure.name;
   r["simulated_s"] = static_cast<double>(result.ticks) * tick_s;

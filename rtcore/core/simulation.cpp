@@ -74,6 +74,12 @@ Status SimulationConfig::validate() const {
     std::snprintf(text, sizeof text, "tetrahedron volume bound %g m^3 is neither 0 (none) nor within [1e-11, 1]", max_tet_volume_m3);
     return Error{text};
   }
+  if (!(tissue.contact_reuse_m >= 0.0 && tissue.contact_reuse_m < tissue.contact_margin_m)) {
+    char text[160];
+    std::snprintf(text, sizeof text, "contact reuse shift %g mm is outside [0, the contact margin %g mm)", units::m_to_mm(tissue.contact_reuse_m),
+                  units::m_to_mm(tissue.contact_margin_m));
+    return Error{text};
+  }
   constexpr std::int32_t kLargestContactCapacity = 1 << 22;
   const ToolContactCapacity& capacity = tissue.contact_capacity;
   for (const auto& [name, value] : {std::pair{"max_tissue_nodes", capacity.max_tissue_nodes}, std::pair{"max_tool_vertices", capacity.max_tool_vertices},
@@ -318,8 +324,13 @@ void Simulation::collect_collision_step(std::uint64_t tick, FrameProfiler* profi
     front_ = 1 - front_;
     tissue_ = &edited;
   }
-  tissue_->end_collision_step();
-  published_ = searching_;
+  if (job_reused_) {
+    ++contact_searches_reused_;  // the front's candidates, and the pose they were searched at, stay
+  } else {
+    tissue_->end_collision_step();
+    published_ = searching_;
+    ++contact_searches_;
+  }
   last_cut_ = job_cut_;
   resection_stats_ = resection_->stats();
   search_pending_ = false;
@@ -355,6 +366,15 @@ void Simulation::run_collision_job() {
   job_edited_ = !lag_log_.empty();
   if (job_edited_ && !cut_job_.cutting) other.set_positions(positions);  // a compaction adds no node
   search_timing_.topology_end_ns = FrameProfiler::now_ns();
+  // Temporal coherence: while the tool and the tissue have barely moved from where the front's
+  // candidates were searched, they serve the next window too, and the step skips its refit and
+  // search (most of a collision step's cost). A cut always searches: its faces are new.
+  job_reused_ = !job_edited_ && front.contact_candidates_still_serve();
+  if (job_reused_) {
+    if (!replays) other.rebuild_surface_tree_if_due();
+    search_timing_.refit_end_ns = search_timing_.query_end_ns = FrameProfiler::now_ns();
+    return;
+  }
   MassSpringTissue& searched = job_edited_ ? other : front;
   if (job_edited_) other.take_search_positions();
   // A decayed tree's rebuild costs as much as a cut's edits (about 10 ms at 8640 triangles); both

@@ -1,6 +1,7 @@
 // Simulation: the deterministic core, state(k+1) = step(state(k), input(k), commands(k)). Ticks are
 // physics steps (960 Hz by default); every `physics_per_collision` ticks a collision step refits the
-// tissue's sphere tree and finds the tool's contact candidates (60 Hz), and the state hash is taken.
+// tissue's sphere tree and finds the tool's contact candidates (60 Hz; or keeps the candidates in use
+// while the tool and tissue have barely moved since they were searched), and the state hash is taken.
 // The refit and search of collision step n run alongside the physics ticks up to step n+1, whose tick
 // publishes their candidates: a fixed one-step pipeline, so the result never depends on when the
 // search finishes, or on which thread it ran. Wall-clock time never enters: the profiler only watches.
@@ -193,6 +194,10 @@ class Simulation {
   const ResectionStats& resection_stats() const { return resection_stats_; }
   /// What the last collected collision step's topology update removed and refined.
   const ResectionStep& last_resection_step() const { return last_cut_; }
+  /// Collected collision steps that refitted and searched, and those that kept the candidates in use
+  /// because the tool and tissue had barely moved since they were searched (TissueConfig::contact_reuse_m).
+  std::uint64_t contact_searches() const { return contact_searches_; }
+  std::uint64_t contact_searches_reused() const { return contact_searches_reused_; }
   /// Waits for the collision step in flight and takes in its result (the edited copy becomes the
   /// front, the candidates are published, the resection metrics renewed), so that tissue(),
   /// resection() and metrics() agree: call once a run ends, before reading the tissue it left.
@@ -264,6 +269,7 @@ class Simulation {
   CutJob cut_job_;
   // Written by the job, read after the wait.
   bool job_edited_ = false;
+  bool job_reused_ = false;  // the front's published candidates serve on (no refit or search ran)
   ResectionStep job_cut_;
   ResectionStats resection_stats_;  // the core's copy, taken at each collection
   SweptVolume sweep_;
@@ -279,6 +285,7 @@ class Simulation {
   };
   SearchTiming search_timing_;
   bool search_pending_ = false;  ///< a collision step's candidates await publishing
+  std::uint64_t contact_searches_ = 0, contact_searches_reused_ = 0;
   int sheath_part_ = 0;
   int loop_part_ = 0;
   std::size_t tetrahedra_ = 0;

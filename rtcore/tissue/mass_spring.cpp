@@ -191,7 +191,27 @@ void MassSpringTissue::rebuild_surface_tree() {
   surface_tree_edited_ = false;
 }
 
-void MassSpringTissue::search_contact_candidates() { tool_.search_candidates(surface_tree_, surface_); }
+void MassSpringTissue::search_contact_candidates() {
+  tool_.search_candidates(surface_tree_, surface_);
+  searched_positions_.assign(surface_.positions.begin(), surface_.positions.begin() + static_cast<std::ptrdiff_t>(x_.size()));  // reserved
+}
+
+bool MassSpringTissue::contact_candidates_still_serve() const {
+  // The tool's shift first (a few hundred vertices); the tissue's, a pass over the nodes, only if needed.
+  // The tool may take only a third of the allowance: a tool that moves needs the margin for its own
+  // motion (at the turn of a fast stroke it is slow for a moment, and then fast again), while the
+  // tissue's jitter under a resting tool is small and local.
+  if (!(config_.contact_reuse_m > 0.0)) return false;
+  const double tool_shift = tool_.tool_shift_since_search();
+  if (!(3.0 * tool_shift <= config_.contact_reuse_m) || searched_positions_.size() != x_.size()) return false;
+  double tissue_shift2 = 0.0;
+  for (std::size_t n = 0; n < searched_positions_.size(); ++n) {
+    const Vec3 d = surface_.positions[n] - searched_positions_[n];
+    tissue_shift2 = std::max(tissue_shift2, glm::dot(d, d));
+  }
+  // Rounded up, as the tissue's travel is: the sum bounds how much nearer any pair can have come.
+  return tool_shift + std::sqrt(tissue_shift2) * (1.0 + 1e-9) + 1e-15 <= config_.contact_reuse_m;
+}
 
 void MassSpringTissue::end_collision_step() {
   tool_.publish_candidates();

@@ -41,6 +41,11 @@ struct TissueConfig {
   double cg_tolerance = 1e-4;          ///< relative residual at which CG stops
   int max_substeps = 4096;             ///< cap of kSubsteppedSymplectic; hitting it is flagged
   double contact_margin_m = 0.0015;
+  /// Temporal coherence of the contact search: a collision step whose tool and tissue have moved at
+  /// most this far together from where the published candidates were searched (the tool's vertices
+  /// at most a third of it: contact_candidates_still_serve) keeps them instead of refitting and
+  /// searching again, its margin short by that much. 0: every collision step searches.
+  double contact_reuse_m = 0.0003;
   ToolContactCapacity contact_capacity;
   /// Steps the nodes in locality order (node_order.h) rather than the mesh's; off only to measure
   /// what the order buys.
@@ -120,6 +125,10 @@ class MassSpringTissue {
   /// Publishes the search's candidates to the physics steps; call between physics steps once the
   /// search has finished.
   void end_collision_step();
+  /// Whether the published candidates still serve the query begin_collision_step() latched, so the
+  /// collision step may skip its refit and search (TissueConfig::contact_reuse_m). May run beside
+  /// physics steps, like the search.
+  bool contact_candidates_still_serve() const;
   /// One physics step of h_s seconds (default 1/960 s). Returns the reaction on the tool.
   ToolReaction physics_step(double h_s);
   /// Shares the physics step's spring and node loops with `helper` (nullptr: this thread alone).
@@ -272,6 +281,9 @@ class MassSpringTissue {
 
   // Hot, per node.
   std::vector<Vec3> x_, v_, rest_, force_;
+  // The positions the last contact search read (the surface's, taken by begin_collision_step, which
+  // the next one overwrites): how far the tissue has moved since decides whether its candidates serve on.
+  std::vector<Vec3> searched_positions_;
   // The physics step's node loops run in chunks of this many nodes, shared with helper_ if set.
   static constexpr std::size_t kNodesPerChunk = 512;
   LoopHelper* helper_ = nullptr;

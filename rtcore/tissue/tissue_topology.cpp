@@ -46,6 +46,7 @@ void MassSpringTissue::reserve_topology(std::size_t node_capacity, std::size_t t
     for (auto* vec : {&cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_dv_}) vec->reserve(node_capacity);
   }
   surface_.positions.reserve(node_capacity);
+  searched_positions_.reserve(node_capacity);
 
   // Springs and faces in proportion to the tetrahedra's room (a tetrahedral mesh has about 1.2
   // edges per tetrahedron; a surface a fraction of its faces).

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include <glm/common.hpp>
@@ -322,6 +323,11 @@ void ToolContacts::publish_candidates() {
   std::swap(pair_distance_, search_.pair_distance);
   candidates_travel_m_ = query_tissue_travel_m_;  // latched for that search; the next latch comes after
   distances_valid_ = true;
+  published_ = true;
+  for (Part& part : parts_) {
+    part.published_pose = part.query_pose;
+    part.published_enabled = part.query_enabled;
+  }
   node_count_ = search_.node_count;
   vertex_count_ = search_.vertex_count;
   pair_count_ = search_.pair_count;
@@ -333,6 +339,22 @@ void ToolContacts::publish_candidates() {
   const std::int32_t penetrating = stats_.penetrating;
   stats_ = search_.stats;
   stats_.penetrating = penetrating;
+}
+
+double ToolContacts::tool_shift_since_search() const {
+  constexpr double kNever = std::numeric_limits<double>::infinity();
+  if (!published_ || !distances_valid_) return kNever;
+  double tool_shift2 = 0.0;
+  for (const Part& part : parts_) {
+    if (part.query_enabled != part.published_enabled) return kNever;
+    if (!part.query_enabled) continue;
+    for (const Vec3& v : part.mesh.positions) {
+      const Vec3 d = part.query_pose.apply_point(v) - part.published_pose.apply_point(v);
+      tool_shift2 = std::max(tool_shift2, glm::dot(d, d));
+    }
+  }
+  // Rounded up, as the tissue's travel is: the shift only ever bounds a distance from above.
+  return std::sqrt(tool_shift2) * (1.0 + 1e-9) + 1e-15;
 }
 
 void ToolContacts::search_candidates(const SphereTree& tissue_tree, const TriangleMesh& surface) {

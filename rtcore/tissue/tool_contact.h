@@ -94,6 +94,11 @@ class ToolContacts {
   void search_candidates(const SphereTree& tissue_tree, const TriangleMesh& surface);
   /// Makes the last search's candidates the ones add_forces() uses (a swap: no allocation).
   void publish_candidates();
+  /// How far the latched query poses have moved the tool from where the published candidates were
+  /// searched: the largest displacement of an enabled part's vertex between the two. Infinite when
+  /// nothing was published, a part was enabled or disabled since, or a topology edit voided the
+  /// candidates. Same threading rules as search_candidates().
+  double tool_shift_since_search() const;
 
   /// One substep's penalty forces on the candidate pairs at positions x, velocities v: adds to
   /// `force`, and to the per-node bounds of the contact stiffness and damping the integrator needs.
@@ -159,6 +164,8 @@ class ToolContacts {
     bool enabled = true;
     RigidPose query_pose;  // latched for the search (the search's thread reads only these)
     bool query_enabled = true;
+    RigidPose published_pose;  // the query pose the published candidates were searched at
+    bool published_enabled = false;
   };
   /// A point with its candidate triangles: entries [first, first + count) of pair_triangles_.
   struct PointCandidates {
@@ -221,6 +228,7 @@ class ToolContacts {
   std::vector<double> pair_distance_;
   double candidates_travel_m_ = 0.0;  // the tissue's travel at the published search (its latched one)
   bool distances_valid_ = false;      // false from a topology edit until the next publish
+  bool published_ = false;            // a search's candidates were published
   std::size_t node_count_ = 0, vertex_count_ = 0, pair_count_ = 0;
   // The published search's corners of the tool vertices' candidate faces: how far they have moved
   // bounds how much nearer a vertex's faces can have come since the search.

@@ -1,0 +1,213 @@
+// Temporal coherence of the core's contact search: a collision step whose tool and tissue have
+// barely moved keeps the candidates in use instead of refitting and searching. Kept candidates must
+// still hold every pair that can touch (checked against brute force at the end of every window, when
+// they are stalest), the choice must be the same every run and on either thread, and a tool that
+// keeps moving must go on searching.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <set>
+#include <tuple>
+#include <vector>
+
+#include "rtcore/anatomy/resectoscope.h"
+#include "rtcore/core/simulation.h"
+#include "rtcore/geometry/closest_point.h"
+
+namespace resecto {
+namespace {
+
+SimulationConfig small_config() {
+  SimulationConfig config;
+  config.prostate_triangles = 1296;
+  return config;
+}
+
+/// A hand that inserts the sheath (fast), holds it still, then creeps in and rolls slowly, the loop
+/// out: a trainee looking before a stroke. The pedal stays up, so no cut forces a search.
+TickInput steady_hand(std::uint64_t tick, double tick_s) {
+  const double t = static_cast<double>(tick) * tick_s;
+  TickInput input;
+  input.tool_present = true;
+  input.joints.insertion_m = 0.130 + 0.030 * std::min(t / 0.6, 1.0) + (t > 1.2 ? 0.004 * (t - 1.2) : 0.0);
+  input.joints.yaw_rad = 0.02;
+  input.joints.roll_rad = t > 1.2 ? 0.2 * (t - 1.2) : 0.0;
+  input.joints.loop_travel_m = 0.004;
+  return input;
+}
+
+/// (part, point, face) of every published candidate pair.
+using PairSet = std::set<std::tuple<int, std::uint32_t, std::uint32_t>>;
+
+/// The pairs of `count` published candidate points, `candidate(i)` the i-th.
+template <class Candidate>
+PairSet pairs_of(std::size_t count, Candidate candidate) {
+  PairSet pairs;
+  for (std::size_t i = 0; i < count; ++i) {
+    const ToolContacts::CandidatePoint c = candidate(i);
+    for (std::uint32_t face : c.faces) pairs.insert({c.part, c.point, face});
+  }
+  return pairs;
+}
+
+double distance2(const Vec3& p, const TriangleMesh& mesh, std::uint32_t face, const std::vector<Vec3>& positions) {
+  const Triangle& t = mesh.triangles[face];
+  const Vec3 q = closest_point_on_triangle(p, positions[t[0]], positions[t[1]], positions[t[2]]);
+  return glm::dot(p - q, p - q);
+}
+
+/// The pairs within `reach` of each other (brute force over every surface node and live face against
+/// every tool face and vertex) that the published candidates miss, as (kind, part, point, face) with
+/// kind 0 for a tissue node against a tool face and 1 for a tool vertex against a tissue face; `near`
+/// gets how many pairs were within reach.
+std::set<std::tuple<int, int, std::uint32_t, std::uint32_t>> missed_pairs(const Simulation& sim, const ResectoscopeModel& tool_model, double reach,
+                                                                         int& near) {
+  const MassSpringTissue& tissue = sim.tissue();
+  const ToolContacts& contacts = tissue.tool();
+  const PairSet nodes = pairs_of(contacts.node_candidate_count(), [&](std::size_t i) { return contacts.node_candidate(i); });
+  const PairSet vertices = pairs_of(contacts.vertex_candidate_count(), [&](std::size_t i) { return contacts.vertex_candidate(i); });
+  const TriangleMesh& surface = tissue.surface();
+  const std::vector<Vec3> x(tissue.positions().begin(), tissue.positions().end());
+  std::set<std::uint32_t> surface_nodes;
+  std::vector<std::uint32_t> live_faces;
+  for (std::size_t s = 0; s < surface.triangles.size(); ++s) {
+    if (tissue.surface_face_owner(s) < 0) continue;
+    live_faces.push_back(static_cast<std::uint32_t>(s));
+    for (std::uint32_t n : surface.triangles[s]) surface_nodes.insert(n);
+  }
+  std::set<std::tuple<int, int, std::uint32_t, std::uint32_t>> missed;
+  const TriangleMesh* parts[] = {&tool_model.sheath, &tool_model.loop};
+  for (int part = 0; part < 2; ++part) {
+    const TriangleMesh& mesh = *parts[part];
+    const RigidPose& pose = contacts.pose(part);
+    for (std::uint32_t n : surface_nodes) {
+      const Vec3 p = pose.inverse_apply_point(x[n]);
+      for (std::uint32_t f = 0; f < mesh.triangle_count(); ++f) {
+        if (distance2(p, mesh, f, mesh.positions) > reach * reach) continue;
+        ++near;
+        if (nodes.count({part, n, f}) == 0) missed.insert({0, part, n, f});
+      }
+    }
+    std::set<std::uint32_t> used;
+    for (const Triangle& t : mesh.triangles) used.insert(t.begin(), t.end());
+    for (std::uint32_t v : used) {
+      const Vec3 w = pose.apply_point(mesh.positions[v]);
+      for (std::uint32_t f : live_faces) {
+        if (distance2(w, surface, f, x) > reach * reach) continue;
+        ++near;
+        if (vertices.count({part, v, f}) == 0) missed.insert({1, part, v, f});
+      }
+    }
+  }
+  return missed;
+}
+
+TEST(ContactReuse, KeptCandidatesMissNoPairThatSearchingEveryStepHolds) {
+  // Two runs in lockstep, one keeping its candidates while the hand holds still or creeps and one
+  // searching at every collision step. At the end of every window, when kept candidates are stalest,
+  // every pair within half a millimetre that the searching run holds, the keeping run holds too;
+  // and keeping changes no bit of the state. (Both miss a few pairs while the sheath is pushed in at
+  // 50 mm/s and the tissue swings with it: motion the margin does not cover, which the metric
+  // contact_margin_exceeded_ticks counts for the tool alone.)
+  SimulationConfig searching_config = small_config();
+  searching_config.tissue.contact_reuse_m = 0.0;
+  auto keeping = Simulation::create(small_config());
+  auto searching = Simulation::create(searching_config);
+  ASSERT_TRUE(keeping) << keeping.error();
+  ASSERT_TRUE(searching) << searching.error();
+  const ResectoscopeModel tool_model = generate_resectoscope();
+  const double h = (*keeping)->config().tick_s();
+  const auto per_collision = static_cast<std::uint64_t>((*keeping)->config().physics_per_collision);
+  constexpr double kReach = 0.0005;
+  int near = 0, checks_in_contact = 0;
+  for (std::uint64_t tick = 0; tick < 2 * 960; ++tick) {
+    (*keeping)->step(steady_hand(tick, h), {});
+    (*searching)->step(steady_hand(tick, h), {});
+    if ((*keeping)->is_collision_tick(tick)) {
+      ASSERT_EQ((*keeping)->state_hash(), (*searching)->state_hash()) << "tick " << tick;
+    }
+    // The last tick before the next collision tick replaces the candidates.
+    if (tick % per_collision != per_collision - 1) continue;
+    int near_keeping = 0, near_searching = 0;
+    const auto missed_keeping = missed_pairs(**keeping, tool_model, kReach, near_keeping);
+    const auto missed_searching = missed_pairs(**searching, tool_model, kReach, near_searching);
+    for (const auto& pair : missed_keeping) EXPECT_EQ(missed_searching.count(pair), 1u) << "tick " << tick;
+    near += near_keeping;
+    if ((*keeping)->tissue().tool().stats().penetrating > 0) ++checks_in_contact;
+  }
+  // The comparison means something only if the hand pressed the tissue and the candidates were kept.
+  EXPECT_GT(near, 1000);
+  EXPECT_GT(checks_in_contact, 60);
+  EXPECT_GT((*keeping)->contact_searches_reused(), 10u) << "holding still and creeping keep the candidates";
+  EXPECT_GT((*keeping)->contact_searches(), 10u) << "inserting searches";
+  EXPECT_EQ((*searching)->contact_searches_reused(), 0u);
+  EXPECT_EQ((*keeping)->metrics().contact_margin_exceeded_ticks, 0u);
+}
+
+std::vector<std::uint64_t> hashes_of(const SimulationConfig& config, std::uint64_t& reused) {
+  auto sim = Simulation::create(config);
+  EXPECT_TRUE(sim) << (sim ? "" : sim.error());
+  std::vector<std::uint64_t> hashes;
+  for (std::uint64_t tick = 0; tick < 2 * 960; ++tick) {
+    (*sim)->step(steady_hand(tick, config.tick_s()), {});
+    if ((*sim)->is_collision_tick(tick)) hashes.push_back((*sim)->state_hash());
+  }
+  (*sim)->settle();
+  reused = (*sim)->contact_searches_reused();
+  return hashes;
+}
+
+TEST(ContactReuse, TheChoiceIsTheSameEveryRunAndOnEitherThread) {
+  SimulationConfig inline_search = small_config();
+  inline_search.collision_thread = false;
+  std::uint64_t reused_a = 0, reused_b = 0, reused_c = 0;
+  const auto a = hashes_of(small_config(), reused_a);
+  const auto b = hashes_of(small_config(), reused_b);
+  const auto c = hashes_of(inline_search, reused_c);
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(a, c);
+  EXPECT_GT(reused_a, 0u);
+  EXPECT_EQ(reused_a, reused_b);
+  EXPECT_EQ(reused_a, reused_c);
+}
+
+TEST(ContactReuse, OffEveryCollisionStepSearches) {
+  SimulationConfig config = small_config();
+  config.tissue.contact_reuse_m = 0.0;
+  std::uint64_t reused = 1;
+  const auto hashes = hashes_of(config, reused);
+  EXPECT_EQ(reused, 0u);
+  EXPECT_EQ(hashes.size(), 120u);
+
+}
+
+TEST(ContactReuse, AHandThatKeepsMovingKeepsSearching) {
+  // Inserting at 30 mm/s moves the tool half a millimetre a collision period, more than the reuse
+  // allows: once the device's smoothing has caught up, every step searches.
+  auto sim = Simulation::create(small_config());
+  ASSERT_TRUE(sim) << sim.error();
+  const double h = (*sim)->config().tick_s();
+  std::uint64_t reused_before = 0;
+  for (std::uint64_t tick = 0; tick < 960; ++tick) {
+    if (tick == 192) reused_before = (*sim)->contact_searches_reused();
+    TickInput input = steady_hand(0, h);
+    input.joints.insertion_m = 0.130 + 0.030 * static_cast<double>(tick) * h;
+    (*sim)->step(input, {});
+  }
+  EXPECT_EQ((*sim)->contact_searches_reused(), reused_before);
+  EXPECT_GT((*sim)->contact_searches(), 40u);
+}
+
+TEST(ContactReuse, AShiftAsLargeAsTheMarginIsRefused) {
+  SimulationConfig config = small_config();
+  config.tissue.contact_reuse_m = config.tissue.contact_margin_m;
+  const auto sim = Simulation::create(config);
+  ASSERT_FALSE(sim);
+  EXPECT_NE(sim.error().find("contact reuse shift"), std::string::npos) << sim.error();
+  config.tissue.contact_reuse_m = -1e-4;
+  EXPECT_FALSE(Simulation::create(config));
+}
+
+}  // namespace
+}  // namespace resecto
