@@ -140,7 +140,7 @@ void register_run(CLI::App& app) {
   cmd->add_flag("--raw-input", o->raw_input, "Place the tool by the device's raw readings, without the One Euro smoothing");
   cmd->add_option("--contact-reuse-mm", o->contact_reuse_mm,
                   "Keep the contact candidates, skipping a collision step's refit and search, while the tool and tissue have moved "
-                  "at most this far since they were searched (0: search every step; default 0.15)")
+                  "at most this far since they were searched (0: search every step; default 0.3, the tool at most a third of it)")
       ->check(CLI::Range(0.0, 1.5));
   cmd->add_option("--spin-us", o->spin_us, "Real time: spin this long before each tick instead of sleeping")
       ->check(CLI::Range(0, 100000))
