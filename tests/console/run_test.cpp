@@ -88,6 +88,26 @@ TEST(RunCommand, TwoRunsWithTheSameArgumentsPrintTheSameHash) {
   EXPECT_NE(nlohmann::json::parse(read_text(stiff)).at("hash_chain").get<std::string>(), chains[0]);
 }
 
+TEST(RunCommand, ReportsTheCollisionStepsThatKeptTheirContactCandidates) {
+  const auto dir = scratch_directory("run_contact_reuse");
+  for (const char* reuse : {"", " --contact-reuse-mm 0"}) {
+    SCOPED_TRACE(reuse);
+    const auto path = dir / (*reuse == '\0' ? "default.json" : "off.json");
+    const CommandOutput run = run_resecto(std::string(kShortRun) + reuse + " --report " + path.string());
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const auto report = nlohmann::json::parse(read_text(path));
+    const auto& searches = report.at("contact_searches");
+    // Every collected collision step either searched or kept the candidates in use.
+    EXPECT_EQ(searches.at("searched").get<int>() + searches.at("reused").get<int>(), report.at("collision_steps").get<int>());
+    if (*reuse != '\0') {
+      EXPECT_EQ(searches.at("reused").get<int>(), 0);
+    }
+  }
+  const CommandOutput refused = run_resecto(std::string(kShortRun) + " --contact-reuse-mm 1.5");
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_NE(refused.err.find("contact reuse shift 1.5 mm is outside [0, the contact margin 1.5 mm)"), std::string::npos) << refused.err;
+}
+
 TEST(RunCommand, RealTimeReportsItsDeadlinesAndScheduling) {
   // One real-time second: the figures must be consistent with each other (how many ticks missed is
   // the machine's business, not a test's).
