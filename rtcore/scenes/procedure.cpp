@@ -51,7 +51,12 @@ struct TurpPlan {
   double median_far_loop_mm = 24.0;
   double median_near_loop_mm = 15.0;  // the median lobe sits at the bladder neck
   double stroke_s = 1.2;          // the cut: loop drawn back at ~22 mm/s
-  double move_s = 0.4;            // roll, tilt and loop out, pedal up
+  double move_s = 0.4;            // roll, tilt and loop out, pedal up: at least this long
+  // A hand's pace between strokes, so that no move outruns the contact search's margin (1.5 mm over
+  // two collision periods): rolls, tilts and the loop's travel at most this fast.
+  double roll_deg_s = 60.0;
+  double tilt_deg_s = 3.0;
+  double loop_mm_s = 40.0;
 };
 
 std::vector<ProcedureKeyframe> turp_keyframes() {
@@ -66,15 +71,21 @@ std::vector<ProcedureKeyframe> turp_keyframes() {
   add(1.5, 0.0, 0.0, 0.0, plan.insertion_mm, 0.0, false);  // in through the apex
   // Tilting by `tilt_deg` toward where the loop hangs at `roll_deg` (roll 0: posterior, +90: the
   // patient's left): yaw swings the tip toward +x, pitch lifts it toward +y.
+  // How long a move from the last keyframe to these joints takes at the plan's pace (at least `least_s`).
+  auto paced = [&](double least_s, double yaw, double pitch, double roll, double loop) {
+    const ProcedureKeyframe& from = keys.back();
+    return std::max({least_s, std::abs(roll - from.roll_deg) / plan.roll_deg_s, std::abs(yaw - from.yaw_deg) / plan.tilt_deg_s,
+                     std::abs(pitch - from.pitch_deg) / plan.tilt_deg_s, std::abs(loop - from.loop_mm) / plan.loop_mm_s});
+  };
   auto stroke = [&](double roll_deg, double tilt_deg, double far_mm, double near_mm) {
     const double roll = roll_deg * 3.141592653589793 / 180.0;
     const double yaw = tilt_deg * std::sin(roll), pitch = -tilt_deg * std::cos(roll);
-    add(plan.move_s * 0.5, yaw, pitch, roll_deg, plan.insertion_mm, 0.0, false);
-    add(plan.move_s * 0.5, yaw, pitch, roll_deg, plan.insertion_mm, far_mm, false);
+    add(paced(plan.move_s * 0.5, yaw, pitch, roll_deg, 0.0), yaw, pitch, roll_deg, plan.insertion_mm, 0.0, false);
+    add(paced(plan.move_s * 0.5, yaw, pitch, roll_deg, far_mm), yaw, pitch, roll_deg, plan.insertion_mm, far_mm, false);
     add(0.05, yaw, pitch, roll_deg, plan.insertion_mm, far_mm, true);
     add(plan.stroke_s, yaw, pitch, roll_deg, plan.insertion_mm, near_mm, true);
     add(0.05, yaw, pitch, roll_deg, plan.insertion_mm, near_mm, false);
-    add(0.2, yaw, pitch, roll_deg, plan.insertion_mm, 0.0, false);
+    add(paced(0.2, yaw, pitch, roll_deg, 0.0), yaw, pitch, roll_deg, plan.insertion_mm, 0.0, false);
   };
   // Median lobe: posterior, at the bladder neck, three layers.
   for (double tilt : {0.0, 0.6, 1.2}) {
@@ -89,7 +100,7 @@ std::vector<ProcedureKeyframe> turp_keyframes() {
       }
     }
   }
-  add(0.5, 0.0, 0.0, 0.0, plan.insertion_mm, 0.0, false);
+  add(paced(0.5, 0.0, 0.0, 0.0, 0.0), 0.0, 0.0, 0.0, plan.insertion_mm, 0.0, false);
   add(1.0, 0.0, 0.0, 0.0, 125.0, 0.0, false);  // out
   return keys;
 }

@@ -1,6 +1,9 @@
 // Procedure files: the built-in demo, interpolation between keyframes, and errors naming the line.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <vector>
+
 #include "rtcore/scenes/procedure.h"
 
 namespace resecto {
@@ -19,6 +22,25 @@ TEST(Procedure, DemoIsBuiltInAndWellFormed) {
   EXPECT_TRUE(cuts);
   EXPECT_GT(deepest, 150.0);  // past the apex (insertion 150 mm with the default registration)
   EXPECT_LT(deepest, 191.5);  // short of the bladder neck
+}
+
+TEST(Procedure, TurpMovesAtAHandsPaceBetweenStrokes) {
+  // Its moves once rolled up to 135 degrees in 0.2 s and sent the loop out at 115 mm/s: faster than
+  // the contact search's margin covers (2,445 ticks outran it, up to 3.79 mm from the searched pose).
+  Result<Procedure> turp = find_procedure("turp");
+  ASSERT_TRUE(turp) << turp.error();
+  const std::vector<ProcedureKeyframe>& keys = turp->keyframes;
+  ASSERT_GT(keys.size(), 100u);
+  for (std::size_t i = 1; i < keys.size(); ++i) {
+    const ProcedureKeyframe &a = keys[i - 1], &b = keys[i];
+    const double dt = b.time_s - a.time_s;
+    ASSERT_GT(dt, 0.0) << "keyframe " << i;
+    EXPECT_LE(std::abs(b.roll_deg - a.roll_deg) / dt, 60.0 + 1e-9) << "keyframe " << i;
+    EXPECT_LE(std::abs(b.yaw_deg - a.yaw_deg) / dt, 3.0 + 1e-9) << "keyframe " << i;
+    EXPECT_LE(std::abs(b.pitch_deg - a.pitch_deg) / dt, 3.0 + 1e-9) << "keyframe " << i;
+    // The loop goes out and back at most 40 mm/s with the pedal up; the cut draws it at 22 mm/s.
+    EXPECT_LE(std::abs(b.loop_mm - a.loop_mm) / dt, 40.0 + 1e-9) << "keyframe " << i;
+  }
 }
 
 TEST(Procedure, JointsInterpolateAndPedalsHold) {
