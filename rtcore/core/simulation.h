@@ -138,6 +138,12 @@ constexpr std::size_t metric_field_count() {
 static_assert(sizeof(ProcedureMetrics) == 8 * (metric_field_count() - 1) + sizeof(std::optional<double>),
               "for_each_metric must visit every field of ProcedureMetrics");
 
+/// The tissue configuration a simulation builds its tissue with: `config.tissue` with room for the
+/// contact candidates of its gland, since a finer surface has proportionally more nodes and faces
+/// within the margin of the tool (about every surface node, half the faces; four pairs per face),
+/// never less than the configured room nor more than validate() allows.
+TissueConfig tissue_config_for(const SimulationConfig& config);
+
 /// What the core publishes for the console and recorder (taken at collision steps).
 struct SimulationSnapshot {
   std::uint64_t tick = 0;

@@ -304,6 +304,28 @@ TEST(RealtimeProbe, SeesAnAllocationAndALock) {
   EXPECT_GE(probe.locks(), 1);
 }
 
+TEST(Simulation, ContactRoomGrowsWithTheGland) {
+  // The 138,240-triangle demo overflowed the default room for candidate nodes at 339 collision steps,
+  // dropping contacts (a peak force of 69 N instead of 5): the room follows the surface's size.
+  SimulationConfig config = small_config();
+  const ToolContactCapacity defaults = config.tissue.contact_capacity;
+  const ToolContactCapacity small = tissue_config_for(config).contact_capacity;
+  EXPECT_EQ(small.max_tissue_nodes, defaults.max_tissue_nodes);
+  EXPECT_EQ(small.max_pair_entries, defaults.max_pair_entries);
+  config.prostate_triangles = 138240;
+  const ToolContactCapacity fine = tissue_config_for(config).contact_capacity;
+  EXPECT_EQ(fine.max_tissue_nodes, 69120);  // about every surface node
+  EXPECT_EQ(fine.max_pair_entries, 552960);
+  EXPECT_EQ(fine.max_tool_vertices, defaults.max_tool_vertices);  // the tool does not grow
+  // A room set larger is kept; the largest gland stays within what validate() allows.
+  config.tissue.contact_capacity.max_tissue_nodes = 100000;
+  EXPECT_EQ(tissue_config_for(config).contact_capacity.max_tissue_nodes, 100000);
+  config.prostate_triangles = 1000000;
+  config.tissue.contact_capacity = tissue_config_for(config).contact_capacity;
+  EXPECT_EQ(config.tissue.contact_capacity.max_pair_entries, 4000000);
+  EXPECT_TRUE(config.validate());
+}
+
 TEST(Simulation, RejectsImpossibleRates) {
   SimulationConfig config = small_config();
   config.physics_per_collision = 0;
