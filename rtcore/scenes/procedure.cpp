@@ -69,14 +69,14 @@ std::vector<ProcedureKeyframe> turp_keyframes() {
   };
   keys.push_back({0.0, 0.0, 0.0, 0.0, 125.0, 0.0, false, false});
   add(1.5, 0.0, 0.0, 0.0, plan.insertion_mm, 0.0, false);  // in through the apex
-  // Tilting by `tilt_deg` toward where the loop hangs at `roll_deg` (roll 0: posterior, +90: the
-  // patient's left): yaw swings the tip toward +x, pitch lifts it toward +y.
   // How long a move from the last keyframe to these joints takes at the plan's pace (at least `least_s`).
   auto paced = [&](double least_s, double yaw, double pitch, double roll, double loop) {
     const ProcedureKeyframe& from = keys.back();
     return std::max({least_s, std::abs(roll - from.roll_deg) / plan.roll_deg_s, std::abs(yaw - from.yaw_deg) / plan.tilt_deg_s,
                      std::abs(pitch - from.pitch_deg) / plan.tilt_deg_s, std::abs(loop - from.loop_mm) / plan.loop_mm_s});
   };
+  // Tilting by `tilt_deg` toward where the loop hangs at `roll_deg` (roll 0: posterior, +90: the
+  // patient's left): yaw swings the tip toward +x, pitch lifts it toward +y.
   auto stroke = [&](double roll_deg, double tilt_deg, double far_mm, double near_mm) {
     const double roll = roll_deg * 3.141592653589793 / 180.0;
     const double yaw = tilt_deg * std::sin(roll), pitch = -tilt_deg * std::cos(roll);
