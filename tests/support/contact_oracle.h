@@ -7,6 +7,7 @@
 
 #include <map>
 #include <set>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -23,11 +24,14 @@ inline bool within(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, d
 }
 
 /// Every surface node against every face of every part, and every part vertex against every live
-/// surface face: the pairs within the margin.
-inline std::pair<Found, Found> brute_force(const MassSpringTissue& tissue, const std::vector<TriangleMesh>& parts) {
+/// surface face: the pairs within the margin, at the positions the search read. With `reach` and
+/// `positions` (e.g. the nodes' current ones): the pairs within that reach there instead.
+inline std::pair<Found, Found> brute_force(const MassSpringTissue& tissue, const std::vector<TriangleMesh>& parts, double reach = -1.0,
+                                           std::span<const Vec3> positions = {}) {
   Found nodes, vertices;
   const TriangleMesh& surface = tissue.surface();
-  const double margin = tissue.tool().margin_m();
+  const double margin = reach >= 0.0 ? reach : tissue.tool().margin_m();
+  const std::span<const Vec3> x = positions.empty() ? std::span<const Vec3>(surface.positions) : positions;
   std::vector<std::uint8_t> on_surface(surface.vertex_count(), 0);
   std::vector<std::uint32_t> live_faces;
   for (std::uint32_t f = 0; f < surface.triangle_count(); ++f) {
@@ -40,7 +44,7 @@ inline std::pair<Found, Found> brute_force(const MassSpringTissue& tissue, const
     const RigidPose& pose = tissue.tool().pose(k);
     for (std::uint32_t n = 0; n < surface.vertex_count(); ++n) {
       if (!on_surface[n]) continue;
-      const Vec3 p = pose.inverse_apply_point(surface.positions[n]);
+      const Vec3 p = pose.inverse_apply_point(x[n]);
       for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
         const Triangle& tri = mesh.triangles[t];
         if (within(p, mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]], margin)) nodes[{k, n}].insert(t);
@@ -50,7 +54,7 @@ inline std::pair<Found, Found> brute_force(const MassSpringTissue& tissue, const
       const Vec3 w = pose.apply_point(mesh.positions[v]);
       for (std::uint32_t f : live_faces) {
         const Triangle& tri = surface.triangles[f];
-        if (within(w, surface.positions[tri[0]], surface.positions[tri[1]], surface.positions[tri[2]], margin)) vertices[{k, v}].insert(f);
+        if (within(w, x[tri[0]], x[tri[1]], x[tri[2]], margin)) vertices[{k, v}].insert(f);
       }
     }
   }

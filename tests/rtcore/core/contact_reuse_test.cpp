@@ -13,16 +13,13 @@
 
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/core/simulation.h"
-#include "rtcore/geometry/closest_point.h"
+#include "tests/support/small_simulation.h"
+#include "tests/support/contact_oracle.h"
 
 namespace resecto {
 namespace {
 
-SimulationConfig small_config() {
-  SimulationConfig config;
-  config.prostate_triangles = 1296;
-  return config;
-}
+using testing::small_config;
 
 /// A hand that inserts the sheath (fast), holds it still, then creeps in and rolls slowly, the loop
 /// out: a trainee looking before a stroke. The pedal stays up, so no cut forces a search.
@@ -37,68 +34,26 @@ TickInput steady_hand(std::uint64_t tick, double tick_s) {
   return input;
 }
 
-/// (part, point, face) of every published candidate pair.
-using PairSet = std::set<std::tuple<int, std::uint32_t, std::uint32_t>>;
-
-/// The pairs of `count` published candidate points, `candidate(i)` the i-th.
-template <class Candidate>
-PairSet pairs_of(std::size_t count, Candidate candidate) {
-  PairSet pairs;
-  for (std::size_t i = 0; i < count; ++i) {
-    const ToolContacts::CandidatePoint c = candidate(i);
-    for (std::uint32_t face : c.faces) pairs.insert({c.part, c.point, face});
-  }
-  return pairs;
-}
-
-double distance2(const Vec3& p, const TriangleMesh& mesh, std::uint32_t face, const std::vector<Vec3>& positions) {
-  const Triangle& t = mesh.triangles[face];
-  const Vec3 q = closest_point_on_triangle(p, positions[t[0]], positions[t[1]], positions[t[2]]);
-  return glm::dot(p - q, p - q);
-}
-
-/// The pairs within `reach` of each other (brute force over every surface node and live face against
-/// every tool face and vertex) that the published candidates miss, as (kind, part, point, face) with
-/// kind 0 for a tissue node against a tool face and 1 for a tool vertex against a tissue face; `near`
-/// gets how many pairs were within reach.
-std::set<std::tuple<int, int, std::uint32_t, std::uint32_t>> missed_pairs(const Simulation& sim, const ResectoscopeModel& tool_model, double reach,
+/// The pairs within `reach` of each other at the current positions (brute force, tests/support/
+/// contact_oracle.h) that the published candidates miss, as (kind, part, point, face) with kind 0
+/// for a tissue node against a tool face and 1 for a tool vertex against a tissue face; `near` gets
+/// how many pairs were within reach.
+std::set<std::tuple<int, int, std::uint32_t, std::uint32_t>> missed_pairs(const Simulation& sim, const std::vector<TriangleMesh>& parts, double reach,
                                                                          int& near) {
   const MassSpringTissue& tissue = sim.tissue();
-  const ToolContacts& contacts = tissue.tool();
-  const PairSet nodes = pairs_of(contacts.node_candidate_count(), [&](std::size_t i) { return contacts.node_candidate(i); });
-  const PairSet vertices = pairs_of(contacts.vertex_candidate_count(), [&](std::size_t i) { return contacts.vertex_candidate(i); });
-  const TriangleMesh& surface = tissue.surface();
-  const std::vector<Vec3> x(tissue.positions().begin(), tissue.positions().end());
-  std::set<std::uint32_t> surface_nodes;
-  std::vector<std::uint32_t> live_faces;
-  for (std::size_t s = 0; s < surface.triangles.size(); ++s) {
-    if (tissue.surface_face_owner(s) < 0) continue;
-    live_faces.push_back(static_cast<std::uint32_t>(s));
-    for (std::uint32_t n : surface.triangles[s]) surface_nodes.insert(n);
-  }
+  const auto [nodes, vertices] = testing::brute_force(tissue, parts, reach, tissue.positions());
   std::set<std::tuple<int, int, std::uint32_t, std::uint32_t>> missed;
-  const TriangleMesh* parts[] = {&tool_model.sheath, &tool_model.loop};
-  for (int part = 0; part < 2; ++part) {
-    const TriangleMesh& mesh = *parts[part];
-    const RigidPose& pose = contacts.pose(part);
-    for (std::uint32_t n : surface_nodes) {
-      const Vec3 p = pose.inverse_apply_point(x[n]);
-      for (std::uint32_t f = 0; f < mesh.triangle_count(); ++f) {
-        if (distance2(p, mesh, f, mesh.positions) > reach * reach) continue;
+  int kind = 0;
+  for (const auto* within : {&nodes, &vertices}) {
+    const testing::Found published = testing::published(tissue.tool(), kind == 0);
+    for (const auto& [point, faces] : *within) {
+      const auto listed = published.find(point);
+      for (std::uint32_t face : faces) {
         ++near;
-        if (nodes.count({part, n, f}) == 0) missed.insert({0, part, n, f});
+        if (listed == published.end() || listed->second.count(face) == 0) missed.insert({kind, point.first, point.second, face});
       }
     }
-    std::set<std::uint32_t> used;
-    for (const Triangle& t : mesh.triangles) used.insert(t.begin(), t.end());
-    for (std::uint32_t v : used) {
-      const Vec3 w = pose.apply_point(mesh.positions[v]);
-      for (std::uint32_t f : live_faces) {
-        if (distance2(w, surface, f, x) > reach * reach) continue;
-        ++near;
-        if (vertices.count({part, v, f}) == 0) missed.insert({1, part, v, f});
-      }
-    }
+    ++kind;
   }
   return missed;
 }
@@ -117,6 +72,7 @@ TEST(ContactReuse, KeptCandidatesMissNoPairThatSearchingEveryStepHolds) {
   ASSERT_TRUE(keeping) << keeping.error();
   ASSERT_TRUE(searching) << searching.error();
   const ResectoscopeModel tool_model = generate_resectoscope();
+  const std::vector<TriangleMesh> parts{tool_model.sheath, tool_model.loop};  // the simulation's parts 0 and 1
   const double h = (*keeping)->config().tick_s();
   const auto per_collision = static_cast<std::uint64_t>((*keeping)->config().physics_per_collision);
   constexpr double kReach = 0.0005;
@@ -130,8 +86,8 @@ TEST(ContactReuse, KeptCandidatesMissNoPairThatSearchingEveryStepHolds) {
     // The last tick before the next collision tick replaces the candidates.
     if (tick % per_collision != per_collision - 1) continue;
     int near_keeping = 0, near_searching = 0;
-    const auto missed_keeping = missed_pairs(**keeping, tool_model, kReach, near_keeping);
-    const auto missed_searching = missed_pairs(**searching, tool_model, kReach, near_searching);
+    const auto missed_keeping = missed_pairs(**keeping, parts, kReach, near_keeping);
+    const auto missed_searching = missed_pairs(**searching, parts, kReach, near_searching);
     for (const auto& pair : missed_keeping) EXPECT_EQ(missed_searching.count(pair), 1u) << "tick " << tick;
     near += near_keeping;
     if ((*keeping)->tissue().tool().stats().penetrating > 0) ++checks_in_contact;

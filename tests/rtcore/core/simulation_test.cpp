@@ -10,15 +10,12 @@
 
 #include "rtcore/core/simulation.h"
 #include "tests/support/realtime_probe.h"
+#include "tests/support/small_simulation.h"
 
 namespace resecto {
 namespace {
 
-SimulationConfig small_config() {
-  SimulationConfig config;
-  config.prostate_triangles = 1296;
-  return config;
-}
+using testing::small_config;
 
 /// A scripted hand: insert through the apex, roll, swing into a lobe and back.
 TickInput input_at(std::uint64_t tick, double tick_s) {
