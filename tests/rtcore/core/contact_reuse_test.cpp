@@ -5,16 +5,17 @@
 // keeps moving must go on searching.
 #include <gtest/gtest.h>
 
-#include <cmath>
+#include <algorithm>
 #include <cstdint>
 #include <set>
+#include <string>
 #include <tuple>
 #include <vector>
 
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/core/simulation.h"
-#include "tests/support/small_simulation.h"
 #include "tests/support/contact_oracle.h"
+#include "tests/support/small_simulation.h"
 
 namespace resecto {
 namespace {
@@ -135,7 +136,6 @@ TEST(ContactReuse, OffEveryCollisionStepSearches) {
   const auto hashes = hashes_of(config, reused);
   EXPECT_EQ(reused, 0u);
   EXPECT_EQ(hashes.size(), 120u);
-
 }
 
 TEST(ContactReuse, AHandThatKeepsMovingKeepsSearching) {
