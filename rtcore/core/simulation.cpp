@@ -383,9 +383,10 @@ void Simulation::run_collision_job() {
   // Temporal coherence: while the tool and the tissue have barely moved from where the front's
   // candidates were searched, they serve the next window too, and the step skips its refit and
   // search (most of a collision step's cost). A cut always searches: its faces are new.
+  const bool quiet = !replays && !job_edited_;
   job_reused_ = !job_edited_ && front.contact_candidates_still_serve();
   if (job_reused_) {
-    if (!replays) other.rebuild_surface_tree_if_due();
+    if (quiet) other.rebuild_surface_tree_if_due();
     search_timing_.refit_end_ns = search_timing_.query_end_ns = FrameProfiler::now_ns();
     return;
   }
@@ -395,7 +396,6 @@ void Simulation::run_collision_job() {
   // in one job overran the collision period and held the core up. A job that edits or replays
   // rebuilds only an overdue tree; a quiet one rebuilds the searched copy's, or else the other
   // copy's, so both are sound again soon after a stroke ends.
-  const bool quiet = !replays && !job_edited_;
   const bool rebuilt = searched.refit_surface_tree(quiet ? MassSpringTissue::TreeRebuild::kWhenDue : MassSpringTissue::TreeRebuild::kOnlyWhenOverdue);
   if (quiet && !rebuilt) other.rebuild_surface_tree_if_due();
   search_timing_.refit_end_ns = FrameProfiler::now_ns();

@@ -193,7 +193,10 @@ void MassSpringTissue::rebuild_surface_tree() {
 
 void MassSpringTissue::search_contact_candidates() {
   tool_.search_candidates(surface_tree_, surface_);
-  searched_positions_.assign(surface_.positions.begin(), surface_.positions.begin() + static_cast<std::ptrdiff_t>(x_.size()));  // reserved
+  // Kept only where a later step may ask whether these candidates still serve.
+  if (config_.contact_reuse_m > 0.0) {
+    searched_positions_.assign(surface_.positions.begin(), surface_.positions.begin() + static_cast<std::ptrdiff_t>(x_.size()));  // reserved
+  }
 }
 
 bool MassSpringTissue::contact_candidates_still_serve() const {

@@ -323,7 +323,6 @@ void ToolContacts::publish_candidates() {
   std::swap(pair_distance_, search_.pair_distance);
   candidates_travel_m_ = query_tissue_travel_m_;  // latched for that search; the next latch comes after
   distances_valid_ = true;
-  published_ = true;
   for (Part& part : parts_) {
     part.published_pose = part.query_pose;
     part.published_enabled = part.query_enabled;
@@ -343,7 +342,7 @@ void ToolContacts::publish_candidates() {
 
 double ToolContacts::tool_shift_since_search() const {
   constexpr double kNever = std::numeric_limits<double>::infinity();
-  if (!published_ || !distances_valid_) return kNever;
+  if (!distances_valid_) return kNever;  // nothing published yet, or an edit voided it
   double tool_shift2 = 0.0;
   for (const Part& part : parts_) {
     if (part.query_enabled != part.published_enabled) return kNever;

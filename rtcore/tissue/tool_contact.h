@@ -227,8 +227,7 @@ class ToolContacts {
   // there (exact: the same face wins as when every face is tested).
   std::vector<double> pair_distance_;
   double candidates_travel_m_ = 0.0;  // the tissue's travel at the published search (its latched one)
-  bool distances_valid_ = false;      // false from a topology edit until the next publish
-  bool published_ = false;            // a search's candidates were published
+  bool distances_valid_ = false;      // false until a publish, and from a topology edit until the next
   std::size_t node_count_ = 0, vertex_count_ = 0, pair_count_ = 0;
   // The published search's corners of the tool vertices' candidate faces: how far they have moved
   // bounds how much nearer a vertex's faces can have come since the search.
