@@ -220,6 +220,25 @@ TEST(SessionHeaderJson, RefusesBoundsNoReplayCouldBuild) {
   EXPECT_NE(refused("tissue.contact_capacity.max_tissue_nodes", 1 << 30).find("max_tissue_nodes"), std::string::npos);
 }
 
+// Headers written before the contact search could keep its candidates have no contact_reuse_m: such
+// a session searched at every collision step, and replays so; one set outside [0, margin) is refused.
+TEST(SessionHeaderJson, AHeaderWithoutContactReuseReplaysSearchingEveryStep) {
+  SessionHeader header;
+  header.format_version = kFormatVersion;
+  header.grid.bits = 11;
+  header.grid.range = 0.1f;
+  nlohmann::ordered_json json = header_to_json(header);
+  EXPECT_EQ(header_from_json(json.dump())->simulation.tissue.contact_reuse_m, header.simulation.tissue.contact_reuse_m);
+  json["simulation"]["tissue"].erase("contact_reuse_m");
+  const Result<SessionHeader> older = header_from_json(json.dump());
+  ASSERT_TRUE(older) << older.error();
+  EXPECT_EQ(older->simulation.tissue.contact_reuse_m, 0.0);
+  json["simulation"]["tissue"]["contact_reuse_m"] = 0.002;
+  const Result<SessionHeader> refused = header_from_json(json.dump());
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().find("contact reuse shift 2 mm"), std::string::npos) << refused.error();
+}
+
 // A hand-edited or damaged header is refused with the path of the field at fault: absent, of the
 // wrong type, or out of its type's range (a negative count would otherwise wrap to four billion).
 TEST(SessionHeaderJson, NamesTheFieldAtFault) {
