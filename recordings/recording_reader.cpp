@@ -4,27 +4,20 @@
 #include <algorithm>
 #include <exception>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 
 #include "recordings/recording_writer.h"
+#include "rtcore/base/text_file.h"
 
 namespace resecto::rec {
 
 Result<Recording> Recording::open(const std::filesystem::path& path) {
+  // Only a regular file, read once to its size: a device or a pipe named as a recording would be
+  // read for ever (/dev/zero filled the memory).
   std::error_code error;
   if (std::filesystem::is_directory(path, error)) return Error{path.string() + ": is a folder, not a recording"};
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path.string() + ": cannot open"};
-  std::vector<std::uint8_t> bytes;
-  try {
-    // libstdc++'s stream buffer throws on a failed read (EIO, a special file) rather than setting badbit.
-    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  } catch (const std::exception& e) {
-    return Error{path.string() + ": read failed: " + e.what()};
-  }
-  if (in.bad()) return Error{path.string() + ": read failed"};
-  return from_bytes(std::move(bytes), path.string());
+  Result<std::vector<std::uint8_t>> bytes = read_regular_file<std::vector<std::uint8_t>>(path, " the recording", kMaxBinaryFileBytes);
+  if (!bytes) return Error{bytes.error()};
+  return from_bytes(std::move(*bytes), path.string());
 }
 
 Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::string name) {

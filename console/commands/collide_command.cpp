@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <stdexcept>
@@ -57,6 +58,12 @@ std::vector<RigidPose> read_poses_or_fail(const std::string& path) {
 
 void run_collide(const CollideOptions& options) {
   using Clock = std::chrono::steady_clock;
+  // Checked before the work: a pairs file that names an input would destroy it, and one whose
+  // folder is missing would be found out only after every query had run.
+  if (!options.pairs.empty()) {
+    const std::filesystem::path inputs[] = {options.tissue, options.tool, options.poses};
+    if (Status ok = check_output_path(options.pairs, inputs); !ok) fail(ok.error());
+  }
   const TriangleMesh tissue = read_mesh_or_fail(options.tissue);
   const TriangleMesh tool = read_mesh_or_fail(options.tool);
   const std::vector<RigidPose> poses = read_poses_or_fail(options.poses);

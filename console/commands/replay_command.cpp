@@ -1,6 +1,7 @@
 // `resecto replay FILE [--verify] [--json]`: re-simulates a recording through the same core from its
 // recorded inputs and commands; with --verify, the state hash of every collision step is compared
 // and the first tick that differs is named (exit status 1).
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -29,6 +30,11 @@ void replay(const ReplayOptions& o) {
   rec::Replayer& r = **replayer;
   const std::uint64_t ticks = r.run_to(r.end_tick());
   const std::uint64_t recorded_steps = recording->steps().size();
+  // The steps the recorder wrote, from its summary: a file recovered from a damaged one holds fewer
+  // (rec recover drops the damaged chunks), and those were never compared.
+  const nlohmann::ordered_json& summary = recording->summary();
+  const std::uint64_t written_steps =
+      std::max<std::uint64_t>(recorded_steps, summary.is_object() && summary.contains("steps") && summary["steps"].is_number_unsigned() ? summary["steps"].get<std::uint64_t>() : 0);
   const bool complete = ticks == recording->ticks().size() && recording->damaged().empty();
 
   nlohmann::ordered_json out = {{"file", o.file},
@@ -36,7 +42,8 @@ void replay(const ReplayOptions& o) {
                                 {"simulated_s", static_cast<double>(ticks) * recording->header().simulation.tick_s()},
                                 {"state_hash", hex_hash(r.simulation().state_hash())},
                                 {"verified_hashes", r.verified_hashes()},
-                                {"recorded_hashes", recorded_steps},
+                                {"recorded_hashes", written_steps},
+                                {"hashes_in_file", recorded_steps},
                                 {"mismatches", r.mismatches()},
                                 {"first_mismatch_tick", r.first_mismatch_tick() ? nlohmann::ordered_json(*r.first_mismatch_tick()) : nlohmann::ordered_json(nullptr)},
                                 {"complete", complete}};
@@ -53,7 +60,7 @@ void replay(const ReplayOptions& o) {
     }
     if (o.verify) {
       std::printf("  %llu of %llu recorded hashes verified, %llu mismatches\n", static_cast<unsigned long long>(r.verified_hashes()),
-                  static_cast<unsigned long long>(recorded_steps), static_cast<unsigned long long>(r.mismatches()));
+                  static_cast<unsigned long long>(written_steps), static_cast<unsigned long long>(r.mismatches()));
     }
   }
   if (o.verify && r.mismatches() > 0) {
@@ -68,6 +75,13 @@ void replay(const ReplayOptions& o) {
   // A damaged file verifies only in part: the steps whose hashes were in damaged or undecodable
   // chunks were never compared, so --verify cannot vouch for the recording.
   const std::size_t broken = recording->damaged().size() + recording->content_errors().size();
+  if (o.verify && broken == 0 && written_steps > recorded_steps) {
+    const bool recovered = summary.is_object() && summary.contains("recovered");
+    throw std::runtime_error(o.file + ": " + std::to_string(written_steps - recorded_steps) + " of the " + std::to_string(written_steps) +
+                             " collision steps' hashes the recorder wrote are not in the file" +
+                             (recovered ? " (`resecto rec recover` left out the damaged chunks that held them)" : "") + ": only " +
+                             std::to_string(r.verified_hashes()) + " could be compared");
+  }
   if (o.verify && broken > 0) {
     throw std::runtime_error(o.file + ": the recording is damaged (" + std::to_string(recording->damaged().size()) + " damaged ranges, " +
                              std::to_string(recording->content_errors().size()) + " undecodable chunks; `resecto rec verify` names them): only " +

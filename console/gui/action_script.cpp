@@ -4,8 +4,9 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <sstream>
+
+#include "rtcore/base/text_file.h"
 
 namespace resecto::gui {
 namespace {
@@ -107,11 +108,10 @@ Result<std::vector<Action>> parse_actions(const std::string& text, const std::st
 }
 
 Result<std::vector<Action>> load_actions(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path.string() + ": cannot open the actions file"};
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return parse_actions(buffer.str(), path.string());
+  Result<std::string> text = read_text_file(path, " the actions file");
+  if (!text) return Error{text.error()};
+  strip_utf8_bom(*text);
+  return parse_actions(*text, path.string());
 }
 
 }  // namespace resecto::gui

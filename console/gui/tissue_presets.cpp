@@ -1,12 +1,13 @@
 // Preset files.
 #include "console/gui/tissue_presets.h"
 
-#include <fstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "console/gui/atomic_file.h"
+#include "rtcore/base/json_text.h"
+#include "rtcore/base/text_file.h"
 
 namespace resecto::gui {
 
@@ -20,12 +21,16 @@ Status save_preset(const std::filesystem::path& path, const TissueParameters& pa
 }
 
 Result<TissueParameters> load_preset(const std::filesystem::path& path, const TissueParameters& base) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path.string() + ": cannot open the preset"};
-  const nlohmann::json preset = nlohmann::json::parse(in, nullptr, false);
-  if (preset.is_discarded() || !preset.is_object()) return Error{path.string() + ": not a JSON object"};
-  if (!preset.contains("resecto_preset") || preset["resecto_preset"] != 1) {
-    return Error{path.string() + ": not a Resecto preset (\"resecto_preset\": 1 is missing)"};
+  Result<std::string> text = read_text_file(path, " the preset");
+  if (!text) return Error{text.error()};
+  strip_utf8_bom(*text);
+  Result<nlohmann::json> parsed = parse_json_text(*text, path.string());
+  if (!parsed) return Error{parsed.error()};
+  const nlohmann::json& preset = *parsed;
+  if (!preset.is_object()) return Error{path.string() + ": not a JSON object (a preset is {\"resecto_preset\": 1, \"parameters\": {...}})"};
+  if (!preset.contains("resecto_preset")) return Error{path.string() + ": not a Resecto preset (\"resecto_preset\": 1 is missing)"};
+  if (preset["resecto_preset"] != 1) {
+    return Error{path.string() + ": preset format " + preset["resecto_preset"].dump() + " is not one this build reads (it reads format 1)"};
   }
   if (!preset.contains("parameters") || !preset["parameters"].is_object()) {
     return Error{path.string() + ": \"parameters\" must be an object of key: value"};

@@ -12,6 +12,7 @@
 #include "resecto/lp3500_sensors.h"
 #include "rtcore/base/atomic_file.h"
 #include "rtcore/base/checked_number.h"
+#include "rtcore/base/json_text.h"
 #include "rtcore/base/text_file.h"
 
 namespace resecto::device {
@@ -134,8 +135,9 @@ Result<lp3500_calibration> to_board(const Calibration& c) {
 }
 
 Result<Calibration> parse_calibration(const std::string& text, const std::string& source) {
-  const json root = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (root.is_discarded()) return Error{source + ": not valid JSON"};
+  Result<json> parsed = parse_json_text(text, source);
+  if (!parsed) return Error{parsed.error()};
+  const json& root = *parsed;
   FieldReader in(root, source);
   Calibration c;
   if (const json* format = in.at("format"); format && (!format->is_string() || *format != kFormat)) {

@@ -6,12 +6,14 @@
 #include <nlohmann/json.hpp>
 
 #include "rtcore/base/checked_number.h"
+#include "rtcore/base/json_text.h"
 
 namespace resecto {
 
 Result<std::pair<Vec3, Vec3>> parse_channel_axis(const std::string& text, const std::string& source) {
-  const nlohmann::json doc = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (doc.is_discarded()) return Error{source + ": not valid JSON"};
+  Result<nlohmann::json> parsed = parse_json_text(text, source);
+  if (!parsed) return Error{parsed.error()};
+  const nlohmann::json& doc = *parsed;
   if (!doc.is_object() || !doc.contains("channel_axis") || !doc["channel_axis"].is_object()) {
     return Error{source + ": channel_axis: missing (an object with apex and bladder_neck)"};
   }

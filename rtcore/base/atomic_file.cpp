@@ -152,6 +152,11 @@ Status check_output_path(const std::filesystem::path& output, std::span<const st
   struct stat parent {};
   if (::stat(folder.c_str(), &parent) != 0) return Error{output.string() + ": its folder " + folder.string() + " does not exist"};
   if (!S_ISDIR(parent.st_mode)) return Error{output.string() + ": " + folder.string() + " is not a folder"};
+  // A folder it cannot write in (read-only, or another user's) would fail only at the end, after
+  // the work the output holds (a long run's report).
+  if (::access(folder.c_str(), W_OK | X_OK) != 0) {
+    return Error{output.string() + ": cannot write in its folder " + folder.string() + ": " + std::strerror(errno)};
+  }
   return Ok{};
 }
 

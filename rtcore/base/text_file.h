@@ -3,10 +3,12 @@
 // error instead of an endless read. Header-only so every module can use it, whatever it links.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <system_error>
 
 #include "rtcore/base/result.h"
@@ -16,10 +18,14 @@ namespace resecto {
 /// The largest text input (procedure, poses, calibration, CSV, landmarks) read whole: 64 MiB.
 inline constexpr std::uintmax_t kMaxTextFileBytes = std::uintmax_t{64} << 20;
 
-/// The file's bytes, or an error "<path>: <why>" (missing, a folder, not a regular file, over
-/// `max_bytes`, unreadable). `what` names the file's role in the open error, e.g. " the procedure file".
-inline Result<std::string> read_text_file(const std::filesystem::path& path, const std::string& what = "",
-                                          std::uintmax_t max_bytes = kMaxTextFileBytes) {
+/// The largest binary input (a recording) read whole: 8 GiB, a third of a large workstation's memory.
+inline constexpr std::uintmax_t kMaxBinaryFileBytes = std::uintmax_t{8} << 30;
+
+/// The file's bytes in `Bytes` (std::string, std::vector<std::uint8_t>), or an error "<path>: <why>"
+/// (missing, a folder, not a regular file, over `max_bytes`, unreadable). `what` names the file's
+/// role in the open error, e.g. " the procedure file".
+template <class Bytes>
+Result<Bytes> read_regular_file(const std::filesystem::path& path, const std::string& what, std::uintmax_t max_bytes) {
   const std::string name = path.string();
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(path, ec);
@@ -37,7 +43,7 @@ inline Result<std::string> read_text_file(const std::filesystem::path& path, con
   std::FILE* file = std::fopen(name.c_str(), "rb");
   if (file == nullptr) return Error{name + ": cannot open" + what};
   // Read at most one byte past the size seen: a file that grows meanwhile is cut, never read forever.
-  std::string bytes(static_cast<std::size_t>(size) + 1, '\0');
+  Bytes bytes(static_cast<std::size_t>(size) + 1, 0);
   const std::size_t got = std::fread(bytes.data(), 1, bytes.size(), file);
   const bool failed = std::ferror(file) != 0;
   std::fclose(file);
@@ -45,6 +51,23 @@ inline Result<std::string> read_text_file(const std::filesystem::path& path, con
   if (got > size) return Error{name + ": changed size while it was read"};
   bytes.resize(got);
   return bytes;
+}
+
+/// A text input read whole (read_regular_file), up to `max_bytes`.
+inline Result<std::string> read_text_file(const std::filesystem::path& path, const std::string& what = "",
+                                          std::uintmax_t max_bytes = kMaxTextFileBytes) {
+  return read_regular_file<std::string>(path, what, max_bytes);
+}
+
+/// "line L, column C" (from 1) of the byte at `offset` (from 0) of `text`, for a parser that reports
+/// where it stopped as a byte count (nlohmann::json's parse_error::byte is the count read, from 1).
+inline std::string text_position(std::string_view text, std::size_t offset) {
+  offset = std::min(offset, text.size());
+  std::size_t line = 1, line_start = 0;
+  for (std::size_t i = 0; i < offset; ++i) {
+    if (text[i] == '\n') ++line, line_start = i + 1;
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(offset - line_start + 1);
 }
 
 /// Drops a leading UTF-8 byte-order mark, which spreadsheets and Windows editors put before text

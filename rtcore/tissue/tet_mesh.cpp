@@ -54,6 +54,7 @@ TetMeshStats compute_stats(const TetMesh& mesh) {
   for (std::size_t t = 0; t < mesh.tetrahedron_count(); ++t) {
     const double volume = tetrahedron_volume(mesh, t);
     stats.volume_m3 += volume;
+    stats.max_tetrahedron_volume_m3 = std::max(stats.max_tetrahedron_volume_m3, volume);
     (mesh.regions[t] == TissueRegion::kCapsule ? stats.capsule_volume_m3 : stats.adenoma_volume_m3) += volume;
     const auto angles = dihedral_angles(mesh, t);
     stats.min_dihedral_deg = std::min(stats.min_dihedral_deg, units::rad_to_deg(angles.front()));

@@ -40,6 +40,7 @@ struct TetMeshStats {
   double volume_m3 = 0.0;
   double capsule_volume_m3 = 0.0;
   double adenoma_volume_m3 = 0.0;
+  double max_tetrahedron_volume_m3 = 0.0;
   double min_dihedral_deg = 0.0;
   double max_dihedral_deg = 0.0;
   double max_radius_edge_ratio = 0.0;

@@ -64,6 +64,10 @@ TEST(ActionScript, ErrorsNameTheLineAndTheProblem) {
     EXPECT_NE(parsed.error().find(expected), std::string::npos) << parsed.error();
   }
   EXPECT_FALSE(load_actions("/nonexistent/x.actions"));
+  // A device is refused by name, not read until the memory runs out.
+  Result<std::vector<Action>> device = load_actions("/dev/zero");
+  ASSERT_FALSE(device);
+  EXPECT_NE(device.error().find("/dev/zero: not a regular file"), std::string::npos) << device.error();
 }
 
 TEST(TissuePresets, RoundTripAndClearErrors) {
@@ -87,7 +91,10 @@ TEST(TissuePresets, RoundTripAndClearErrors) {
       {R"({"resecto_preset": 1, "parameters": {"stiffness": 9000}})", "out of range"},
       {R"({"resecto_preset": 1, "parameters": {"stiffness": "hard"}})", "must be a number"},
       {R"({"parameters": {}})", "not a Resecto preset"},
-      {R"(not json)", "not a JSON object"},
+      {R"(not json)", "not valid JSON at line 1, column 2"},
+      {"{\"resecto_preset\": 1,\n \"parameters\": {\"stiffness\" 40}}", "not valid JSON at line 2, column "},
+      {R"([1, 2])", "not a JSON object"},
+      {R"({"resecto_preset": 2, "parameters": {}})", "preset format 2 is not one this build reads"},
   };
   for (const auto& [text, expected] : bad) {
     std::ofstream(dir / "bad.json") << text;
@@ -95,6 +102,12 @@ TEST(TissuePresets, RoundTripAndClearErrors) {
     ASSERT_FALSE(r) << text;
     EXPECT_NE(r.error().find(expected), std::string::npos) << r.error();
     EXPECT_NE(r.error().find("bad.json"), std::string::npos) << r.error();
+  }
+  // A folder, or a device that would be read for ever, is refused by name before any read.
+  for (const std::filesystem::path& not_a_file : {dir, std::filesystem::path("/dev/zero")}) {
+    Result<TissueParameters> r = load_preset(not_a_file, TissueParameters{});
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().find(not_a_file.string() + ": "), std::string::npos) << r.error();
   }
 }
 

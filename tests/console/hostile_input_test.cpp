@@ -37,6 +37,11 @@ void expect_clean_failure(const CommandOutput& run, const std::string& expected,
   EXPECT_TRUE(rest == "\n" || rest == "\nRun with --help for more information.\n") << "more than one line: " << run.err;
 }
 
+std::string read_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 /// Names of the entries in `dir`, to check nothing new (a temporary, a partial file) appeared.
 std::set<std::string> listing(const std::filesystem::path& dir) {
   std::set<std::string> names;
@@ -96,6 +101,18 @@ TEST_F(HostileInput, OffHeadersWithoutUsableCountsAreBoundedErrors) {
     expect_clean_failure(run_resecto_bounded(collide_args(file)), expected[i], "collide " + file);
   }
   EXPECT_FALSE(std::filesystem::exists(path("t.vtk")));
+}
+
+TEST_F(HostileInput, CollideNeverWritesItsPairsOverAnInput) {
+  const std::string tool = read_bytes(path("tool.off"));
+  for (const std::string input : {"tool.off", "pose.txt", "p.off"}) {
+    const std::set<std::string> before = listing(*dir_);
+    expect_clean_failure(run_resecto_bounded(collide_args(arg("p.off")) + " --pairs " + arg(input)), arg(input) + ": is the input", input);
+    EXPECT_EQ(listing(*dir_), before);
+  }
+  EXPECT_EQ(read_bytes(path("tool.off")), tool);
+  // A pairs file in a folder that is not there is refused before the queries run.
+  expect_clean_failure(run_resecto_bounded(collide_args(arg("p.off")) + " --pairs " + arg("missing/pairs.csv")), "does not exist", "missing folder");
 }
 
 TEST_F(HostileInput, ProcedureFromADeviceIsRefusedAtOnce) {

@@ -51,6 +51,12 @@ TEST(MeshCommand, TetraReportsVolumesAndAngles) {
   EXPECT_NE(run.out.find("dihedral angles"), std::string::npos);
   EXPECT_NE(run.out.find("difference 0.0000%"), std::string::npos) << run.out;  // boundary kept: volume exact
   EXPECT_TRUE(std::filesystem::exists(dir / "p.vtk"));
+  EXPECT_EQ(run.err.find("warning"), std::string::npos) << run.err;  // the default quality is an aim, not a bound asked for
+
+  // A bound the user asks for that the kept surface faces do not let TetGen meet is said, not passed over.
+  const CommandOutput bounded = run_resecto("mesh tetra " + (dir / "p.ply").string() + " --max-volume 0.5 -o " + (dir / "q.vtk").string());
+  ASSERT_EQ(bounded.exit_code, 0) << bounded.err;
+  EXPECT_NE(bounded.err.find("above --max-volume 0.5"), std::string::npos) << bounded.err;
 }
 
 TEST(MeshCommand, BrokenFileFailsWithOneLineNamingTheFace) {

@@ -3,6 +3,7 @@
 // recovered, and Draco's own decoder reading an exported keyframe.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include <thread>
 
 #include <nlohmann/json.hpp>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -32,6 +34,24 @@ nlohmann::json record(const std::filesystem::path& file, const std::string& extr
       run_resecto("run --headless --procedure demo --triangles 1296 --json --record " + file.string() + " " + extra);
   EXPECT_EQ(run.exit_code, 0) << run.err;
   return json_of(run);
+}
+
+/// A scratch folder `name` with demo.rsrec recorded there (`extra` options), and the file opened.
+struct OpenedRecording {
+  std::filesystem::path dir, file;
+  Result<rec::Recording> recording;
+};
+OpenedRecording record_and_open(const std::string& name, const std::string& extra) {
+  const std::filesystem::path dir = scratch_directory(name), file = dir / "demo.rsrec";
+  record(file, extra);
+  return {dir, file, rec::Recording::open(file)};
+}
+
+/// A copy of `r` at `out` with `mask` flipped in the middle byte of `victim`'s payload: its CRC fails.
+void write_with_a_bit_flipped(const rec::Recording& r, const rec::ChunkLocation& victim, std::uint8_t mask, const std::filesystem::path& out) {
+  std::vector<std::uint8_t> bytes(r.bytes().begin(), r.bytes().end());
+  bytes[victim.payload_offset() + victim.payload_bytes / 2] ^= mask;
+  std::ofstream(out, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
 }
 
 TEST(RecordingCommands, BatchRecordingReplaysWithEveryHashVerified) {
@@ -73,10 +93,7 @@ TEST(RecordingCommands, RealTimeRecordingReplaysToTheRunsHash) {
 }
 
 TEST(RecordingCommands, AnInputAlteredAtOneTickIsReportedAtThatTick) {
-  const auto dir = scratch_directory("recording_altered");
-  const auto file = dir / "demo.rsrec";
-  record(file, "--seconds 1.5");
-  Result<rec::Recording> original = rec::Recording::open(file);
+  const auto [dir, file, original] = record_and_open("recording_altered", "--seconds 1.5");
   ASSERT_TRUE(original);
   // Rewrite the file with one joint of tick 960 (a collision tick, in contact) nudged by 1 um.
   const std::uint64_t altered_tick = 960;
@@ -106,16 +123,11 @@ TEST(RecordingCommands, AnInputAlteredAtOneTickIsReportedAtThatTick) {
 }
 
 TEST(RecordingCommands, VerifyNamesADamagedChunkAndRecoverRepairsIt) {
-  const auto dir = scratch_directory("recording_damaged");
-  const auto file = dir / "demo.rsrec";
-  record(file, "--seconds 1");
-  Result<rec::Recording> r = rec::Recording::open(file);
+  const auto [dir, file, r] = record_and_open("recording_damaged", "--seconds 1");
   ASSERT_TRUE(r);
   const rec::ChunkLocation victim = r->chunks()[5];
-  std::vector<std::uint8_t> bytes(r->bytes().begin(), r->bytes().end());
-  bytes[victim.payload_offset() + victim.payload_bytes / 2] ^= 0x04;
   const auto damaged = dir / "damaged.rsrec";
-  std::ofstream(damaged, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  write_with_a_bit_flipped(*r, victim, 0x04, damaged);
   const testing::CommandOutput verify = run_resecto("rec verify " + damaged.string());
   EXPECT_NE(verify.exit_code, 0);
   EXPECT_NE(verify.err.find("at byte " + std::to_string(victim.offset)), std::string::npos) << verify.err;
@@ -132,6 +144,42 @@ TEST(RecordingCommands, VerifyNamesADamagedChunkAndRecoverRepairsIt) {
   const testing::CommandOutput replay = run_resecto("replay " + recovered.string() + " --verify --json");
   EXPECT_EQ(replay.exit_code, 0) << replay.err;
   EXPECT_EQ(json_of(replay)["mismatches"], 0);
+}
+
+TEST(RecordingCommands, ARecoveryWithoutSomeStepHashesDoesNotVerifyAsWhole) {
+  const auto [dir, file, r] = record_and_open("recording_lost_steps", "--seconds 1");
+  ASSERT_TRUE(r);
+  const auto steps = std::find_if(r->chunks().begin(), r->chunks().end(),
+                                  [](const rec::ChunkLocation& c) { return c.type == static_cast<std::uint16_t>(rec::ChunkType::kSteps); });
+  ASSERT_NE(steps, r->chunks().end());
+  const auto damaged = dir / "damaged.rsrec";
+  write_with_a_bit_flipped(*r, *steps, 0x10, damaged);
+  const auto recovered = dir / "recovered.rsrec";
+  ASSERT_EQ(run_resecto("rec recover " + damaged.string() + " " + recovered.string()).exit_code, 0);
+  // Every tick replays, but the hashes of the dropped chunk's steps were never compared: the
+  // recorder's summary says how many it wrote, and --verify says how many are missing.
+  const testing::CommandOutput replay = run_resecto("replay " + recovered.string() + " --verify --json");
+  EXPECT_NE(replay.exit_code, 0);
+  EXPECT_NE(replay.err.find("collision steps' hashes the recorder wrote are not in the file (`resecto rec recover` left out"), std::string::npos)
+      << replay.err;
+  const nlohmann::json out = json_of(replay);
+  EXPECT_EQ(out["recorded_hashes"], 60);
+  EXPECT_LT(out["hashes_in_file"].get<int>(), 60);
+  EXPECT_EQ(out["mismatches"], 0);
+}
+
+TEST(RecordingCommands, ADeviceOrPipeIsNeverReadAsARecording) {
+  // /dev/zero read as a recording filled the memory; a pipe with no writer hung.
+  const auto dir = scratch_directory("recording_not_a_file");
+  const auto pipe = dir / "pipe.rsrec";
+  ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
+  for (const std::string& path : {std::string("/dev/zero"), pipe.string()}) {
+    for (const std::string command : {"rec info ", "rec verify ", "replay ", "score "}) {
+      const testing::CommandOutput out = run_resecto(command + path);
+      EXPECT_NE(out.exit_code, 0) << command << path;
+      EXPECT_NE(out.err.find(path + ": not a regular file"), std::string::npos) << command << path << ": " << out.err;
+    }
+  }
 }
 
 TEST(RecordingCommands, NoOutputEverReplacesTheFileItIsMadeFrom) {
