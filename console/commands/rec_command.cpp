@@ -118,8 +118,26 @@ void verify(const std::string& file) {
     std::fprintf(stderr, "%s: no index: the recording was not closed (`resecto rec recover %s OUT` rebuilds it)\n", file.c_str(), file.c_str());
     ++problems;
   }
+  // A chunk whose CRC holds can still be unusable (written wrong, or rewritten with a new CRC): the
+  // keyframes are decoded as export and the console's timeline would, and the first ticks must be the
+  // header's start tick on, or nothing replays. (A later gap, where a recovery dropped a damaged
+  // chunk, leaves what precedes it replayable: it is said, not failed.)
+  for (std::size_t k = 0; k < r.keyframes().size(); ++k) {
+    if (const auto frame = r.decode_keyframe(k); !frame) {
+      std::fprintf(stderr, "%s: undecodable: %s\n", file.c_str(), frame.error().c_str());
+      ++problems;
+    }
+  }
+  const std::uint64_t start = static_cast<std::uint64_t>(r.header().start_tick);
+  if (r.replayable_ticks() == 0 && !r.ticks().empty()) {
+    std::fprintf(stderr, "%s: no tick replays: the header starts at tick %llu, the first recorded tick is %llu\n", file.c_str(),
+                 static_cast<unsigned long long>(start), static_cast<unsigned long long>(r.ticks().front().tick));
+    ++problems;
+  }
   if (problems > 0) throw std::runtime_error(file + ": " + std::to_string(problems) + " problem(s), " + std::to_string(r.chunks().size()) + " intact chunks");
-  std::printf("%s: ok, %zu chunks, every CRC matches, index present\n", file.c_str(), r.chunks().size());
+  std::printf("%s: ok, %zu chunks, every CRC matches, every keyframe decodes, index present; %llu of %zu recorded ticks replay%s\n", file.c_str(),
+              r.chunks().size(), static_cast<unsigned long long>(r.replayable_ticks()), r.ticks().size(),
+              r.replayable_ticks() < r.ticks().size() ? (" (a gap at tick " + std::to_string(start + r.replayable_ticks()) + ")").c_str() : "");
 }
 
 void recover(const std::string& in, const std::string& out) {

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iterator>
 #include <thread>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 #include <sys/stat.h>
@@ -45,6 +46,20 @@ OpenedRecording record_and_open(const std::string& name, const std::string& extr
   const std::filesystem::path dir = scratch_directory(name), file = dir / "demo.rsrec";
   record(file, extra);
   return {dir, file, rec::Recording::open(file)};
+}
+
+/// `r` written again at `out` chunk by chunk, each with a fresh CRC, after `edit(chunk, payload)`
+/// (false: leave the chunk out), and closed with a new index.
+template <class Edit>
+void rewrite(const rec::Recording& r, const std::filesystem::path& out, Edit edit) {
+  rec::RecordingWriter writer;
+  ASSERT_TRUE(writer.open(out));
+  for (const rec::ChunkLocation& chunk : r.chunks()) {
+    if (chunk.type == static_cast<std::uint16_t>(rec::ChunkType::kIndex)) continue;
+    std::vector<std::uint8_t> payload(r.payload(chunk).begin(), r.payload(chunk).end());
+    if (edit(chunk, payload)) writer.add_chunk(static_cast<rec::ChunkType>(chunk.type), payload);
+  }
+  ASSERT_TRUE(writer.close());
 }
 
 /// A copy of `r` at `out` with `mask` flipped in the middle byte of `victim`'s payload: its CRC fails.
@@ -97,23 +112,18 @@ TEST(RecordingCommands, AnInputAlteredAtOneTickIsReportedAtThatTick) {
   ASSERT_TRUE(original);
   // Rewrite the file with one joint of tick 960 (a collision tick, in contact) nudged by 1 um.
   const std::uint64_t altered_tick = 960;
-  rec::RecordingWriter writer;
   const auto altered = dir / "altered.rsrec";
-  ASSERT_TRUE(writer.open(altered));
-  for (const rec::ChunkLocation& chunk : original->chunks()) {
-    if (chunk.type == static_cast<std::uint16_t>(rec::ChunkType::kIndex)) continue;
-    std::vector<std::uint8_t> payload(original->payload(chunk).begin(), original->payload(chunk).end());
+  rewrite(*original, altered, [&](const rec::ChunkLocation& chunk, std::vector<std::uint8_t>& payload) {
     if (chunk.type == static_cast<std::uint16_t>(rec::ChunkType::kTicks)) {
       auto ticks = rec::decode_tick_block(payload);
-      ASSERT_TRUE(ticks);
+      EXPECT_TRUE(ticks);
       for (rec::TickRecord& t : *ticks) {
         if (t.tick == altered_tick) t.input.joints.insertion_m += 1e-6;
       }
       rec::encode_tick_block(*ticks, payload);
     }
-    writer.add_chunk(static_cast<rec::ChunkType>(chunk.type), payload);
-  }
-  ASSERT_TRUE(writer.close());
+    return true;
+  });
   const testing::CommandOutput replay = run_resecto("replay " + altered.string() + " --verify --json");
   EXPECT_NE(replay.exit_code, 0);
   EXPECT_EQ(json_of(replay)["first_mismatch_tick"], altered_tick);
@@ -166,6 +176,36 @@ TEST(RecordingCommands, ARecoveryWithoutSomeStepHashesDoesNotVerifyAsWhole) {
   EXPECT_EQ(out["recorded_hashes"], 60);
   EXPECT_LT(out["hashes_in_file"].get<int>(), 60);
   EXPECT_EQ(out["mismatches"], 0);
+}
+
+TEST(RecordingCommands, VerifyDecodesEveryKeyframeAndFindsTicksThatCannotReplay) {
+  // Chunks whose CRCs hold but whose content cannot be used (written wrong, or rewritten with new
+  // CRCs): verify said "ok" and export or replay failed after it.
+  const auto [dir, file, r] = record_and_open("recording_verify_content", "--seconds 1");
+  ASSERT_TRUE(r);
+  const auto is = [](const rec::ChunkLocation& chunk, rec::ChunkType type) { return chunk.type == static_cast<std::uint16_t>(type); };
+  const auto garbled = dir / "garbled_keyframe.rsrec";
+  bool first_keyframe = true;
+  rewrite(*r, garbled, [&](const rec::ChunkLocation& chunk, std::vector<std::uint8_t>& payload) {
+    if (is(chunk, rec::ChunkType::kKeyframe) && std::exchange(first_keyframe, false)) {
+      for (std::size_t b = payload.size() / 2; b < payload.size(); ++b) payload[b] ^= 0x5A;  // the Draco body
+    }
+    return true;
+  });
+  const auto late = dir / "no_first_ticks.rsrec";
+  bool first_ticks = true;
+  rewrite(*r, late, [&](const rec::ChunkLocation& chunk, std::vector<std::uint8_t>&) {
+    return !(is(chunk, rec::ChunkType::kTicks) && std::exchange(first_ticks, false));
+  });
+  const testing::CommandOutput keyframe = run_resecto("rec verify " + garbled.string());
+  EXPECT_NE(keyframe.exit_code, 0);
+  EXPECT_NE(keyframe.err.find("undecodable: " + garbled.string() + ": keyframe 0"), std::string::npos) << keyframe.err;
+  const testing::CommandOutput ticks = run_resecto("rec verify " + late.string());
+  EXPECT_NE(ticks.exit_code, 0);
+  EXPECT_NE(ticks.err.find("no tick replays: the header starts at tick 0"), std::string::npos) << ticks.err;
+  const testing::CommandOutput sound = run_resecto("rec verify " + file.string());
+  EXPECT_EQ(sound.exit_code, 0) << sound.err;
+  EXPECT_NE(sound.out.find("every keyframe decodes"), std::string::npos) << sound.out;
 }
 
 TEST(RecordingCommands, ADeviceOrPipeIsNeverReadAsARecording) {
