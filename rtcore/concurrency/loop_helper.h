@@ -26,6 +26,21 @@
 
 namespace resecto {
 
+/// Work the owner does beside a shared loop, while the helper starts on the loop's chunks: a
+/// function and its context (no allocation, unlike a std::function). Empty: nothing.
+struct SideTask {
+  void (*run)(void*) = nullptr;
+  void* context = nullptr;
+  void operator()() const {
+    if (run != nullptr) run(context);
+  }
+};
+/// A SideTask that calls `task()`; `task` must outlive it.
+template <class Task>
+SideTask side_task(Task& task) {
+  return {[](void* context) { (*static_cast<Task*>(context))(); }, &task};
+}
+
 class LoopHelper {
  public:
   /// The most chunks one loop may have.
@@ -57,10 +72,12 @@ class LoopHelper {
   /// Owner: body(chunk) for every chunk in [0, chunks), run by this thread and the helper (if it is on
   /// call); returns once all have run, with their writes visible. A loop of more than kMaxChunks
   /// chunks runs on this thread alone.
+  /// `alongside` runs on this thread once the loop is offered, before it claims chunks: the helper
+  /// starts on them meanwhile. It must touch nothing the chunks write.
   template <class Body>
-  void for_each_chunk(std::uint32_t chunks, Body& body) {
-    if (chunks == 0) return;
-    if (chunks > kMaxChunks) {
+  void for_each_chunk(std::uint32_t chunks, Body& body, SideTask alongside = {}) {
+    if (chunks == 0 || chunks > kMaxChunks) {
+      alongside();
       for (std::uint32_t chunk = 0; chunk < chunks; ++chunk) body(chunk);
       return;
     }
@@ -71,6 +88,7 @@ class LoopHelper {
     ++generation_;
     const std::uint64_t loop = (static_cast<std::uint64_t>(generation_) << 32) | (static_cast<std::uint64_t>(chunks) << 16);
     work_.store(loop, std::memory_order_release);
+    alongside();
     std::uint32_t ran = 0;
     for (std::uint32_t chunk = 0; claim(generation_, true, chunk);) {
       body(chunk);
@@ -177,12 +195,14 @@ class LoopHelper {
 };
 
 /// body(chunk) for every chunk in [0, chunks): shared with `helper` where there is one, else in order on
-/// this thread. Either way each chunk runs once, so the result is the same.
+/// this thread. Either way each chunk runs once, so the result is the same. `alongside` runs on this
+/// thread too, before it takes any chunk (see LoopHelper::for_each_chunk).
 template <class Body>
-void for_each_chunk(LoopHelper* helper, std::uint32_t chunks, Body& body) {
+void for_each_chunk(LoopHelper* helper, std::uint32_t chunks, Body& body, SideTask alongside = {}) {
   if (helper != nullptr) {
-    helper->for_each_chunk(chunks, body);
+    helper->for_each_chunk(chunks, body, alongside);
   } else {
+    alongside();
     for (std::uint32_t chunk = 0; chunk < chunks; ++chunk) body(chunk);
   }
 }

@@ -226,8 +226,14 @@ void MassSpringTissue::accumulate_forces(double h_s) {
   // springs in ascending spring order (SpringForces::add_sums), its anchor. Each node's force is
   // thus the same sum in the same order every run, and the bounds start from their constant part.
   // Both passes run in chunks shared with the loop helper; every value belongs to one spring or one
-  // node, so the threads change no bit.
-  const std::size_t compressed = springs_.compute(x_.data(), v_.data(), helper_);
+  // node, so the threads change no bit. The contact forces read only positions and velocities: this
+  // thread finds them while the helper starts on the springs (they were a serial fifth of the step
+  // with the tool in contact), and adds them last, as when they were found there.
+  auto find_contact_forces = [&] {
+    reaction_ = tool_.evaluate_forces(x_, v_, surface_.triangles, parameters_.si(TissueParameter::kPenaltyStiffness),
+                                      parameters_.si(TissueParameter::kPenaltyDamping), h_s, travel_m_);
+  };
+  const std::size_t compressed = springs_.compute(x_.data(), v_.data(), helper_, side_task(find_contact_forces));
   const double viscous_rate = parameters_.si(TissueParameter::kViscousDamping);
   const std::size_t n = x_.size();
   auto node_pass = [&](std::uint32_t chunk) {
@@ -248,8 +254,7 @@ void MassSpringTissue::accumulate_forces(double h_s) {
   }
   if (compressed > 0) [[unlikely]] springs_.add_compression_bounds(x_.data(), stiffness_bound_.data(), compressed);
   if (config_.integrator == TissueIntegrator::kImplicitEuler) springs_.linearise(x_.data(), spring_direction_.data(), spring_transverse_k_.data());
-  reaction_ = tool_.add_forces(x_, v_, surface_.triangles, parameters_.si(TissueParameter::kPenaltyStiffness),
-                               parameters_.si(TissueParameter::kPenaltyDamping), h_s, travel_m_, force_, stiffness_bound_, damping_bound_);
+  tool_.apply_forces(force_, stiffness_bound_, damping_bound_);
 }
 
 void MassSpringTissue::step_bounded_symplectic(double h_s) {

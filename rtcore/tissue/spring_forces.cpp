@@ -106,7 +106,7 @@ void SpringForces::reserve(std::size_t spring_capacity, std::size_t node_capacit
   listed_per_chunk_.reserve(chunks_covering(spring_capacity, kSpringsPerChunk));
 }
 
-std::size_t SpringForces::compute(const Vec3* x, const Vec3* v, LoopHelper* helper) {
+std::size_t SpringForces::compute(const Vec3* x, const Vec3* v, LoopHelper* helper, SideTask alongside) {
   refresh_groups();  // normally done by the edits' end already (MassSpringTissue): then free
   const std::size_t count = spring_count();
   const std::uint32_t chunks = chunks_covering(count, kSpringsPerChunk);
@@ -117,7 +117,7 @@ std::size_t SpringForces::compute(const Vec3* x, const Vec3* v, LoopHelper* help
     const std::size_t begin = chunk * kSpringsPerChunk, end = std::min(count, begin + kSpringsPerChunk);
     listed_per_chunk_[chunk] = static_cast<std::uint32_t>(spring_forces(arrays_, x, v, nodes, begin, end, compressed + begin));
   };
-  for_each_chunk(helper, chunks, chunk_pass);
+  for_each_chunk(helper, chunks, chunk_pass, alongside);
   // Each chunk listed its springs at its own start; close the gaps, in chunk order (so ascending).
   std::size_t listed = 0;
   for (std::uint32_t chunk = 0; chunk < chunks; ++chunk) {

@@ -33,8 +33,9 @@ class SpringForces {
   /// The per-spring pass at positions x and velocities v (spring_kernel.h), in chunks shared with
   /// `helper` where there is one: every spring's force is its own, so the chunking changes no bit.
   /// Returns how many springs are compressed below half their rest length, listed ascending
-  /// (add_compression_bounds handles those; usually none).
-  std::size_t compute(const Vec3* x, const Vec3* v, LoopHelper* helper = nullptr);
+  /// (add_compression_bounds handles those; usually none). `alongside` runs on this thread while
+  /// the helper starts on the chunks (LoopHelper::for_each_chunk).
+  std::size_t compute(const Vec3* x, const Vec3* v, LoopHelper* helper = nullptr, SideTask alongside = {});
 
   /// The per-node pass: adds to each force[n] (n in [begin, end)) n's spring forces of the last
   /// compute(), in a fixed order (its springs as node j ascending, then as node i ascending). Each

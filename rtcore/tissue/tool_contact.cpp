@@ -148,6 +148,7 @@ ToolContacts::ToolContacts(double margin_m, const ToolContactCapacity& capacity)
   search_.sorting.resize(static_cast<std::size_t>(std::max(capacity.max_tissue_nodes, capacity.max_tool_vertices)));
   node_clearance_.resize(static_cast<std::size_t>(capacity.max_tissue_nodes));
   vertex_clearance_.resize(static_cast<std::size_t>(capacity.max_tool_vertices));
+  shares_.resize(static_cast<std::size_t>(capacity.max_tissue_nodes) + 3 * static_cast<std::size_t>(capacity.max_tool_vertices));
   stack_.reserve(256);
 }
 
@@ -515,7 +516,24 @@ void ToolContacts::search_tool_vertices(std::uint16_t part_index, const SphereTr
 ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const Vec3> v, const std::vector<Triangle>& surface_triangles,
                                       double k, double c, double h_s, double tissue_travel_m, std::span<Vec3> force,
                                       std::span<double> stiffness_bound, std::span<double> damping_bound) {
+  const ToolReaction reaction = evaluate_forces(x, v, surface_triangles, k, c, h_s, tissue_travel_m);
+  apply_forces(force, stiffness_bound, damping_bound);
+  return reaction;
+}
+
+void ToolContacts::apply_forces(std::span<Vec3> force, std::span<double> stiffness_bound, std::span<double> damping_bound) const {
+  for (std::size_t s = 0; s < share_count_; ++s) {
+    const NodeShare& share = shares_[s];
+    force[share.node] += share.force;
+    stiffness_bound[share.node] += share.stiffness;
+    damping_bound[share.node] += share.damping;
+  }
+}
+
+ToolReaction ToolContacts::evaluate_forces(std::span<const Vec3> x, std::span<const Vec3> v, const std::vector<Triangle>& surface_triangles,
+                                           double k, double c, double h_s, double tissue_travel_m) {
   ToolReaction reaction;
+  share_count_ = 0;  // at most one share per node candidate and three per vertex candidate: within the room
   std::int32_t penetrating = 0;
   std::int64_t skipped = 0;
   const double inverse_h = 1.0 / h_s;
@@ -549,9 +567,7 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
     const double separating_speed = glm::dot(v[pc.point] - surface_velocity, out);
     const double magnitude = std::max(0.0, k * depth - c * separating_speed);
     const Vec3 f = magnitude * out;
-    force[pc.point] += f;
-    stiffness_bound[pc.point] += k;
-    damping_bound[pc.point] += c;
+    shares_[share_count_++] = {pc.point, f, k, c};
     reaction.force_n -= f;
     reaction.torque_nm += glm::cross(surface_world - part.pose.translation, -f);
     ++penetrating;
@@ -594,11 +610,7 @@ ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const V
     const double approach_speed = glm::dot(tool_velocity - tissue_velocity, in);
     const double magnitude = std::max(0.0, k * depth + c * approach_speed);
     const Vec3 f = magnitude * in;
-    for (int corner = 0; corner < 3; ++corner) {
-      force[t[corner]] += weights[corner] * f;
-      stiffness_bound[t[corner]] += weights[corner] * k;
-      damping_bound[t[corner]] += weights[corner] * c;
-    }
+    for (int corner = 0; corner < 3; ++corner) shares_[share_count_++] = {t[corner], weights[corner] * f, weights[corner] * k, weights[corner] * c};
     reaction.force_n -= f;
     reaction.torque_nm += glm::cross(w - part.pose.translation, -f);
     ++penetrating;

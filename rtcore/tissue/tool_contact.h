@@ -108,6 +108,13 @@ class ToolContacts {
   ToolReaction add_forces(std::span<const Vec3> x, std::span<const Vec3> v, const std::vector<Triangle>& surface_triangles,
                           double stiffness_n_m, double damping_ns_m, double h_s, double tissue_travel_m, std::span<Vec3> force,
                           std::span<double> stiffness_bound, std::span<double> damping_bound);
+  /// add_forces() in two halves, so that the first can run beside the spring pass (it reads only the
+  /// positions and velocities): evaluate_forces() finds the forces and keeps each node's share in
+  /// order; apply_forces() then adds the shares to `force` and the bounds in that order, the very
+  /// additions add_forces() makes. Returns the reaction on the tool.
+  ToolReaction evaluate_forces(std::span<const Vec3> x, std::span<const Vec3> v, const std::vector<Triangle>& surface_triangles,
+                               double stiffness_n_m, double damping_ns_m, double h_s, double tissue_travel_m);
+  void apply_forces(std::span<Vec3> force, std::span<double> stiffness_bound, std::span<double> damping_bound) const;
 
   /// Whether add_forces() may skip points whose clearance certificate still holds, and stop a point's
   /// scan at the first face its search distance proves cannot be the nearest (on by default). Off,
@@ -235,6 +242,14 @@ class ToolContacts {
   std::size_t corner_count_ = 0;
   // Per published candidate point, its clearance certificate (the search's, renewed by add_forces()).
   std::vector<Clearance> node_clearance_, vertex_clearance_;
+  // evaluate_forces()'s result: each push's share of a node's force and bounds, in the order made.
+  struct NodeShare {
+    std::uint32_t node;
+    Vec3 force;
+    double stiffness, damping;
+  };
+  std::vector<NodeShare> shares_;  // room for a share per candidate node and three per candidate vertex
+  std::size_t share_count_ = 0;
   double query_tissue_travel_m_ = 0.0;  // latched with the query poses
   bool clearance_skipping_ = true;
   std::int64_t points_evaluated_ = 0, points_skipped_ = 0;
