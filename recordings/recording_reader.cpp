@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "recordings/recording_writer.h"
+#include "rtcore/base/json_text.h"
 #include "rtcore/base/text_file.h"
 
 namespace resecto::rec {
@@ -80,7 +81,7 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
         try {
           r.summary_ = nlohmann::ordered_json::parse(payload.begin(), payload.end());
         } catch (const std::exception& e) {
-          r.content_errors_.push_back(where + ": " + e.what());
+          r.content_errors_.push_back(where + ": " + library_free(e.what()));
         }
         break;
       case ChunkType::kIndex:

@@ -78,7 +78,7 @@ Result<RecoverReport> recover(const Recording& recording, const std::filesystem:
 
 Status export_keyframe(const Recording& recording, std::size_t k, const std::filesystem::path& out) {
   if (k >= recording.keyframes().size()) {
-    return Error{"keyframe " + std::to_string(k) + " does not exist (" + std::to_string(recording.keyframes().size()) + " recorded)"};
+    return Error{recording.name() + ": keyframe " + std::to_string(k) + " does not exist (" + std::to_string(recording.keyframes().size()) + " recorded)"};
   }
   if (out.extension() == ".drc") return write_bytes_atomically(out, recording.keyframe_draco(k));
   Result<SurfaceFrame> frame = recording.decode_keyframe(k);

@@ -7,6 +7,7 @@
 
 #include "recordings/chunk_format.h"
 #include "recordings/json_fields.h"
+#include "rtcore/base/json_text.h"
 
 namespace resecto::rec {
 namespace {
@@ -155,6 +156,7 @@ Result<SessionHeader> header_from_json(std::string_view text) {
     h.mode = j.get<std::string>("mode");
     h.seed = j.get<std::uint64_t>("seed");
     h.start_tick = j.get<std::int64_t>("start_tick");
+    if (h.start_tick < 0) JsonFields::fail("start_tick", "must be at least 0, not " + std::to_string(h.start_tick));
     h.surface_triangles = j.get<std::uint32_t>("surface_triangles");
     h.nodes = j.get<std::uint32_t>("nodes");
     h.metric_words = j.get<std::uint32_t>("metric_words");
@@ -170,7 +172,7 @@ Result<SessionHeader> header_from_json(std::string_view text) {
     h.calibration = j.contains("calibration") ? j.at("calibration") : ordered_json(nullptr);
     return h;
   } catch (const std::exception& e) {
-    return Error{std::string("header: ") + e.what()};
+    return Error{"header: " + library_free(e.what())};
   }
 }
 

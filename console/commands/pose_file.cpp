@@ -30,7 +30,9 @@ Result<std::vector<RigidPose>> parse_poses(const std::string& text, const std::s
       char* end = nullptr;
       const double v = std::strtod(cursor, &end);
       if (end == cursor) return Error{where + "'" + std::string(cursor).substr(0, 20) + "' is not a number"};
-      if (!std::isfinite(v)) return Error{where + "value " + std::to_string(count + 1) + " is not finite"};
+      if (!std::isfinite(v)) {
+        return Error{where + "number " + std::to_string(count + 1) + " of 12, '" + std::string(cursor, static_cast<std::size_t>(end - cursor)) + "', is not finite"};
+      }
       if (count == 12) return Error{where + "more than 12 numbers (expected r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz)"};
       values[count++] = v;
       cursor = end;

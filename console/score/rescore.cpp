@@ -104,7 +104,7 @@ std::string score_csv_row(const RecordingScore& s) {
 Result<RecordingScore> score_recording(const std::filesystem::path& path, const ScoreProgress& progress) {
   const std::string name = path.string();
   Result<rec::Recording> recording = rec::Recording::open(path);
-  if (!recording) return Error{name + ": " + recording.error()};
+  if (!recording) return Error{recording.error()};  // it names the file
   if (!recording->damaged().empty()) {
     const rec::DamagedRange& d = recording->damaged().front();
     return Error{name + ": damaged (" + std::to_string(recording->damaged().size()) + " damaged byte ranges, the first at byte " +

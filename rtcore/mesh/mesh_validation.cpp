@@ -101,8 +101,9 @@ Status check_edges(const TriangleMesh& mesh, std::vector<EdgeUse>& uses) {
     if (count == 1) {
       problem = "open surface: " + edge + " of " + face_name(uses[i].face) + " has no neighbouring face";
     } else if (count > 2) {
-      problem = "non-manifold " + edge + " is shared by " + std::to_string(count) + " faces (" +
-                face_name(uses[i].face) + ", " + std::to_string(uses[i + 1].face) + ", " + std::to_string(uses[i + 2].face) + ")";
+      problem = "non-manifold " + edge + " is shared by " + std::to_string(count) + " faces (" + face_name(uses[i].face);
+      for (std::size_t k = i + 1; k < std::min(j, i + 6); ++k) problem += ", " + std::to_string(uses[k].face);
+      problem += count > 6 ? ", ...)" : ")";
     } else if (uses[i].forward == uses[i + 1].forward) {
       problem = "inconsistent orientation: " + face_name(uses[i].face) + " and " + face_name(uses[i + 1].face) +
                 " walk " + edge + " the same way";

@@ -143,6 +143,8 @@ Result<Procedure> parse_procedure(const std::string& text, const std::string& so
     ++number;
     const auto first = line.find_first_not_of(" \t\r");
     if (first == std::string::npos || line[first] == '#') continue;
+    // A comment may also end a line ("2.0  0 0 0  80 0  1 0   # first stroke").
+    if (const std::size_t comment = line.find('#'); comment != std::string::npos) line.erase(comment);
     std::istringstream words(line);
     double v[8];
     int count = 0;

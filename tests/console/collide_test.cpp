@@ -190,6 +190,11 @@ TEST(CollideCommand, MalformedPosesLineIsNamed) {
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.err.find("poses.txt:1: expected 12 numbers"), std::string::npos) << result.err;
 
+  std::ofstream(f.poses) << "1 0 0 0 0 1 0 0 0 0 1 nan\n";
+  result = run_resecto(common_args(f));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.err.find("poses.txt:1: number 12 of 12, 'nan', is not finite"), std::string::npos) << result.err;
+
   std::ofstream(f.poses) << "2 0 0 0 0 1 0 0 0 0 1 0\n";
   result = run_resecto(common_args(f));
   EXPECT_NE(result.exit_code, 0);

@@ -222,6 +222,22 @@ TEST(SessionHeaderJson, RefusesBoundsNoReplayCouldBuild) {
 
 // Headers written before the contact search could keep its candidates have no contact_reuse_m: such
 // a session searched at every collision step, and replays so; one set outside [0, margin) is refused.
+TEST(SessionHeaderJson, ANegativeStartTickIsRefusedByName) {
+  SessionHeader header;
+  header.format_version = kFormatVersion;
+  header.grid.bits = 11;
+  header.grid.range = 0.1f;
+  nlohmann::ordered_json json = header_to_json(header);
+  json["start_tick"] = -5;
+  const Result<SessionHeader> parsed = header_from_json(json.dump());
+  ASSERT_FALSE(parsed);
+  EXPECT_EQ(parsed.error(), "header: start_tick: must be at least 0, not -5");
+  // Syntax errors carry the parser's place, without the library's exception prefix.
+  const Result<SessionHeader> broken = header_from_json("{\"format_version\": ");
+  ASSERT_FALSE(broken);
+  EXPECT_EQ(broken.error().find("[json.exception"), std::string::npos) << broken.error();
+}
+
 TEST(SessionHeaderJson, AHeaderWithoutContactReuseReplaysSearchingEveryStep) {
   SessionHeader header;
   header.format_version = kFormatVersion;

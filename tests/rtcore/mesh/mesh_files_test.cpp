@@ -114,12 +114,12 @@ TEST(MeshFiles, NonManifoldEdgeNamesTheFaces) {
   // A cube plus a fin: an extra triangle on the cube's edge (0, 1) makes that edge three-way.
   std::string text = "OFF\n9 13 0\n" + std::string(kCubeVertices) + "0.5 -1 -1\n";
   for (const auto& t : kCubeFaces) text += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + "\n";
-  text += "3 0 1 8\n";
+  text += "3 0 1 8\n3 1 0 8\n";  // two fins: the edge is shared by four faces, and each is named
   const std::string error = validation_error(write_file("fin.ply", std::string("ply\nformat ascii 1.0\nelement vertex 9\nproperty float x\n"
-      "property float y\nproperty float z\nelement face 13\nproperty list uchar int vertex_indices\nend_header\n") +
+      "property float y\nproperty float z\nelement face 14\nproperty list uchar int vertex_indices\nend_header\n") +
       text.substr(text.find('\n', 4) + 1)));
-  EXPECT_NE(error.find("non-manifold edge (0, 1)"), std::string::npos) << error;
-  EXPECT_NE(error.find("face 0"), std::string::npos) << error;
+  EXPECT_NE(error.find("non-manifold edge (0, 1) is shared by 4 faces (face 0, "), std::string::npos) << error;
+  EXPECT_NE(error.find(", 12, 13)"), std::string::npos) << error;
 }
 
 TEST(MeshFiles, BowtieVertexIsNonManifold) {

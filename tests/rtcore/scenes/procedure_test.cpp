@@ -72,6 +72,7 @@ TEST(Procedure, ErrorsNameTheLine) {
   EXPECT_NE(error_of("0 0 zero 0 100 0 0 0\n").find("pitch_deg is not a number: 'zero'"), std::string::npos);
   EXPECT_NE(error_of("0 5 0 0 100 0 0 0\n").find("mine.txt:1: the first keyframe must have yaw, pitch and roll 0"), std::string::npos);
   EXPECT_NE(error_of("# nothing\n").find("no keyframes"), std::string::npos);
+  EXPECT_EQ(error_of("0 0 0 0 100 0 0 0   # start\n1 0 0 0 120 0 0 0# in\n"), "");  // a comment may end a line
   Result<Procedure> unknown = find_procedure("tour");
   ASSERT_FALSE(unknown);
   EXPECT_NE(unknown.error().find("built-in: demo"), std::string::npos);
