@@ -198,13 +198,19 @@ TEST(RecordingFile, AFlippedBitInChunkKLosesChunkKOnly) {
 namespace resecto::rec {
 namespace {
 
-// A header whose checksums are right but whose values would make the replay build a model of
-// billions of tetrahedra or buffers of billions of entries is refused by name, not attempted.
-TEST(SessionHeaderJson, RefusesBoundsNoReplayCouldBuild) {
+/// A header every field of which is in range: the tests change one at a time.
+SessionHeader sound_header() {
   SessionHeader header;
   header.format_version = kFormatVersion;
   header.grid.bits = 11;
   header.grid.range = 0.1f;
+  return header;
+}
+
+// A header whose checksums are right but whose values would make the replay build a model of
+// billions of tetrahedra or buffers of billions of entries is refused by name, not attempted.
+TEST(SessionHeaderJson, RefusesBoundsNoReplayCouldBuild) {
+  const SessionHeader header = sound_header();
   const auto refused = [&](const char* key_path, double value) {
     nlohmann::ordered_json json = header_to_json(header);
     nlohmann::ordered_json* at = &json["simulation"];
@@ -223,10 +229,7 @@ TEST(SessionHeaderJson, RefusesBoundsNoReplayCouldBuild) {
 // Headers written before the contact search could keep its candidates have no contact_reuse_m: such
 // a session searched at every collision step, and replays so; one set outside [0, margin) is refused.
 TEST(SessionHeaderJson, ANegativeStartTickIsRefusedByName) {
-  SessionHeader header;
-  header.format_version = kFormatVersion;
-  header.grid.bits = 11;
-  header.grid.range = 0.1f;
+  const SessionHeader header = sound_header();
   nlohmann::ordered_json json = header_to_json(header);
   json["start_tick"] = -5;
   const Result<SessionHeader> parsed = header_from_json(json.dump());
@@ -239,10 +242,7 @@ TEST(SessionHeaderJson, ANegativeStartTickIsRefusedByName) {
 }
 
 TEST(SessionHeaderJson, AHeaderWithoutContactReuseReplaysSearchingEveryStep) {
-  SessionHeader header;
-  header.format_version = kFormatVersion;
-  header.grid.bits = 11;
-  header.grid.range = 0.1f;
+  const SessionHeader header = sound_header();
   nlohmann::ordered_json json = header_to_json(header);
   EXPECT_EQ(header_from_json(json.dump())->simulation.tissue.contact_reuse_m, header.simulation.tissue.contact_reuse_m);
   json["simulation"]["tissue"].erase("contact_reuse_m");
@@ -258,10 +258,7 @@ TEST(SessionHeaderJson, AHeaderWithoutContactReuseReplaysSearchingEveryStep) {
 // A hand-edited or damaged header is refused with the path of the field at fault: absent, of the
 // wrong type, or out of its type's range (a negative count would otherwise wrap to four billion).
 TEST(SessionHeaderJson, NamesTheFieldAtFault) {
-  SessionHeader header;
-  header.format_version = kFormatVersion;
-  header.grid.bits = 11;
-  header.grid.range = 0.1f;
+  const SessionHeader header = sound_header();
   const nlohmann::ordered_json good = header_to_json(header);
   ASSERT_TRUE(header_from_json(good.dump()));
   const auto error_of = [](const nlohmann::ordered_json& json) {
