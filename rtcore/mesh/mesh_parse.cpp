@@ -528,10 +528,14 @@ Result<RawMesh> parse_ply(std::string_view text, const std::string& name) {
         if (!length) return Error{length.error()};
         const bool corners = is_face && static_cast<int>(p) == corners_property;
         const std::size_t item_min = body.ascii() ? 2 : ply_size(property.type);
-        if (*length < 0 || *length > static_cast<double>(body.bytes_left() / item_min) ||
-            (corners && (*length < 3 || *length > static_cast<double>(kMaxPolygonCorners)))) {
-          return Error{name + ": byte " + std::to_string(body.position()) + ": " + what + " has " + exact_number(*length) +
-                       (corners ? " corners (3 to " + std::to_string(kMaxPolygonCorners) + " are read)" : " items, more than the file holds")};
+        if (corners && (*length < 3 || *length > static_cast<double>(kMaxPolygonCorners))) {
+          return Error{name + ": byte " + std::to_string(body.position()) + ": " + what + " has " + exact_number(*length) + " corners (3 to " +
+                       std::to_string(kMaxPolygonCorners) + " are read)"};
+        }
+        if (*length < 0) return Error{name + ": byte " + std::to_string(body.position()) + ": " + what + " has a negative count " + exact_number(*length)};
+        if (*length > static_cast<double>(body.bytes_left() / item_min)) {
+          return Error{name + ": byte " + std::to_string(body.position()) + ": " + what + " has " + exact_number(*length) + " items, but " +
+                       std::to_string(body.bytes_left()) + " bytes are left: the file is cut short"};
         }
         for (std::int64_t i = 0; i < static_cast<std::int64_t>(*length); ++i) {
           Result<double> item = body.read(property.type, what.c_str());

@@ -37,11 +37,6 @@ void expect_clean_failure(const CommandOutput& run, const std::string& expected,
   EXPECT_TRUE(rest == "\n" || rest == "\nRun with --help for more information.\n") << "more than one line: " << run.err;
 }
 
-std::string read_bytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 /// Names of the entries in `dir`, to check nothing new (a temporary, a partial file) appeared.
 std::set<std::string> listing(const std::filesystem::path& dir) {
   std::set<std::string> names;
@@ -104,13 +99,13 @@ TEST_F(HostileInput, OffHeadersWithoutUsableCountsAreBoundedErrors) {
 }
 
 TEST_F(HostileInput, CollideNeverWritesItsPairsOverAnInput) {
-  const std::string tool = read_bytes(path("tool.off"));
+  const std::string tool = read_text(path("tool.off"));
   for (const std::string input : {"tool.off", "pose.txt", "p.off"}) {
     const std::set<std::string> before = listing(*dir_);
     expect_clean_failure(run_resecto_bounded(collide_args(arg("p.off")) + " --pairs " + arg(input)), arg(input) + ": is the input", input);
     EXPECT_EQ(listing(*dir_), before);
   }
-  EXPECT_EQ(read_bytes(path("tool.off")), tool);
+  EXPECT_EQ(read_text(path("tool.off")), tool);
   // A pairs file in a folder that is not there is refused before the queries run.
   expect_clean_failure(run_resecto_bounded(collide_args(arg("p.off")) + " --pairs " + arg("missing/pairs.csv")), "does not exist", "missing folder");
 }
@@ -192,6 +187,18 @@ TEST_F(HostileInput, CollideRefusesTruncatedMeshesInEveryFormat) {
     const CommandOutput run = run_resecto_bounded(collide_args(arg(cut)));
     expect_clean_failure(run, "cut." + std::string(format), format);
   }
+  // A binary PLY cut inside its face list says so (it read as "has 3 corners (3 to 1024 are read)").
+  std::string ply = "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                    "element face 4\nproperty list uchar int vertex_indices\nend_header\n";
+  const float corners[4][3] = {{0, 0, 0}, {10, 0, 0}, {0, 10, 0}, {0, 0, 10}};
+  ply.append(reinterpret_cast<const char*>(corners), sizeof corners);  // little-endian, as on every machine this builds for
+  const std::int32_t faces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  for (const auto& face : faces) ply.append(1, '\x03').append(reinterpret_cast<const char*>(face), sizeof face);
+  write_bytes(path("tet.ply"), ply);
+  EXPECT_EQ(run_resecto_bounded("mesh check " + arg("tet.ply")).exit_code, 0);
+  write_bytes(path("cut_binary.ply"), ply.substr(0, ply.size() - 10));
+  expect_clean_failure(run_resecto_bounded("mesh check " + arg("cut_binary.ply")), "face 3 vertex_indices has 3 items, but 2 bytes are left: the file is cut short",
+                       "binary PLY cut in a face");
 }
 
 TEST_F(HostileInput, NumericOptionsRejectNanAndZeroDurations) {
