@@ -1,5 +1,6 @@
 // `resecto mesh ...`: the procedural models (prostate, resectoscope), validation of a user's surface,
 // and TetGen's volumetric model with region labels. Lengths on the command line are millimetres.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -41,6 +42,20 @@ void print_surface_report(const SurfaceReport& r) {
               units::m_to_mm(r.max_edge_m), r.min_angle_deg);
 }
 
+
+/// Says on standard error when a surface read as millimetres is far from an organ's or a tool's
+/// size: a file exported in metres (1000 times too small) or in micrometres reads as valid.
+void warn_if_unlikely_scale(const TriangleMesh& mesh, const std::string& what) {
+  if (mesh.positions.empty()) return;
+  Vec3 low = mesh.positions.front(), high = low;
+  for (const Vec3& p : mesh.positions) low = glm::min(low, p), high = glm::max(high, p);
+  const double span_mm = units::m_to_mm(std::max({high.x - low.x, high.y - low.y, high.z - low.z}));
+  constexpr double kSmallestMm = 2.0, kLargestMm = 1000.0;  // a wire loop's span; a metre
+  if (span_mm < kSmallestMm || span_mm > kLargestMm) {
+    std::fprintf(stderr, "warning: %s spans %.4g mm at most; resecto reads meshes in millimetres (one exported in %s?)\n", what.c_str(), span_mm,
+                 span_mm < kSmallestMm ? "metres" : "micrometres");
+  }
+}
 
 SurfaceReport validated(const TriangleMesh& mesh, const std::string& what) {
   Result<SurfaceReport> report = validate_closed_surface(mesh);
@@ -118,6 +133,7 @@ void register_check(CLI::App& mesh) {
     const SurfaceReport report = validated(*mesh, *path);
     std::printf("%s: valid closed surface\n", path->c_str());
     print_surface_report(report);
+    warn_if_unlikely_scale(*mesh, *path);
   });
 }
 
@@ -146,6 +162,7 @@ void register_tetra(CLI::App& mesh) {
     Result<TriangleMesh> surface = read_surface_mesh(options->input);
     if (!surface) fail(surface.error());
     const SurfaceReport report = validated(*surface, options->input);
+    warn_if_unlikely_scale(*surface, options->input);
 
     TetrahedralizeOptions tet;
     tet.max_radius_edge_ratio = options->radius_edge;

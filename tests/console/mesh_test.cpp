@@ -73,6 +73,21 @@ TEST(MeshCommand, BrokenFileFailsWithOneLineNamingTheFace) {
   EXPECT_FALSE(std::filesystem::exists(dir / "o.vtk"));
 }
 
+TEST(MeshCommand, ASurfaceFarFromAnOrgansSizeIsPointedOut) {
+  // Meshes are read in millimetres: a tetrahedron exported in metres is valid but 1000 times too small.
+  const auto dir = scratch_directory("mesh_scale");
+  const auto path = dir / "metres.off";
+  std::ofstream(path) << "OFF\n4 4 0\n0 0 0\n0.01 0 0\n0 0.01 0\n0 0 0.01\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  const CommandOutput tiny = run_resecto("mesh check " + path.string());
+  EXPECT_EQ(tiny.exit_code, 0) << tiny.err;
+  EXPECT_NE(tiny.err.find("metres.off spans 0.01 mm at most; resecto reads meshes in millimetres (one exported in metres?)"), std::string::npos)
+      << tiny.err;
+  ASSERT_EQ(run_resecto("mesh prostate --triangles 1296 -o " + (dir / "p.off").string()).exit_code, 0);
+  const CommandOutput gland = run_resecto("mesh check " + (dir / "p.off").string());
+  EXPECT_EQ(gland.exit_code, 0) << gland.err;
+  EXPECT_EQ(gland.err, "");
+}
+
 TEST(MeshCommand, EverySubcommandHasHelp) {
   for (const char* sub : {"mesh", "mesh prostate", "mesh resectoscope", "mesh check", "mesh tetra"}) {
     const CommandOutput run = run_resecto(std::string(sub) + " --help");
