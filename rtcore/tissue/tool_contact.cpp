@@ -513,14 +513,6 @@ void ToolContacts::search_tool_vertices(std::uint16_t part_index, const SphereTr
   }
 }
 
-ToolReaction ToolContacts::add_forces(std::span<const Vec3> x, std::span<const Vec3> v, const std::vector<Triangle>& surface_triangles,
-                                      double k, double c, double h_s, double tissue_travel_m, std::span<Vec3> force,
-                                      std::span<double> stiffness_bound, std::span<double> damping_bound) {
-  const ToolReaction reaction = evaluate_forces(x, v, surface_triangles, k, c, h_s, tissue_travel_m);
-  apply_forces(force, stiffness_bound, damping_bound);
-  return reaction;
-}
-
 void ToolContacts::apply_forces(std::span<Vec3> force, std::span<double> stiffness_bound, std::span<double> damping_bound) const {
   for (std::size_t s = 0; s < share_count_; ++s) {
     const NodeShare& share = shares_[s];

@@ -88,11 +88,11 @@ class ToolContacts {
   /// Finds, for each part at its latched pose, the tissue surface nodes within the margin of it and
   /// the part's vertices within the margin of the tissue, each with every triangle of the other side
   /// within the margin, from the tissue surface tree (already refitted to `surface`'s positions), into
-  /// a back buffer. Touches nothing add_forces() or set_pose() use, so
+  /// a back buffer. Touches nothing evaluate_forces() or set_pose() use, so
   /// it may run concurrently with them; never with latch_query_poses() or publish_candidates().
   /// Each point it keeps comes with its clearance certificate at the searched positions.
   void search_candidates(const SphereTree& tissue_tree, const TriangleMesh& surface);
-  /// Makes the last search's candidates the ones add_forces() uses (a swap: no allocation).
+  /// Makes the last search's candidates the ones evaluate_forces() uses (a swap: no allocation).
   void publish_candidates();
   /// How far the latched query poses have moved the tool from where the published candidates were
   /// searched: the largest displacement of an enabled part's vertex between the two. Infinite when
@@ -100,23 +100,19 @@ class ToolContacts {
   /// candidates. Same threading rules as search_candidates().
   double tool_shift_since_search() const;
 
-  /// One substep's penalty forces on the candidate pairs at positions x, velocities v: adds to
-  /// `force`, and to the per-node bounds of the contact stiffness and damping the integrator needs.
-  /// `tissue_travel_m` bounds how far any tissue node has moved since the tissue was created (a
-  /// running sum of each step's largest node displacement); it lets a point found clear of the other
-  /// surface skip its tests until the two could have met. Returns the reaction on the tool.
-  ToolReaction add_forces(std::span<const Vec3> x, std::span<const Vec3> v, const std::vector<Triangle>& surface_triangles,
-                          double stiffness_n_m, double damping_ns_m, double h_s, double tissue_travel_m, std::span<Vec3> force,
-                          std::span<double> stiffness_bound, std::span<double> damping_bound);
-  /// add_forces() in two halves, so that the first can run beside the spring pass (it reads only the
-  /// positions and velocities): evaluate_forces() finds the forces and keeps each node's share in
-  /// order; apply_forces() then adds the shares to `force` and the bounds in that order, the very
-  /// additions add_forces() makes. Returns the reaction on the tool.
+  /// One substep's penalty forces on the candidate pairs at positions x, velocities v, in two
+  /// halves so that the first can run beside the spring pass (it reads only positions and
+  /// velocities): evaluate_forces() finds them and keeps each node's share in order, apply_forces()
+  /// adds the shares to `force` and to the per-node bounds of the contact stiffness and damping the
+  /// integrator needs, in that order. `tissue_travel_m` bounds how far any tissue node has moved since
+  /// the tissue was created (a running sum of each step's largest node displacement); it lets a point
+  /// found clear of the other surface skip its tests until the two could have met. Returns the
+  /// reaction on the tool.
   ToolReaction evaluate_forces(std::span<const Vec3> x, std::span<const Vec3> v, const std::vector<Triangle>& surface_triangles,
                                double stiffness_n_m, double damping_ns_m, double h_s, double tissue_travel_m);
   void apply_forces(std::span<Vec3> force, std::span<double> stiffness_bound, std::span<double> damping_bound) const;
 
-  /// Whether add_forces() may skip points whose clearance certificate still holds, and stop a point's
+  /// Whether evaluate_forces() may skip points whose clearance certificate still holds, and stop a point's
   /// scan at the first face its search distance proves cannot be the nearest (on by default). Off,
   /// every candidate point is tested against every one of its faces at every step: the brute-force
   /// reference the tests and benchmarks compare against. The forces are the same either way.
@@ -149,7 +145,7 @@ class ToolContacts {
   /// The parts' latched query poses and flags and the latched tissue travel become `front`'s, so a
   /// search here looks where the front's would (call while no search runs on either).
   void copy_query_state(const ToolContacts& front);
-  /// Point evaluations add_forces() ran and skipped on its certificates, since construction.
+  /// Point evaluations evaluate_forces() ran and skipped on its certificates, since construction.
   std::int64_t points_evaluated() const { return points_evaluated_; }
   std::int64_t points_skipped() const { return points_skipped_; }
 
@@ -225,7 +221,7 @@ class ToolContacts {
   double margin_m_;
   ToolContactCapacity capacity_;
   std::vector<Part> parts_;
-  // The published candidates, which add_forces() reads.
+  // The published candidates, which evaluate_forces() reads.
   std::vector<PointCandidates> node_candidates_;    // tissue node against tool triangles
   std::vector<PointCandidates> vertex_candidates_;  // tool vertex against tissue triangles
   std::vector<std::uint32_t> pair_triangles_;
@@ -240,7 +236,7 @@ class ToolContacts {
   // bounds how much nearer a vertex's faces can have come since the search.
   std::vector<SearchedCorner> searched_corners_;
   std::size_t corner_count_ = 0;
-  // Per published candidate point, its clearance certificate (the search's, renewed by add_forces()).
+  // Per published candidate point, its clearance certificate (the search's, renewed by evaluate_forces()).
   std::vector<Clearance> node_clearance_, vertex_clearance_;
   // evaluate_forces()'s result: each push's share of a node's force and bounds, in the order made.
   struct NodeShare {
@@ -253,7 +249,7 @@ class ToolContacts {
   double query_tissue_travel_m_ = 0.0;  // latched with the query poses
   bool clearance_skipping_ = true;
   std::int64_t points_evaluated_ = 0, points_skipped_ = 0;
-  // The search's side: its result and its scratch (stamps, stack), never read by add_forces().
+  // The search's side: its result and its scratch (stamps, stack), never read by evaluate_forces().
   CandidateSet search_;
   std::vector<std::uint32_t> node_stamp_, tissue_triangle_stamp_;
   std::uint32_t stamp_ = 0;
