@@ -32,6 +32,11 @@ Result<TissueParameters> load_preset(const std::filesystem::path& path, const Ti
   if (preset["resecto_preset"] != 1) {
     return Error{path.string() + ": preset format " + preset["resecto_preset"].dump() + " is not one this build reads (it reads format 1)"};
   }
+  for (const auto& [key, value] : preset.items()) {
+    if (key != "resecto_preset" && key != "parameters") {
+      return Error{path.string() + ": unknown key '" + key + "' (a preset holds \"resecto_preset\" and \"parameters\")"};
+    }
+  }
   if (!preset.contains("parameters") || !preset["parameters"].is_object()) {
     return Error{path.string() + ": \"parameters\" must be an object of key: value"};
   }

@@ -95,6 +95,7 @@ TEST(TissuePresets, RoundTripAndClearErrors) {
       {"{\"resecto_preset\": 1,\n \"parameters\": {\"stiffness\" 40}}", "not valid JSON at line 2, column "},
       {R"([1, 2])", "not a JSON object"},
       {R"({"resecto_preset": 2, "parameters": {}})", "preset format 2 is not one this build reads"},
+      {R"({"resecto_preset": 1, "parameters": {}, "stiffnes": 40})", "unknown key 'stiffnes'"},
   };
   for (const auto& [text, expected] : bad) {
     std::ofstream(dir / "bad.json") << text;
