@@ -594,6 +594,20 @@ void BM_RefitWithSlabs(benchmark::State& state) { refit_case(state, true); }
 BENCHMARK(BM_RefitWithSlabs)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Refit)->Arg(1296)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
 
+// The rebuild a tree decayed by cuts gets (SphereTree::rebuild, as the tissue's collision job runs it),
+// of the spheres alone as the tissue's tree keeps them: it shares the collision period with a search.
+void BM_Rebuild(benchmark::State& state) {
+  ProstateModel gland = generate_prostate(static_cast<int>(state.range(0)));
+  SphereTree tree;
+  tree.set_slabs(false);
+  tree.build(gland.surface);
+  for (auto _ : state) {
+    tree.rebuild(gland.surface);
+    benchmark::DoNotOptimize(tree.spheres().data());
+  }
+}
+BENCHMARK(BM_Rebuild)->Arg(8640)->Arg(138240)->Unit(benchmark::kMicrosecond);
+
 void BM_FclAabbRefit(benchmark::State& state) {
   ProstateModel gland = generate_prostate(static_cast<int>(state.range(0)));
   TriangleMesh& mesh = gland.surface;

@@ -288,11 +288,17 @@ std::int32_t SphereTree::build_range(std::int32_t* first, std::int32_t* last, st
   Vec3 axis = extent.x >= extent.y && extent.x >= extent.z ? Vec3{1, 0, 0}
               : extent.y >= extent.z                       ? Vec3{0, 1, 0}
                                                            : Vec3{0, 0, 1};
-  for (int i = 0; i < 12; ++i) {
-    const Vec3 next{cxx * axis.x + cxy * axis.y + cxz * axis.z, cxy * axis.x + cyy * axis.y + cyz * axis.z,
-                    cxz * axis.x + cyz * axis.y + czz * axis.z};
+  // Normalised every fourth product only: the square root and division each round cost more than
+  // the product (a rebuild's largest part), and four products of a covariance in square metres
+  // neither overflow nor underflow a double.
+  for (int round = 0; round < 3; ++round) {
+    Vec3 next = axis;
+    for (int i = 0; i < 4; ++i) {
+      next = Vec3{cxx * next.x + cxy * next.y + cxz * next.z, cxy * next.x + cyy * next.y + cyz * next.z,
+                  cxz * next.x + cyz * next.y + czz * next.z};
+    }
     const double norm = length(next);
-    if (!(norm > 0.0)) break;
+    if (!(norm > 0.0) || !std::isfinite(norm)) break;
     axis = next / norm;
   }
   // Split at the middle of the leaf set's extent along that axis.
