@@ -171,6 +171,15 @@ TEST(ScoreCommand, BadArgumentsAreNamed) {
   const CommandOutput compare = run_resecto("score --compare a b");
   EXPECT_NE(compare.exit_code, 0);
   EXPECT_NE(compare.err.find("needs --html"), std::string::npos) << compare.err;
+  // With several recordings --html is a folder: a file in its place is refused before any scoring
+  // (the recordings need not even exist for that).
+  const auto dir = testing::scratch_directory("score_html_file");
+  std::ofstream(dir / "page.html") << "kept\n";
+  const CommandOutput file_for_folder = run_resecto("score --quiet a.resecto b.resecto --html " + (dir / "page.html").string());
+  EXPECT_EQ(file_for_folder.exit_code, 1);
+  EXPECT_NE(file_for_folder.err.find("page.html: is a file; with several recordings --html names a folder of pages"), std::string::npos)
+      << file_for_folder.err;
+  EXPECT_EQ(file_for_folder.err.find("skipped"), std::string::npos) << file_for_folder.err;
 }
 
 /// Counts the pixels of colour `rgb` in a PNG file (stb_image, as the console's screenshot tests), or
