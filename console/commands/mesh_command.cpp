@@ -7,7 +7,6 @@
 #include <fstream>
 #include <stdexcept>
 #include <string>
-#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -17,9 +16,11 @@
 #include "rtcore/anatomy/prostate.h"
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/base/atomic_file.h"
+#include "rtcore/base/checked_number.h"
 #include "rtcore/base/text_file.h"
 #include "rtcore/base/units.h"
 #include "rtcore/mesh/mesh_io.h"
+#include "rtcore/mesh/triangle_mesh.h"
 #include "rtcore/mesh/mesh_validation.h"
 #include "rtcore/tissue/tetrahedralize.h"
 
@@ -47,9 +48,9 @@ void print_surface_report(const SurfaceReport& r) {
 /// size: a file exported in metres (1000 times too small) or in micrometres reads as valid.
 void warn_if_unlikely_scale(const TriangleMesh& mesh, const std::string& what) {
   if (mesh.positions.empty()) return;
-  Vec3 low = mesh.positions.front(), high = low;
-  for (const Vec3& p : mesh.positions) low = glm::min(low, p), high = glm::max(high, p);
-  const double span_mm = units::m_to_mm(std::max({high.x - low.x, high.y - low.y, high.z - low.z}));
+  const Aabb box = bounding_box(mesh);
+  const Vec3 extent = box.max - box.min;
+  const double span_mm = units::m_to_mm(std::max({extent.x, extent.y, extent.z}));
   constexpr double kSmallestMm = 2.0, kLargestMm = 1000.0;  // a wire loop's span; a metre
   if (span_mm < kSmallestMm || span_mm > kLargestMm) {
     std::fprintf(stderr, "warning: %s spans %.4g mm at most; resecto reads meshes in millimetres (one exported in %s?)\n", what.c_str(), span_mm,
@@ -196,24 +197,19 @@ void register_tetra(CLI::App& mesh) {
     // TetGen keeps the surface's faces whole (-Y, so the tissue's surface is the one given): the
     // tetrahedra on them may stay past a bound. One the user set is said rather than passed over
     // (the default quality is an aim, which the generated glands' slivers at the surface miss).
-    std::vector<std::string> unmet;
-    char line[256];
-    if (options->max_volume_mm3 > 0.0 && stats.max_tetrahedron_volume_m3 * 1e9 > options->max_volume_mm3 * (1.0 + 1e-9)) {
-      std::snprintf(line, sizeof line, "the largest tetrahedron is %.4g mm^3, above --max-volume %.4g", stats.max_tetrahedron_volume_m3 * 1e9,
-                    options->max_volume_mm3);
-      unmet.emplace_back(line);
-    }
-    if (radius_edge->count() > 0 && stats.max_radius_edge_ratio > options->radius_edge * (1.0 + 1e-9)) {
-      std::snprintf(line, sizeof line, "radius-edge ratio %.3g, above --radius-edge %.3g", stats.max_radius_edge_ratio, options->radius_edge);
-      unmet.emplace_back(line);
-    }
-    if (min_dihedral->count() > 0 && stats.min_dihedral_deg < options->min_dihedral_deg * (1.0 - 1e-9)) {
-      std::snprintf(line, sizeof line, "smallest dihedral angle %.3g deg, below --min-dihedral %.3g", stats.min_dihedral_deg, options->min_dihedral_deg);
-      unmet.emplace_back(line);
-    }
-    for (const std::string& what : unmet) {
+    const auto unmet = [&](const std::string& what) {
       std::fprintf(stderr, "warning: %s: %s (TetGen keeps the surface's faces whole, and its bounds hold only where they allow: a finer surface gets nearer)\n",
                    options->output.c_str(), what.c_str());
+    };
+    if (options->max_volume_mm3 > 0.0 && stats.max_tetrahedron_volume_m3 * 1e9 > options->max_volume_mm3 * (1.0 + 1e-9)) {
+      unmet("the largest tetrahedron is " + rounded_number(stats.max_tetrahedron_volume_m3 * 1e9, 4) + " mm^3, above --max-volume " +
+            rounded_number(options->max_volume_mm3, 4));
+    }
+    if (radius_edge->count() > 0 && stats.max_radius_edge_ratio > options->radius_edge * (1.0 + 1e-9)) {
+      unmet("radius-edge ratio " + rounded_number(stats.max_radius_edge_ratio, 3) + ", above --radius-edge " + rounded_number(options->radius_edge, 3));
+    }
+    if (min_dihedral->count() > 0 && stats.min_dihedral_deg < options->min_dihedral_deg * (1.0 - 1e-9)) {
+      unmet("smallest dihedral angle " + rounded_number(stats.min_dihedral_deg, 3) + " deg, below --min-dihedral " + rounded_number(options->min_dihedral_deg, 3));
     }
   });
 }

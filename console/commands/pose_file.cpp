@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 
@@ -51,9 +50,8 @@ Result<std::vector<RigidPose>> parse_poses(const std::string& text, const std::s
       }
     }
     if (const double defect = orthonormality_error(pose.rotation); !(defect <= 1e-4)) {
-      char measured[64];
-      std::snprintf(measured, sizeof measured, "%.3g", defect);
-      return Error{where + "the 3x3 rotation is not orthonormal (R^T R is off the identity by " + measured + " in an entry; 1e-4 is the most taken)"};
+      return Error{where + "the 3x3 rotation is not orthonormal (R^T R is off the identity by " + rounded_number(defect, 3) +
+                   " in an entry; 1e-4 is the most taken)"};
     }
     const double det = glm::determinant(pose.rotation);
     if (!(det > 0.0)) return Error{where + "the 3x3 rotation is a reflection (determinant " + exact_number(det) + "), not a rotation"};

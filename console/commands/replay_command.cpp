@@ -33,8 +33,10 @@ void replay(const ReplayOptions& o) {
   // The steps the recorder wrote, from its summary: a file recovered from a damaged one holds fewer
   // (rec recover drops the damaged chunks), and those were never compared.
   const nlohmann::ordered_json& summary = recording->summary();
-  const std::uint64_t written_steps =
-      std::max<std::uint64_t>(recorded_steps, summary.is_object() && summary.contains("steps") && summary["steps"].is_number_unsigned() ? summary["steps"].get<std::uint64_t>() : 0);
+  std::uint64_t written_steps = recorded_steps;
+  if (summary.is_object() && summary.contains("steps") && summary["steps"].is_number_unsigned()) {
+    written_steps = std::max(written_steps, summary["steps"].get<std::uint64_t>());
+  }
   const bool complete = ticks == recording->ticks().size() && recording->damaged().empty();
 
   nlohmann::ordered_json out = {{"file", o.file},

@@ -47,17 +47,8 @@ void score(const ScoreOptions& o) {
   const std::vector<std::filesystem::path> inputs(files.begin(), files.end());
   const std::vector<std::filesystem::path> outputs{o.csv, comparing || files.size() == 1 ? o.html : std::string()};
   if (Status ok = check_output_paths(outputs, inputs); !ok) throw std::runtime_error("score: " + ok.error());
-  if (!comparing && files.size() > 1 && !o.html.empty()) {
-    // The folder of pages: a file in its place, or no folder it could be made in, is found now.
-    std::error_code error;
-    const std::filesystem::file_status status = std::filesystem::status(o.html, error);
-    if (std::filesystem::exists(status) && !std::filesystem::is_directory(status)) {
-      throw std::runtime_error("score --html " + o.html + ": is a file; with several recordings --html names a folder of pages");
-    }
-    const std::filesystem::path parent = std::filesystem::absolute(o.html).parent_path();
-    if (!std::filesystem::exists(status) && !std::filesystem::is_directory(parent, error)) {
-      throw std::runtime_error("score --html " + o.html + ": its folder " + parent.string() + " does not exist");
-    }
+  if (!comparing && files.size() > 1 && !o.html.empty()) {  // the folder of pages
+    if (Status ok = check_output_folder(o.html, "with several recordings --html names a folder of pages"); !ok) throw std::runtime_error("score --html " + ok.error());
   }
 
   std::vector<RecordingScore> scored;

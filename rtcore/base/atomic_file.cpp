@@ -133,7 +133,33 @@ bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
   return std::filesystem::equivalent(a, b, error) && !error;
 }
 
+/// Whether `folder` is a folder this process can create entries in; the error names `output`. A
+/// folder it cannot write in (read-only, or another user's) would fail only at the end, after the
+/// work the output holds (a long run's report).
+Status check_writable_folder(const std::filesystem::path& folder, const std::filesystem::path& output) {
+  struct stat parent {};
+  if (::stat(folder.c_str(), &parent) != 0) return Error{output.string() + ": its folder " + folder.string() + " does not exist"};
+  if (!S_ISDIR(parent.st_mode)) return Error{output.string() + ": " + folder.string() + " is not a folder"};
+  if (::access(folder.c_str(), W_OK | X_OK) != 0) {
+    return Error{output.string() + ": cannot write in its folder " + folder.string() + ": " + std::strerror(errno)};
+  }
+  return Ok{};
+}
+
 }  // namespace
+
+Status check_output_folder(const std::filesystem::path& output, const std::string& what) {
+  std::error_code error;
+  const std::filesystem::file_status status = std::filesystem::status(output, error);
+  if (std::filesystem::exists(status)) {
+    if (!std::filesystem::is_directory(status)) return Error{output.string() + ": is a file; " + what};
+    return check_writable_folder(output, output);
+  }
+  // Missing folders are made on the way down: the nearest one that exists must take them.
+  std::filesystem::path ancestor = std::filesystem::absolute(output).parent_path();
+  while (!std::filesystem::exists(ancestor, error) && ancestor.has_relative_path()) ancestor = ancestor.parent_path();
+  return check_writable_folder(ancestor, output);
+}
 
 Status check_output_path(const std::filesystem::path& output, std::span<const std::filesystem::path> inputs) {
   struct stat existing {};
@@ -148,16 +174,7 @@ Status check_output_path(const std::filesystem::path& output, std::span<const st
   } else if (stat_errno != ENOENT && stat_errno != ENOTDIR) {  // ENOTDIR: a file where its folder should be, named below
     return Error{output.string() + ": cannot inspect: " + std::strerror(stat_errno)};
   }
-  const std::filesystem::path folder = output.parent_path().empty() ? std::filesystem::path(".") : output.parent_path();
-  struct stat parent {};
-  if (::stat(folder.c_str(), &parent) != 0) return Error{output.string() + ": its folder " + folder.string() + " does not exist"};
-  if (!S_ISDIR(parent.st_mode)) return Error{output.string() + ": " + folder.string() + " is not a folder"};
-  // A folder it cannot write in (read-only, or another user's) would fail only at the end, after
-  // the work the output holds (a long run's report).
-  if (::access(folder.c_str(), W_OK | X_OK) != 0) {
-    return Error{output.string() + ": cannot write in its folder " + folder.string() + ": " + std::strerror(errno)};
-  }
-  return Ok{};
+  return check_writable_folder(output.parent_path().empty() ? std::filesystem::path(".") : output.parent_path(), output);
 }
 
 Status check_output_paths(std::span<const std::filesystem::path> outputs, std::span<const std::filesystem::path> inputs) {

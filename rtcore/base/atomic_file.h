@@ -52,6 +52,10 @@ Status write_file_atomically(const std::filesystem::path& target, std::string_vi
 /// missing folder, or the very file of one of `inputs` (which the output would destroy) is an
 /// error naming the path.
 Status check_output_path(const std::filesystem::path& output, std::span<const std::filesystem::path> inputs = {});
+/// The same for an output that is a folder of files, made with its missing parents when written:
+/// a file in its place (the error says `what` the folder is for), or a nearest existing folder this
+/// process cannot write in, is an error.
+Status check_output_folder(const std::filesystem::path& output, const std::string& what);
 /// The same for several outputs of one command, which must also differ from each other (the last
 /// written would replace the others). Empty paths are outputs not asked for and are skipped.
 Status check_output_paths(std::span<const std::filesystem::path> outputs, std::span<const std::filesystem::path> inputs = {});

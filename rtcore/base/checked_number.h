@@ -20,6 +20,13 @@ inline std::string exact_number(double value) {
   return error == std::errc{} ? std::string(buffer, end) : std::string("?");
 }
 
+/// `value` to `digits` significant digits, as printf's %g: for figures a person reads (12.5 mm^3).
+inline std::string rounded_number(double value, int digits) {
+  char buffer[48];
+  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::general, digits);
+  return error == std::errc{} ? std::string(buffer, end) : std::string("?");
+}
+
 /// True when `value` is a finite number in [lo, hi]; NaN is never in range.
 inline bool in_closed_range(double value, double lo, double hi) { return lo <= value && value <= hi; }
 
