@@ -203,17 +203,17 @@ void SphereTree::add_triangle_leaves(const TriangleMesh& mesh, std::uint32_t t, 
 // ---- Build ------------------------------------------------------------------------------------
 
 void SphereTree::build(const TriangleMesh& mesh) {
-  std::vector<std::uint32_t> all(mesh.triangle_count());
-  for (std::uint32_t t = 0; t < all.size(); ++t) all[t] = t;
-  build_over(mesh, all);
+  build_triangles_.resize(mesh.triangle_count());
+  for (std::uint32_t t = 0; t < build_triangles_.size(); ++t) build_triangles_[t] = t;
+  build_over(mesh);
 }
 
 void SphereTree::rebuild(const TriangleMesh& mesh) {
-  std::vector<std::uint32_t> present;
+  build_triangles_.clear();
   for (std::uint32_t t = 0; t < first_leaf_.size(); ++t) {
-    if (first_leaf_[t] != kNoNode) present.push_back(t);
+    if (first_leaf_[t] != kNoNode) build_triangles_.push_back(t);
   }
-  build_over(mesh, present);
+  build_over(mesh);
 }
 
 void SphereTree::reserve(std::int32_t max_nodes, std::uint32_t max_triangles) {
@@ -233,58 +233,98 @@ void SphereTree::reserve(std::int32_t max_nodes, std::uint32_t max_triangles) {
   height_slots_.reserve(64);
   stack_.reserve(nodes);
   first_leaf_.reserve(max_triangles);
+  build_triangles_.reserve(max_triangles);
+  // A rebuild's leaf records: at most one leaf per node.
+  build_leaves_.reserve(nodes);
+  build_pieces_.reserve(nodes);
+  build_slabs_.reserve(nodes);
+  build_leaf_nodes_.reserve(nodes);
 }
 
-void SphereTree::build_over(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles) {
+// The leaves are made first, as records apart from the tree (their piece, sphere and slab); the
+// top-down build then partitions those records in place and numbers the nodes as it reaches them,
+// a parent before its left subtree and that before its right one. That is the depth-first layout
+// the descent and refit want, with no renumbering pass, and every pass reads the records in a row.
+void SphereTree::build_over(const TriangleMesh& mesh) {
   ++structure_version_;
   slabs_kept_ = slabs_wanted_;
-  spheres_.clear();
-  slabs_.clear();
-  leans_.clear();
-  links_.clear();
-  pieces_.clear();
-  next_leaf_.clear();
+  build_leaves_.clear();
+  build_pieces_.clear();
+  build_slabs_.clear();
+  for (const std::uint32_t t : build_triangles_) {
+    std::uint8_t apex = 0;
+    const int slices = slice_count(mesh, t, apex, slice_aspect_);
+    for (int s = slices - 1; s >= 0; --s) {  // the order the chains are pushed in below
+      const LeafPiece piece{t, static_cast<std::uint16_t>(s), static_cast<std::uint16_t>(slices), apex};
+      const Sphere sphere = piece_sphere(mesh, piece);
+      build_leaves_.push_back({sphere, static_cast<std::int32_t>(build_pieces_.size())});
+      build_pieces_.push_back(piece);
+      if (slabs_kept_) build_slabs_.push_back(triangle_slab(mesh, t, sphere));
+    }
+  }
+  leaf_count_ = static_cast<std::int32_t>(build_leaves_.size());
+  live_nodes_ = leaf_count_ > 0 ? 2 * leaf_count_ - 1 : 0;
+  const auto nodes = static_cast<std::size_t>(live_nodes_);
+  spheres_.resize(nodes);
+  slabs_.resize(nodes);
+  leans_.assign(nodes, Lean{});  // the root keeps the default; every other is set by its parent
+  links_.resize(nodes);
+  pieces_.assign(nodes, LeafPiece{});
+  next_leaf_.assign(nodes, kNoNode);
+  build_leaf_nodes_.resize(build_leaves_.size());
   first_leaf_.assign(mesh.triangle_count(), kNoNode);
-  root_ = kNoNode;
   free_list_ = kNoNode;
-  leaf_count_ = 0;
-  live_nodes_ = 0;
-  for (const std::uint32_t t : triangles) add_triangle_leaves(mesh, t, false);
+  root_ = kNoNode;
   build_mesh_ = &mesh;
-  std::vector<std::int32_t> leaves(static_cast<std::size_t>(leaf_count_));
-  for (std::int32_t i = 0; i < leaf_count_; ++i) leaves[i] = i;  // leaves were allocated first
-  if (!leaves.empty()) root_ = build_range(leaves.data(), leaves.data() + leaves.size(), kNoNode);
+  next_build_node_ = 0;
+  if (leaf_count_ > 0) root_ = build_range(build_leaves_.data(), build_leaves_.data() + build_leaves_.size(), kNoNode);
   build_mesh_ = nullptr;
-  renumber_depth_first();
+  // Each triangle's chain runs slice 0, 1, ...: pushed front-first, in the order the records were made.
+  for (std::size_t r = 0; r < build_pieces_.size(); ++r) {
+    const std::int32_t leaf = build_leaf_nodes_[r];
+    const std::uint32_t t = build_pieces_[r].triangle;
+    next_leaf_[leaf] = first_leaf_[t];
+    first_leaf_[t] = leaf;
+  }
   order_dirty_ = true;
   built_mean_internal_radius_ = quality().mean_internal_radius;
 }
 
-std::int32_t SphereTree::build_range(std::int32_t* first, std::int32_t* last, std::int32_t parent) {
+std::int32_t SphereTree::build_range(BuildLeaf* first, BuildLeaf* last, std::int32_t parent) {
+  const std::int32_t node = next_build_node_++;
   const std::ptrdiff_t count = last - first;
   if (count == 1) {
-    links_[*first].parent = parent;
-    return *first;
+    const auto record = static_cast<std::size_t>(first->record);
+    spheres_[node] = first->sphere;
+    if (slabs_kept_) slabs_[node] = build_slabs_[record];
+    pieces_[node] = build_pieces_[record];
+    links_[node] = {parent, kNoNode, kNoNode, 0};
+    build_leaf_nodes_[record] = node;
+    return node;
   }
   // Principal component of the leaf centres: power iteration on their covariance, started from
-  // the longest side of their box (deterministic: fixed start, fixed iteration count).
-  Vec3 mean{0.0};
-  Vec3 lo{INFINITY};
-  Vec3 hi{-INFINITY};
-  for (const std::int32_t* n = first; n != last; ++n) {
-    const Vec3& c = spheres_[*n].center;
-    mean += c;
-    lo = glm::min(lo, c);
-    hi = glm::max(hi, c);
-  }
-  mean /= static_cast<double>(count);
+  // the longest side of the leaf spheres' box (deterministic: fixed start, fixed iteration count).
+  // One pass gathers the centres' moments (about the first centre, so that the covariance's
+  // subtraction cancels little) and that box, which also centres the direct cover. (The centres'
+  // own box as well would take more registers than the processor has, and cost a pass.)
+  const Vec3 origin = first->sphere.center;
+  Vec3 sum{0.0};
+  Vec3 cover_lo{INFINITY};
+  Vec3 cover_hi{-INFINITY};
   double cxx = 0, cxy = 0, cxz = 0, cyy = 0, cyz = 0, czz = 0;
-  for (const std::int32_t* n = first; n != last; ++n) {
-    const Vec3 d = spheres_[*n].center - mean;
+  for (const BuildLeaf* n = first; n != last; ++n) {
+    const Vec3& c = n->sphere.center;
+    cover_lo = glm::min(cover_lo, c - n->sphere.radius);
+    cover_hi = glm::max(cover_hi, c + n->sphere.radius);
+    const Vec3 d = c - origin;
+    sum += d;
     cxx += d.x * d.x, cxy += d.x * d.y, cxz += d.x * d.z;
     cyy += d.y * d.y, cyz += d.y * d.z, czz += d.z * d.z;
   }
-  const Vec3 extent = hi - lo;
+  const Vec3 mean = sum / static_cast<double>(count);
+  cxx -= sum.x * mean.x, cxy -= sum.x * mean.y, cxz -= sum.x * mean.z;
+  cyy -= sum.y * mean.y, cyz -= sum.y * mean.z, czz -= sum.z * mean.z;
+  const Vec3 extent = cover_hi - cover_lo;
   Vec3 axis = extent.x >= extent.y && extent.x >= extent.z ? Vec3{1, 0, 0}
               : extent.y >= extent.z                       ? Vec3{0, 1, 0}
                                                            : Vec3{0, 0, 1};
@@ -301,108 +341,49 @@ std::int32_t SphereTree::build_range(std::int32_t* first, std::int32_t* last, st
     if (!(norm > 0.0) || !std::isfinite(norm)) break;
     axis = next / norm;
   }
-  // Split at the middle of the leaf set's extent along that axis.
+  // Split at the middle of the leaf set's extent along that axis. The same pass measures the direct
+  // cover (cover_leaves), which needs no child yet.
+  const Vec3 cover_center = 0.5 * (cover_lo + cover_hi);
+  double cover_radius = 0.0;
   double pmin = INFINITY;
   double pmax = -INFINITY;
-  for (const std::int32_t* n = first; n != last; ++n) {
-    const double p = dot(spheres_[*n].center, axis);
+  for (const BuildLeaf* n = first; n != last; ++n) {
+    const double p = dot(n->sphere.center, axis);
     pmin = std::min(pmin, p);
     pmax = std::max(pmax, p);
+    cover_radius = std::max(cover_radius, length(n->sphere.center - cover_center) + n->sphere.radius);
   }
   const double middle = 0.5 * (pmin + pmax);
-  std::int32_t* split =
-      std::partition(first, last, [&](std::int32_t n) { return dot(spheres_[n].center, axis) < middle; });
+  BuildLeaf* split = std::partition(first, last, [&](const BuildLeaf& n) { return dot(n.sphere.center, axis) < middle; });
   if (split == first || split == last) {
-    // Everything on one side (coincident centres): the median by projection, ties by node index.
+    // Everything on one side (coincident centres): the median by projection, ties by creation order.
     split = first + count / 2;
-    std::nth_element(first, split, last, [&](std::int32_t a, std::int32_t b) {
-      const double pa = dot(spheres_[a].center, axis);
-      const double pb = dot(spheres_[b].center, axis);
-      return pa < pb || (pa == pb && a < b);
+    std::nth_element(first, split, last, [&](const BuildLeaf& a, const BuildLeaf& b) {
+      const double pa = dot(a.sphere.center, axis);
+      const double pb = dot(b.sphere.center, axis);
+      return pa < pb || (pa == pb && a.record < b.record);
     });
   }
-  const std::int32_t node = allocate_node();
-  links_[node].parent = parent;
   const std::int32_t left = build_range(first, split, node);
   const std::int32_t right = build_range(split, last, node);
-  links_[node].left = left;
-  links_[node].right = right;
-  links_[node].height = 1 + std::max(links_[left].height, links_[right].height);
-  cover_leaves(node, first, last);
+  links_[node] = {parent, left, right, 1 + std::max(links_[left].height, links_[right].height)};
+  cover_leaves(node, inflated_sphere(cover_center, cover_radius), first, last);
   return node;
 }
 
-// Lays the nodes out in depth-first order, a left child right after its parent: the descent and
-// the refit then walk the arrays mostly forward instead of jumping between leaves and internals.
-void SphereTree::renumber_depth_first() {
-  if (root_ == kNoNode) return;
-  const std::size_t count = links_.size();
-  std::vector<std::int32_t> old_of;  // new index -> old index
-  old_of.reserve(count);
-  stack_.clear();
-  stack_.push_back(root_);
-  while (!stack_.empty()) {
-    const std::int32_t node = stack_.back();
-    stack_.pop_back();
-    old_of.push_back(node);
-    if (!is_leaf(node)) {
-      stack_.push_back(links_[node].right);
-      stack_.push_back(links_[node].left);
-    }
-  }
-  std::vector<std::int32_t> new_of(count, kNoNode);
-  for (std::size_t i = 0; i < old_of.size(); ++i) new_of[static_cast<std::size_t>(old_of[i])] = static_cast<std::int32_t>(i);
-  const auto remap = [&](std::int32_t n) { return n == kNoNode ? kNoNode : new_of[static_cast<std::size_t>(n)]; };
-  std::vector<Sphere> spheres(old_of.size());
-  std::vector<Slab> slabs(old_of.size());
-  std::vector<Lean> leans(old_of.size());
-  std::vector<SphereTreeLinks> links(old_of.size());
-  std::vector<LeafPiece> pieces(old_of.size());
-  std::vector<std::int32_t> next_leaf(old_of.size());
-  for (std::size_t i = 0; i < old_of.size(); ++i) {
-    const auto o = static_cast<std::size_t>(old_of[i]);
-    spheres[i] = spheres_[o];
-    slabs[i] = slabs_[o];
-    leans[i] = leans_[o];
-    pieces[i] = pieces_[o];
-    next_leaf[i] = remap(next_leaf_[o]);
-    const SphereTreeLinks& l = links_[o];
-    links[i] = {remap(l.parent), remap(l.left), remap(l.right), l.height};
-  }
-  for (std::int32_t& leaf : first_leaf_) leaf = remap(leaf);
-  spheres_ = std::move(spheres);
-  slabs_ = std::move(slabs);
-  leans_ = std::move(leans);
-  links_ = std::move(links);
-  pieces_ = std::move(pieces);
-  next_leaf_ = std::move(next_leaf);
-  root_ = 0;
-}
-
-// The paper's rule: a node's sphere covers every leaf sphere below it directly, which is tighter
-// than covering the two child spheres; the smaller of the two covers is kept.
-void SphereTree::cover_leaves(std::int32_t node, const std::int32_t* first, const std::int32_t* last) {
-  Vec3 lo{INFINITY};
-  Vec3 hi{-INFINITY};
-  for (const std::int32_t* n = first; n != last; ++n) {
-    const Sphere& s = spheres_[*n];
-    lo = glm::min(lo, s.center - s.radius);
-    hi = glm::max(hi, s.center + s.radius);
-  }
-  const Vec3 center = 0.5 * (lo + hi);
-  double radius = 0.0;
-  for (const std::int32_t* n = first; n != last; ++n) {
-    radius = std::max(radius, length(spheres_[*n].center - center) + spheres_[*n].radius);
-  }
-  const Sphere direct = inflated_sphere(center, radius);
+// The paper's rule: a node's sphere covers every leaf sphere below it directly (`direct`, measured
+// by build_range), which is tighter than covering the two child spheres; the smaller of the two
+// covers is kept.
+void SphereTree::cover_leaves(std::int32_t node, const Sphere& direct, const BuildLeaf* first, const BuildLeaf* last) {
   const Sphere merged = enclosing_sphere(spheres_[links_[node].left], spheres_[links_[node].right]);
   spheres_[node] = direct.radius < merged.radius ? direct : merged;
   if (!slabs_kept_) return;
   // The slab likewise from the leaves' triangles directly, along their area-weighted mean normal:
   // exact at the build, where merging the children's slabs (as refit does) widens it at every level.
+  const auto triangle_of = [&](const BuildLeaf* n) { return build_mesh_->triangles[build_pieces_[static_cast<std::size_t>(n->record)].triangle]; };
   Vec3 normal{0.0};
-  for (const std::int32_t* n = first; n != last; ++n) {
-    const Triangle& tri = build_mesh_->triangles[pieces_[*n].triangle];
+  for (const BuildLeaf* n = first; n != last; ++n) {
+    const Triangle& tri = triangle_of(n);
     const Vec3& a = build_mesh_->positions[tri[0]];
     normal += cross(build_mesh_->positions[tri[1]] - a, build_mesh_->positions[tri[2]] - a);
   }
@@ -417,8 +398,8 @@ void SphereTree::cover_leaves(std::int32_t node, const std::int32_t* first, cons
   double slab_lo = INFINITY;
   double slab_hi = -INFINITY;
   double magnitude = 0.0;
-  for (const std::int32_t* n = first; n != last; ++n) {
-    for (const std::uint32_t v : build_mesh_->triangles[pieces_[*n].triangle]) {
+  for (const BuildLeaf* n = first; n != last; ++n) {
+    for (const std::uint32_t v : triangle_of(n)) {
       const Vec3& p = build_mesh_->positions[v];
       const double along = dot(normal, p);
       slab_lo = std::min(slab_lo, along);

@@ -203,19 +203,24 @@ class SphereTree {
  private:
   std::int32_t allocate_node();
   void free_node(std::int32_t node);
-  std::int32_t build_range(std::int32_t* first, std::int32_t* last, std::int32_t parent);
-  void cover_leaves(std::int32_t node, const std::int32_t* first, const std::int32_t* last);
+  /// A leaf waiting for its place in a build: its sphere, and its index among the records made.
+  struct BuildLeaf {
+    Sphere sphere;
+    std::int32_t record = 0;
+  };
+  std::int32_t build_range(BuildLeaf* first, BuildLeaf* last, std::int32_t parent);
+  void cover_leaves(std::int32_t node, const Sphere& direct, const BuildLeaf* first, const BuildLeaf* last);
   void refit_node(std::int32_t node);
   void refit_leaf(const TriangleMesh& mesh, std::int32_t leaf);
   void refit_internal(const TriangleMesh& mesh, std::int32_t node);
   void set_child_leans(std::int32_t node);
   void refit_upward(std::int32_t node);
   void insert_leaf(std::int32_t leaf);
-  void build_over(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles);
+  /// Builds over the triangles in build_triangles_.
+  void build_over(const TriangleMesh& mesh);
   void add_triangle_leaves(const TriangleMesh& mesh, std::uint32_t t, bool insert);
   void update_refit_order();
   void update_sphere_refit_blocks();
-  void renumber_depth_first();
 
   std::vector<Sphere> spheres_;         // hot: per node
   std::vector<SphereTreeLinks> links_;  // per node
@@ -250,6 +255,15 @@ class SphereTree {
   std::int32_t free_list_ = kNoNode;
   std::int32_t leaf_count_ = 0;
   std::int32_t live_nodes_ = 0;
+  // A build's scratch, kept so that a rebuild within reserve() allocates nothing: the triangles to
+  // cover, the leaf records (partitioned in place) with each record's piece and slab, and the node
+  // each record became.
+  std::vector<std::uint32_t> build_triangles_;
+  std::vector<BuildLeaf> build_leaves_;
+  std::vector<LeafPiece> build_pieces_;
+  std::vector<Slab> build_slabs_;
+  std::vector<std::int32_t> build_leaf_nodes_;
+  std::int32_t next_build_node_ = 0;
   const TriangleMesh* build_mesh_ = nullptr;  // the mesh of the build under way
   bool order_dirty_ = true;
   bool slabs_wanted_ = true;

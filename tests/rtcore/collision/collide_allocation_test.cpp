@@ -40,5 +40,29 @@ TEST(CollideAllocation, WarmQueriesAllocateNothing) {
   }
 }
 
+// A rebuild runs in the core's collision job beside the physics (and on the core's thread in a batch
+// run): within the room reserved, it and the refit after it allocate nothing either.
+TEST(CollideAllocation, RebuildWithinTheReservedRoomAllocatesNothing) {
+  ProstateModel gland = generate_prostate(2816);
+  SphereTree tree;
+  tree.set_slabs(false);
+  tree.reserve(4 * static_cast<std::int32_t>(gland.surface.triangle_count()), gland.surface.triangle_count());
+  tree.build(gland.surface);
+  for (std::uint32_t t = 0; t < gland.surface.triangle_count(); t += 5) tree.remove_triangle(t);
+  tree.rebuild(gland.surface);  // the scratch takes its size
+  tree.refit(gland.surface);
+  const std::int32_t leaves = tree.leaf_count();
+  long allocations = 0;
+  {
+    testing::RealtimeProbe probe;
+    tree.rebuild(gland.surface);
+    tree.refit(gland.surface);
+    allocations = probe.allocations();
+  }
+  EXPECT_EQ(allocations, 0);
+  EXPECT_EQ(tree.leaf_count(), leaves);
+  EXPECT_EQ(tree.live_node_count(), 2 * leaves - 1);
+}
+
 }  // namespace
 }  // namespace resecto
