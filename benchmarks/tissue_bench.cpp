@@ -135,6 +135,7 @@ void BM_CollisionStep(benchmark::State& state) {
   state.counters["search_median_us"] = resecto::quantile(search_us, 0.5);
   const ToolContactStats& stats = tissue->tool().stats();
   state.counters["candidate_pairs"] = stats.pair_entries;
+  state.counters["pair_tests"] = stats.pair_tests;
   state.counters["tissue_leaves"] = stats.tissue_leaves;
   state.counters["tool_clusters"] = stats.tool_clusters;
   state.counters["candidate_nodes"] = stats.tissue_nodes;

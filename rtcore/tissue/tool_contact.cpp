@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -257,22 +258,24 @@ void ToolContacts::keep_within_margin(std::uint32_t first, const Vec3& p, const 
   // The gathered faces over-approximate; the substeps only need those really within the margin,
   // nearest first. A tool vertex on the fine gland keeps hundreds, so they are sorted, not inserted.
   std::vector<std::uint32_t>& pairs = search_.pair_triangles;
-  std::vector<std::pair<double, std::uint32_t>>& kept = search_.kept;
+  std::vector<KeptFace>& kept = search_.kept;
   kept.clear();
   const std::size_t count = search_.pair_count - first;
+  search_.stats.pair_tests += static_cast<std::int32_t>(count);
   double* d2 = search_.pair_distance.data() + first;  // scratch until the kept ones' distances are written
   squared_distances_to_triangles(p, positions.data(), triangles.data(), &pairs[first], count, d2);
   for (std::size_t k = 0; k < count; ++k) {
-    if (d2[k] <= margin_m_ * margin_m_) kept.emplace_back(d2[k], pairs[first + k]);
+    if (d2[k] <= margin_m_ * margin_m_) kept.push_back({std::bit_cast<std::uint64_t>(d2[k]), pairs[first + k]});
   }
-  // By distance², ties by face index: the same order every run. (The pair's own operator< gives the
-  // same order through a three-way comparison per step, which the profile showed in this sort.)
-  std::sort(kept.begin(), kept.end(), [](const std::pair<double, std::uint32_t>& a, const std::pair<double, std::uint32_t>& b) {
-    return a.first < b.first || (a.first == b.first && a.second < b.second);
+  // By distance², ties by face index: the same order every run. A square is never negative, so its
+  // bits order as the number does, and the comparisons are of integers (the doubles' compared for
+  // NaN and equality too, which the profile showed as most of this sort).
+  std::sort(kept.begin(), kept.end(), [](const KeptFace& a, const KeptFace& b) {
+    return a.distance2_bits < b.distance2_bits || (a.distance2_bits == b.distance2_bits && a.face < b.face);
   });
   for (std::size_t k = 0; k < kept.size(); ++k) {
-    pairs[first + k] = kept[k].second;
-    search_.pair_distance[first + k] = std::sqrt(kept[k].first);
+    pairs[first + k] = kept[k].face;
+    search_.pair_distance[first + k] = std::sqrt(std::bit_cast<double>(kept[k].distance2_bits));
   }
   search_.pair_count = first + kept.size();
 }

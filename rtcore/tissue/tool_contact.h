@@ -37,6 +37,7 @@ struct ToolContactStats {
   std::int32_t tissue_nodes = 0;   ///< candidate tissue nodes
   std::int32_t tool_vertices = 0;  ///< candidate tool vertices
   std::int32_t pair_entries = 0;
+  std::int32_t pair_tests = 0;     ///< (point, face) distances the search measured to keep pair_entries
   std::int32_t penetrating = 0;    ///< points that pushed in the last substep
   bool overflowed = false;
 };
@@ -183,12 +184,18 @@ class ToolContacts {
     std::uint32_t node;
     Vec3 at;
   };
+  /// A face within the margin of a point, with the bits of its squared distance (non-negative, so
+  /// they order as the distance does).
+  struct KeptFace {
+    std::uint64_t distance2_bits;
+    std::uint32_t face;
+  };
   /// A search's result, built in the back buffer and swapped in by publish_candidates().
   struct CandidateSet {
     std::vector<PointCandidates> nodes, vertices;
     std::vector<std::uint32_t> pair_triangles;
     std::vector<double> pair_distance;  // per pair, its face's distance from the point at the search
-    std::vector<std::pair<double, std::uint32_t>> kept;  // scratch: a point's kept faces with their distance², for the order
+    std::vector<KeptFace> kept;  // scratch: a point's kept faces with their distance², for the order
     std::vector<Clearance> node_clearance, vertex_clearance;  // per point, at the searched positions
     std::vector<SearchedCorner> corners;  // every corner of the tool vertices' candidate faces, each once
     std::size_t node_count = 0, vertex_count = 0, pair_count = 0, corner_count = 0;
