@@ -13,7 +13,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version print and succeed; any other command line that cannot be parsed (a
+    // missing file, an unknown option, a value out of range) is a usage error: 2, as for most Unix
+    // tools, rather than CLI11's own codes (105 to 109) that scripts would have to learn.
+    return app.exit(e) == 0 ? 0 : 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "resecto: %s\n", e.what());
     return 1;

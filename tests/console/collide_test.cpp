@@ -211,7 +211,13 @@ TEST(CollideCommand, MalformedMeshNamesTheFace) {
 }
 
 TEST(CollideCommand, MissingArgumentsFailWithHelpAvailable) {
-  EXPECT_NE(run_resecto("collide --tissue nowhere.off").exit_code, 0);
+  // A command line that cannot be parsed is a usage error, exit 2, whatever CLI11 calls it.
+  const auto missing_file = run_resecto("collide --tissue nowhere.off");
+  EXPECT_EQ(missing_file.exit_code, 2);
+  EXPECT_NE(missing_file.err.find("nowhere.off"), std::string::npos) << missing_file.err;
+  EXPECT_EQ(run_resecto("collide --tissue").exit_code, 2);
+  EXPECT_EQ(run_resecto("collide --repeat 0").exit_code, 2);
+  EXPECT_EQ(run_resecto("no-such-command").exit_code, 2);
   const auto help = run_resecto("collide --help");
   EXPECT_EQ(help.exit_code, 0);
   EXPECT_NE(help.out.find("--poses"), std::string::npos);
