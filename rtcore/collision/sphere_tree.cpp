@@ -205,15 +205,21 @@ void SphereTree::add_triangle_leaves(const TriangleMesh& mesh, std::uint32_t t, 
 void SphereTree::build(const TriangleMesh& mesh) {
   build_triangles_.resize(mesh.triangle_count());
   for (std::uint32_t t = 0; t < build_triangles_.size(); ++t) build_triangles_[t] = t;
-  build_over(mesh);
+  start_build(mesh);
+  continue_build(std::numeric_limits<std::int64_t>::max());
 }
 
 void SphereTree::rebuild(const TriangleMesh& mesh) {
+  begin_build(mesh, *this);
+  continue_build(std::numeric_limits<std::int64_t>::max());
+}
+
+void SphereTree::begin_build(const TriangleMesh& mesh, const SphereTree& covered) {
   build_triangles_.clear();
-  for (std::uint32_t t = 0; t < first_leaf_.size(); ++t) {
-    if (first_leaf_[t] != kNoNode) build_triangles_.push_back(t);
+  for (std::uint32_t t = 0; t < covered.first_leaf_.size(); ++t) {
+    if (covered.first_leaf_[t] != kNoNode) build_triangles_.push_back(t);
   }
-  build_over(mesh);
+  start_build(mesh);
 }
 
 void SphereTree::reserve(std::int32_t max_nodes, std::uint32_t max_triangles) {
@@ -239,13 +245,16 @@ void SphereTree::reserve(std::int32_t max_nodes, std::uint32_t max_triangles) {
   build_pieces_.reserve(nodes);
   build_slabs_.reserve(nodes);
   build_leaf_nodes_.reserve(nodes);
+  build_tasks_.reserve(nodes);
 }
 
 // The leaves are made first, as records apart from the tree (their piece, sphere and slab); the
 // top-down build then partitions those records in place and numbers the nodes as it reaches them,
 // a parent before its left subtree and that before its right one. That is the depth-first layout
 // the descent and refit want, with no renumbering pass, and every pass reads the records in a row.
-void SphereTree::build_over(const TriangleMesh& mesh) {
+// The build runs from a stack of tasks rather than by recursion, so that it can stop after a given
+// amount of work and go on at the next call (continue_build).
+void SphereTree::start_build(const TriangleMesh& mesh) {
   ++structure_version_;
   slabs_kept_ = slabs_wanted_;
   build_leaves_.clear();
@@ -277,7 +286,44 @@ void SphereTree::build_over(const TriangleMesh& mesh) {
   root_ = kNoNode;
   build_mesh_ = &mesh;
   next_build_node_ = 0;
-  if (leaf_count_ > 0) root_ = build_range(build_leaves_.data(), build_leaves_.data() + build_leaves_.size(), kNoNode);
+  build_tasks_.clear();
+  if (leaf_count_ > 0) build_tasks_.push_back({0, leaf_count_, kNoNode, BuildTask::kLeftChild});
+}
+
+void SphereTree::abandon_build() {
+  if (build_mesh_ == nullptr) return;
+  build_mesh_ = nullptr;
+  build_tasks_.clear();
+  root_ = kNoNode;
+  leaf_count_ = live_nodes_ = 0;
+  spheres_.clear();
+  links_.clear();
+  slabs_.clear();
+  leans_.clear();
+  pieces_.clear();
+  next_leaf_.clear();
+  std::fill(first_leaf_.begin(), first_leaf_.end(), kNoNode);
+  order_dirty_ = true;
+}
+
+bool SphereTree::continue_build(std::int64_t work) {
+  if (build_mesh_ == nullptr) return true;  // no build under way
+  std::int64_t done = 0;
+  while (!build_tasks_.empty() && done < work) {
+    const BuildTask task = build_tasks_.back();
+    build_tasks_.pop_back();
+    BuildLeaf* first = build_leaves_.data() + task.first;
+    BuildLeaf* last = build_leaves_.data() + task.last;
+    if (task.kind == BuildTask::kFinish) {
+      finish_node(task.node, first, last);
+      done += slabs_kept_ ? task.last - task.first : 1;
+    } else {
+      start_node(task, first, last);
+      done += task.last - task.first;
+    }
+  }
+  if (!build_tasks_.empty()) return false;
+  if (leaf_count_ > 0) root_ = 0;
   build_mesh_ = nullptr;
   // Each triangle's chain runs slice 0, 1, ...: pushed front-first, in the order the records were made.
   for (std::size_t r = 0; r < build_pieces_.size(); ++r) {
@@ -288,19 +334,22 @@ void SphereTree::build_over(const TriangleMesh& mesh) {
   }
   order_dirty_ = true;
   built_mean_internal_radius_ = quality().mean_internal_radius;
+  return true;
 }
 
-std::int32_t SphereTree::build_range(BuildLeaf* first, BuildLeaf* last, std::int32_t parent) {
+void SphereTree::start_node(const BuildTask& task, BuildLeaf* first, BuildLeaf* last) {
   const std::int32_t node = next_build_node_++;
+  const std::int32_t parent = task.node;
+  links_[node] = {parent, kNoNode, kNoNode, 0};
+  if (parent != kNoNode) (task.kind == BuildTask::kRightChild ? links_[parent].right : links_[parent].left) = node;
   const std::ptrdiff_t count = last - first;
   if (count == 1) {
     const auto record = static_cast<std::size_t>(first->record);
     spheres_[node] = first->sphere;
     if (slabs_kept_) slabs_[node] = build_slabs_[record];
     pieces_[node] = build_pieces_[record];
-    links_[node] = {parent, kNoNode, kNoNode, 0};
     build_leaf_nodes_[record] = node;
-    return node;
+    return;
   }
   // Principal component of the leaf centres: power iteration on their covariance, started from
   // the longest side of the leaf spheres' box (deterministic: fixed start, fixed iteration count).
@@ -364,15 +413,24 @@ std::int32_t SphereTree::build_range(BuildLeaf* first, BuildLeaf* last, std::int
       return pa < pb || (pa == pb && a.record < b.record);
     });
   }
-  const std::int32_t left = build_range(first, split, node);
-  const std::int32_t right = build_range(split, last, node);
-  links_[node] = {parent, left, right, 1 + std::max(links_[left].height, links_[right].height)};
-  cover_leaves(node, inflated_sphere(cover_center, cover_radius), first, last);
-  return node;
+  // The direct cover waits in the node's sphere for finish_node(), which runs once both subtrees are
+  // built (the last of the three tasks out: the left subtree goes first, then the right).
+  spheres_[node] = inflated_sphere(cover_center, cover_radius);
+  const auto split_at = static_cast<std::int32_t>(split - build_leaves_.data());
+  build_tasks_.push_back({task.first, task.last, node, BuildTask::kFinish});
+  build_tasks_.push_back({split_at, task.last, node, BuildTask::kRightChild});
+  build_tasks_.push_back({task.first, split_at, node, BuildTask::kLeftChild});
+}
+
+void SphereTree::finish_node(std::int32_t node, const BuildLeaf* first, const BuildLeaf* last) {
+  SphereTreeLinks& l = links_[node];
+  l.height = 1 + std::max(links_[l.left].height, links_[l.right].height);
+  const Sphere direct = spheres_[node];
+  cover_leaves(node, direct, first, last);
 }
 
 // The paper's rule: a node's sphere covers every leaf sphere below it directly (`direct`, measured
-// by build_range), which is tighter than covering the two child spheres; the smaller of the two
+// by start_node), which is tighter than covering the two child spheres; the smaller of the two
 // covers is kept.
 void SphereTree::cover_leaves(std::int32_t node, const Sphere& direct, const BuildLeaf* first, const BuildLeaf* last) {
   const Sphere merged = enclosing_sphere(spheres_[links_[node].left], spheres_[links_[node].right]);

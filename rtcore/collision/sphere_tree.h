@@ -133,6 +133,22 @@ class SphereTree {
   /// The rebuild policy's action: builds afresh, top-down, over the triangles now in the tree.
   void rebuild(const TriangleMesh& mesh);
 
+  /// The same build in stages, for a caller that must bound each call's work (the core's collision
+  /// job, where a whole rebuild beside the search overran the collision period): begin_build() makes
+  /// the leaves of the triangles `covered` now holds (this tree's own, or another's) from `mesh`'s
+  /// positions, and each continue_build() goes on for about `work` leaf visits (a level of the build
+  /// visits every leaf once) and returns true once the tree is whole. The result is the tree rebuild()
+  /// would have made from those positions. Until then the tree must not be queried, refitted or
+  /// edited. `mesh` must outlive the build; its positions may change between calls (they shape the
+  /// tree only, and the refit after it measures them).
+  void begin_build(const TriangleMesh& mesh, const SphereTree& covered);
+  bool continue_build(std::int64_t work);
+  /// Whether a build is under way (begun, not yet whole).
+  bool build_pending() const { return build_mesh_ != nullptr; }
+  /// Drops a build under way (the tree it was replacing changed); the tree is then empty until the
+  /// next build.
+  void abandon_build();
+
   /// Recomputes every sphere bottom-up from the mesh's current vertex positions (section 3.4).
   /// Allocates nothing once the tree's size has been seen before. The vertices may move; a triangle
   /// whose corners change must be removed and inserted again (the tree keeps its leaves' corners).
@@ -208,7 +224,20 @@ class SphereTree {
     Sphere sphere;
     std::int32_t record = 0;
   };
-  std::int32_t build_range(BuildLeaf* first, BuildLeaf* last, std::int32_t parent);
+  /// A step of the build: place the node of records [first, last) under `node` as its left or right
+  /// child (the root: no parent), or finish `node` once its subtrees are built.
+  struct BuildTask {
+    enum Kind : std::int32_t { kLeftChild, kRightChild, kFinish };
+    std::int32_t first = 0, last = 0;
+    std::int32_t node = kNoNode;
+    Kind kind = kLeftChild;
+  };
+  /// Makes the leaf records of build_triangles_ and sizes the node arrays; continue_build() builds.
+  void start_build(const TriangleMesh& mesh);
+  /// Numbers the task's node and links it; a leaf is done, an internal node is split and its
+  /// subtrees and its finish become tasks.
+  void start_node(const BuildTask& task, BuildLeaf* first, BuildLeaf* last);
+  void finish_node(std::int32_t node, const BuildLeaf* first, const BuildLeaf* last);
   void cover_leaves(std::int32_t node, const Sphere& direct, const BuildLeaf* first, const BuildLeaf* last);
   void refit_node(std::int32_t node);
   void refit_leaf(const TriangleMesh& mesh, std::int32_t leaf);
@@ -216,8 +245,6 @@ class SphereTree {
   void set_child_leans(std::int32_t node);
   void refit_upward(std::int32_t node);
   void insert_leaf(std::int32_t leaf);
-  /// Builds over the triangles in build_triangles_.
-  void build_over(const TriangleMesh& mesh);
   void add_triangle_leaves(const TriangleMesh& mesh, std::uint32_t t, bool insert);
   void update_refit_order();
   void update_sphere_refit_blocks();
@@ -263,8 +290,9 @@ class SphereTree {
   std::vector<LeafPiece> build_pieces_;
   std::vector<Slab> build_slabs_;
   std::vector<std::int32_t> build_leaf_nodes_;
+  std::vector<BuildTask> build_tasks_;  // the build's stack, last out first
   std::int32_t next_build_node_ = 0;
-  const TriangleMesh* build_mesh_ = nullptr;  // the mesh of the build under way
+  const TriangleMesh* build_mesh_ = nullptr;  // the mesh of the build under way, null when none is
   bool order_dirty_ = true;
   bool slabs_wanted_ = true;
   bool slabs_kept_ = false;

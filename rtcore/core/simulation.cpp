@@ -392,10 +392,12 @@ void Simulation::run_collision_job() {
   }
   MassSpringTissue& searched = job_edited_ ? other : front;
   if (job_edited_) other.take_search_positions();
-  // A decayed tree's rebuild costs as much as a cut's edits (about 10 ms at 8640 triangles); both
-  // in one job overran the collision period and held the core up. A job that edits or replays
-  // rebuilds only an overdue tree; a quiet one rebuilds the searched copy's, or else the other
-  // copy's, so both are sound again soon after a stroke ends.
+  // A decayed tree's rebuild costs as much as a cut's edits (about 5 ms of processor at 8640
+  // triangles); both in one job overran the collision period and held the core up, and so did a
+  // whole rebuild beside a quiet job's search. A job that edits or replays rebuilds only an overdue
+  // tree, whole; a quiet one takes a staged rebuild of the searched copy's tree, or else of the other
+  // copy's, a few levels further (MassSpringTissue::kStagedRebuildLevels), so both are sound again
+  // within a few collision steps after a stroke ends.
   const bool rebuilt = searched.refit_surface_tree(quiet ? MassSpringTissue::TreeRebuild::kWhenDue : MassSpringTissue::TreeRebuild::kOnlyWhenOverdue);
   if (quiet && !rebuilt) other.rebuild_surface_tree_if_due();
   search_timing_.refit_end_ns = FrameProfiler::now_ns();

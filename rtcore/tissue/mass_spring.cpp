@@ -77,6 +77,7 @@ MassSpringTissue::MassSpringTissue(OrderedMesh&& ordered_mesh, const TissueParam
   surface_ = boundary_surface(mesh);
   surface_tree_.set_slabs(false);  // its one query is the contact's, on spheres (ToolContacts)
   surface_tree_.build(surface_);
+  spare_tree_.set_slabs(false);
   reserve_topology(topology_.node_capacity(), topology_.tetrahedron_capacity());
   map_initial_surface();
   topology_hash_ = topology_hash();
@@ -163,29 +164,49 @@ bool MassSpringTissue::refit_surface_tree(TreeRebuild rebuild) {
   // judging that (a pass over the tree) and rebuilding belong here, off the core's tick, once per
   // collision step rather than once per edit. The refit after a rebuild makes every node's sphere
   // hold its children's (a build bounds the triangles below, which a child's sphere may exceed).
-  bool rebuilt = false;
+  bool rebuilding = false;
   if (surface_tree_edited_) {
-    const bool due = rebuild == TreeRebuild::kWhenDue ? surface_tree_.should_rebuild() : surface_tree_.must_rebuild();
-    if (due) {
+    spare_tree_.abandon_build();  // its leaves are the tree's before these edits
+    if (surface_tree_.must_rebuild()) {
       rebuild_surface_tree();
-      rebuilt = true;
+      rebuilding = true;
+    } else if (rebuild == TreeRebuild::kWhenDue && surface_tree_.should_rebuild()) {
+      spare_tree_.begin_build(surface_, surface_tree_);
+      rebuilding = true;
     }
-    // Judged (and rebuilt if due); a deferred rebuild keeps the tree marked for a quieter step.
+    // Judged (and rebuilt, or its rebuild begun, if due); a deferred one keeps the tree marked for a
+    // quieter step.
     if (rebuild == TreeRebuild::kWhenDue) surface_tree_edited_ = false;
   }
+  rebuilding = continue_staged_rebuild() || rebuilding;
   surface_tree_.refit(surface_);
-  return rebuilt;
+  return rebuilding;
 }
 
 bool MassSpringTissue::rebuild_surface_tree_if_due() {
-  if (!surface_tree_edited_) return false;
-  surface_tree_edited_ = false;
-  if (!surface_tree_.should_rebuild()) return false;
-  rebuild_surface_tree();
+  if (surface_tree_edited_) {
+    surface_tree_edited_ = false;
+    spare_tree_.abandon_build();
+    if (surface_tree_.should_rebuild()) spare_tree_.begin_build(surface_, surface_tree_);
+  }
+  return continue_staged_rebuild();
+}
+
+bool MassSpringTissue::continue_staged_rebuild() {
+  // A whole rebuild beside the search overran the collision period (about 5 ms of processor at 8640
+  // triangles, and the job shares its processor with the physics): the spare tree takes the build
+  // kStagedRebuildLevels levels further a step, in leaf visits (the same count every run), and the
+  // search keeps using the decayed tree, whose shape changes no result, until the new one is whole.
+  if (!spare_tree_.build_pending()) return false;
+  if (spare_tree_.continue_build(kStagedRebuildLevels * static_cast<std::int64_t>(spare_tree_.leaf_count()))) {
+    std::swap(surface_tree_, spare_tree_);
+    ++surface_tree_rebuilds_;
+  }
   return true;
 }
 
 void MassSpringTissue::rebuild_surface_tree() {
+  spare_tree_.abandon_build();
   surface_tree_.rebuild(surface_);
   ++surface_tree_rebuilds_;
   surface_tree_edited_ = false;

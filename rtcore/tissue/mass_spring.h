@@ -111,15 +111,24 @@ class MassSpringTissue {
     kWhenDue,          ///< as soon as SphereTree::should_rebuild()
     kOnlyWhenOverdue,  ///< only past SphereTree::must_rebuild(): the step is busy with edits already
   };
-  /// Refits the surface's sphere tree to the positions taken by begin_collision_step(), or rebuilds
-  /// it when edits have decayed it, as `rebuild` says; returns whether it rebuilt. Reads and writes
-  /// nothing a physics step touches. The tree's shape changes no result (the contact search finds
-  /// exact sets, in point order), so when it is rebuilt is only a matter of time spent.
+  /// Refits the surface's sphere tree to the positions taken by begin_collision_step(), after
+  /// rebuilding it when edits have decayed it, as `rebuild` says: an overdue tree
+  /// (SphereTree::must_rebuild) is rebuilt whole at once; with kWhenDue a decayed one
+  /// (should_rebuild) is rebuilt in stages, a few levels of the build per collision step, beside it
+  /// in a spare tree that takes its place once whole (an edit drops a staged rebuild begun before it,
+  /// so under edits at every step only the overdue bound rebuilds). Returns whether it did
+  /// rebuilding work. Reads
+  /// and writes nothing a physics step touches. The tree's shape changes no result (the contact
+  /// search finds exact sets, in point order), so when it is rebuilt is only a matter of time spent.
   bool refit_surface_tree(TreeRebuild rebuild = TreeRebuild::kWhenDue);
-  /// Rebuilds the tree, at the surface's current positions, when edits have decayed it
-  /// (SphereTree::should_rebuild); the next refit brings it to the search's positions. For the copy
-  /// of the tissue the physics is not stepping, in a collision step with time to spare.
+  /// Begins, or takes a stage further, the staged rebuild of a tree that edits have decayed
+  /// (SphereTree::should_rebuild), at the surface's current positions; the next refit brings it to
+  /// the search's positions. For the copy of the tissue the physics is not stepping, in a collision
+  /// step with time to spare. Returns whether it did rebuilding work.
   bool rebuild_surface_tree_if_due();
+  /// Levels of the staged rebuild (in leaf visits: a level visits each leaf once) a collision step
+  /// takes: a build of the 8640 gland's ~17 levels then spreads over five collision steps.
+  static constexpr int kStagedRebuildLevels = 4;
   /// Finds the tool's candidate pairs against the refitted tree, into the tool's back buffer.
   void search_contact_candidates();
   /// Publishes the search's candidates to the physics steps; call between physics steps once the
@@ -202,8 +211,8 @@ class MassSpringTissue {
   std::size_t surface_face_capacity() const { return surface_face_capacity_; }
   std::size_t node_capacity() const { return topology_.node_capacity(); }
   /// Rebuilds of the surface's sphere tree after edits decayed it (SphereTree::should_rebuild), done
-  /// by the search (refit_surface_tree), so on the collision thread where there is one; the rebuild
-  /// allocates its build scratch. Read it while no search runs.
+  /// by the search (refit_surface_tree), so on the collision thread where there is one; counted when
+  /// the new tree takes the old one's place. Read it while no search runs.
   std::int64_t surface_tree_rebuilds() const { return surface_tree_rebuilds_; }
   /// Bumped by every edit that changed the surface.
   std::uint64_t topology_version() const { return topology_version_; }
@@ -238,6 +247,9 @@ class MassSpringTissue {
  private:
   /// Rebuilds the surface's sphere tree over its present faces; counts it.
   void rebuild_surface_tree();
+  /// Takes a staged rebuild a stage further, and puts the new tree in place once whole; returns
+  /// whether one was under way.
+  bool continue_staged_rebuild();
   struct OrderedMesh {
     std::vector<std::uint32_t> mesh_node;  // per tissue node, its mesh index
     TetMesh mesh;                          // renumbered
@@ -304,6 +316,8 @@ class MassSpringTissue {
 
   TriangleMesh surface_;
   SphereTree surface_tree_;
+  // Where a staged rebuild of surface_tree_ grows (refit_surface_tree); swapped in once whole.
+  SphereTree spare_tree_;
   std::uint64_t topology_hash_ = 0;  // of the live tetrahedra and the surface's faces, kept per edit
   std::uint64_t topology_version_ = 0;
   std::int64_t surface_tree_rebuilds_ = 0;

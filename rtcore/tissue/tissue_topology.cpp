@@ -93,7 +93,9 @@ void MassSpringTissue::reserve_topology(std::size_t node_capacity, std::size_t t
   changed_face_.assign(surface_face_capacity_, 0);
   changed_faces_.reserve(surface_face_capacity_);
   tool_.reserve_tissue(node_capacity, surface_face_capacity_);
-  surface_tree_.reserve(static_cast<std::int32_t>(4 * surface_face_capacity_), static_cast<std::uint32_t>(surface_face_capacity_));
+  for (SphereTree* tree : {&surface_tree_, &spare_tree_}) {
+    tree->reserve(static_cast<std::int32_t>(4 * surface_face_capacity_), static_cast<std::uint32_t>(surface_face_capacity_));
+  }
 }
 
 void MassSpringTissue::map_initial_surface() {

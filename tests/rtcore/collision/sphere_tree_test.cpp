@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "scene.h"
@@ -83,6 +84,56 @@ TEST(SphereTree, BuildIsBalancedAndDeterministic) {
   }
   std::mt19937_64 rng(2);
   for (std::uint32_t t = 0; t < gland.surface.triangle_count(); t += 7) expect_triangles_covered(a, gland.surface, t, rng);
+}
+
+// A build in stages of a few hundred leaf visits (the core's collision job takes a decayed tree's
+// rebuild a few levels a step) ends in the very tree a whole rebuild makes, and can be dropped midway.
+TEST(SphereTree, AStagedBuildEndsInTheWholeRebuildsTree) {
+  ProstateModel gland = generate_prostate(1296);
+  for (const bool slabs : {false, true}) {
+    SphereTree whole;
+    whole.set_slabs(slabs);
+    whole.build(gland.surface);
+    for (std::uint32_t t = 0; t < gland.surface.triangle_count(); t += 5) whole.remove_triangle(t);
+    SphereTree staged;
+    staged.set_slabs(slabs);
+    staged.begin_build(gland.surface, whole);
+    EXPECT_TRUE(staged.build_pending());
+    int calls = 1;
+    while (!staged.continue_build(300)) ++calls;
+    EXPECT_FALSE(staged.build_pending());
+    EXPECT_GT(calls, 20) << "it stopped and went on";
+    whole.rebuild(gland.surface);
+    testing::expect_tree_invariants(staged);
+    ASSERT_EQ(staged.node_capacity(), whole.node_capacity());
+    ASSERT_EQ(staged.leaf_count(), whole.leaf_count());
+    for (std::int32_t n = 0; n < whole.node_capacity(); ++n) {
+      ASSERT_EQ(staged.spheres()[n].center, whole.spheres()[n].center) << "node " << n;
+      ASSERT_EQ(staged.spheres()[n].radius, whole.spheres()[n].radius) << "node " << n;
+      ASSERT_EQ(staged.links()[n].parent, whole.links()[n].parent) << "node " << n;
+      ASSERT_EQ(staged.links()[n].left, whole.links()[n].left) << "node " << n;
+      ASSERT_EQ(staged.links()[n].right, whole.links()[n].right) << "node " << n;
+      ASSERT_EQ(staged.links()[n].height, whole.links()[n].height) << "node " << n;
+      ASSERT_EQ(staged.pieces()[n].triangle, whole.pieces()[n].triangle) << "node " << n;
+      if (slabs) {
+        ASSERT_EQ(staged.slabs()[n].normal, whole.slabs()[n].normal) << "node " << n;
+      }
+    }
+    for (std::uint32_t t = 0; t < gland.surface.triangle_count(); ++t) {
+      ASSERT_EQ(staged.first_leaf_of_triangle(t), whole.first_leaf_of_triangle(t)) << "triangle " << t;
+    }
+    // Dropped midway, the tree is empty and a new build starts clean.
+    staged.begin_build(gland.surface, whole);
+    EXPECT_FALSE(staged.continue_build(300));
+    staged.abandon_build();
+    EXPECT_FALSE(staged.build_pending());
+    EXPECT_TRUE(staged.empty());
+    EXPECT_EQ(staged.first_leaf_of_triangle(1), SphereTree::kNoNode);
+    staged.begin_build(gland.surface, whole);
+    EXPECT_TRUE(staged.continue_build(std::numeric_limits<std::int64_t>::max()));
+    testing::expect_tree_invariants(staged);
+    EXPECT_EQ(staged.leaf_count(), whole.leaf_count());
+  }
 }
 
 TEST(SphereTree, CoincidentTrianglesFallBackToMedianSplits) {

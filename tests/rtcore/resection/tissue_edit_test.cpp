@@ -147,6 +147,54 @@ TEST(TissueEdits, ContactCandidatesDoNotDependOnWhenTheTreeIsRebuilt) {
   EXPECT_FALSE(deferred.rebuild_surface_tree_if_due()) << "judged once";
 }
 
+TEST(TissueEdits, AQuietStepsStagedRebuildKeepsTheCandidatesAndFinishesInAFewSteps) {
+  // Cuts decay the tree; the quiet collision steps after them rebuild it in stages (a few levels a
+  // step, MassSpringTissue::kStagedRebuildLevels) beside the search, which goes on with the decayed
+  // tree meanwhile and finds exactly what a copy whose tree is rebuilt whole at once finds.
+  const ProstateTissueModel& model = tissue_model(1296);
+  MassSpringTissue staged(model.mesh), whole(model.mesh);
+  Resection cut_staged(staged), cut_whole(whole);
+  const int loop = staged.tool().add_part(model.loop);
+  (void)whole.tool().add_part(model.loop);
+  const RigidPose pose = indentation_loop_pose(model.anatomy, model.loop, 0.002);
+  staged.tool().reset_pose(loop, pose);
+  whole.tool().reset_pose(loop, pose);
+  int strokes = 0;
+  for (; strokes < 30 && !staged.surface_tree().should_rebuild(); ++strokes) {
+    // Edits with the rebuild deferred, as the collision job makes them while it cuts.
+    cut_through_gland(cut_staged, 1, strokes);
+    cut_through_gland(cut_whole, 1, strokes);
+    for (MassSpringTissue* tissue : {&staged, &whole}) {
+      tissue->begin_collision_step();
+      (void)tissue->refit_surface_tree(MassSpringTissue::TreeRebuild::kOnlyWhenOverdue);
+      tissue->search_contact_candidates();
+      tissue->end_collision_step();
+    }
+  }
+  ASSERT_TRUE(staged.surface_tree().should_rebuild()) << "the cuts decayed the tree (" << strokes << " strokes)";
+  ASSERT_FALSE(staged.surface_tree().must_rebuild()) << "not so far that the rebuild cannot wait";
+  const std::int64_t rebuilds = staged.surface_tree_rebuilds();
+  const std::int32_t leaves = staged.surface_tree().leaf_count();
+  int steps = 0;
+  for (; steps < 40 && staged.surface_tree_rebuilds() == rebuilds; ++steps) {
+    staged.begin_collision_step();
+    EXPECT_TRUE(staged.refit_surface_tree(MassSpringTissue::TreeRebuild::kWhenDue)) << "step " << steps;
+    staged.search_contact_candidates();
+    staged.end_collision_step();
+    whole.collision_step();  // kWhenDue as well: must_rebuild() is not reached, so it too stages
+    EXPECT_EQ(testing::published(staged.tool(), true), testing::published(whole.tool(), true)) << "step " << steps;
+    EXPECT_EQ(testing::published(staged.tool(), false), testing::published(whole.tool(), false)) << "step " << steps;
+    expect_tree_covers_its_leaves(staged.surface_tree());
+  }
+  EXPECT_EQ(staged.surface_tree_rebuilds(), rebuilds + 1);
+  EXPECT_GE(steps, 2) << "spread over steps";
+  EXPECT_LE(steps, 10) << "a 1296 gland's build has fewer than 40 levels";
+  EXPECT_FALSE(staged.surface_tree().should_rebuild());
+  EXPECT_EQ(staged.surface_tree().leaf_count(), leaves);
+  EXPECT_FALSE(staged.refit_surface_tree(MassSpringTissue::TreeRebuild::kWhenDue)) << "nothing more to do";
+  std::printf("decayed after %d strokes; the staged rebuild of %d leaves took %d collision steps\n", strokes, leaves, steps);
+}
+
 TEST(TissueEdits, CollisionPairsAfterCutsEqualBruteForce) {
   const ProstateTissueModel& model = tissue_model(1296);
   MassSpringTissue tissue(model.mesh);
