@@ -117,9 +117,9 @@ class MassSpringTissue {
   /// (should_rebuild) is rebuilt in stages, a few levels of the build per collision step, beside it
   /// in a spare tree that takes its place once whole (an edit drops a staged rebuild begun before it,
   /// so under edits at every step only the overdue bound rebuilds). Returns whether it did
-  /// rebuilding work. Reads
-  /// and writes nothing a physics step touches. The tree's shape changes no result (the contact
-  /// search finds exact sets, in point order), so when it is rebuilt is only a matter of time spent.
+  /// rebuilding work. Reads and writes nothing a physics step touches. The tree's shape changes no
+  /// result (the contact search finds exact sets, in point order), so when it is rebuilt is only a
+  /// matter of time spent.
   bool refit_surface_tree(TreeRebuild rebuild = TreeRebuild::kWhenDue);
   /// Begins, or takes a stage further, the staged rebuild of a tree that edits have decayed
   /// (SphereTree::should_rebuild), at the surface's current positions; the next refit brings it to
