@@ -20,6 +20,15 @@
 namespace resecto {
 namespace {
 
+/// A collision step as the core's job runs it while it cuts: a decayed tree's rebuild waits for a
+/// quieter step unless the tree is overdue (TreeRebuild::kOnlyWhenOverdue).
+void collision_step_deferring_rebuild(MassSpringTissue& tissue) {
+  tissue.begin_collision_step();
+  (void)tissue.refit_surface_tree(MassSpringTissue::TreeRebuild::kOnlyWhenOverdue);
+  tissue.search_contact_candidates();
+  tissue.end_collision_step();
+}
+
 TetMesh live_mesh(const MassSpringTissue& tissue) {
   TetMesh mesh;
   mesh.positions.assign(tissue.rest_positions().begin(), tissue.rest_positions().end());
@@ -130,10 +139,7 @@ TEST(TissueEdits, ContactCandidatesDoNotDependOnWhenTheTreeIsRebuilt) {
     cut_through_gland(cut_prompt, 1, step);
     cut_through_gland(cut_deferred, 1, step);
     prompt.collision_step();
-    deferred.begin_collision_step();
-    (void)deferred.refit_surface_tree(MassSpringTissue::TreeRebuild::kOnlyWhenOverdue);
-    deferred.search_contact_candidates();
-    deferred.end_collision_step();
+    collision_step_deferring_rebuild(deferred);
     EXPECT_EQ(testing::published(deferred.tool(), true), testing::published(prompt.tool(), true)) << "step " << step;
     EXPECT_EQ(testing::published(deferred.tool(), false), testing::published(prompt.tool(), false)) << "step " << step;
     expect_tree_covers_its_leaves(deferred.surface_tree());
@@ -150,26 +156,21 @@ TEST(TissueEdits, ContactCandidatesDoNotDependOnWhenTheTreeIsRebuilt) {
 TEST(TissueEdits, AQuietStepsStagedRebuildKeepsTheCandidatesAndFinishesInAFewSteps) {
   // Cuts decay the tree; the quiet collision steps after them rebuild it in stages (a few levels a
   // step, MassSpringTissue::kStagedRebuildLevels) beside the search, which goes on with the decayed
-  // tree meanwhile and finds exactly what a copy whose tree is rebuilt whole at once finds.
+  // tree meanwhile. At every step it finds exactly what a copy that keeps the decayed tree finds.
   const ProstateTissueModel& model = tissue_model(1296);
-  MassSpringTissue staged(model.mesh), whole(model.mesh);
-  Resection cut_staged(staged), cut_whole(whole);
+  MassSpringTissue staged(model.mesh), decayed(model.mesh);
+  Resection cut_staged(staged), cut_decayed(decayed);
   const int loop = staged.tool().add_part(model.loop);
-  (void)whole.tool().add_part(model.loop);
+  (void)decayed.tool().add_part(model.loop);
   const RigidPose pose = indentation_loop_pose(model.anatomy, model.loop, 0.002);
   staged.tool().reset_pose(loop, pose);
-  whole.tool().reset_pose(loop, pose);
+  decayed.tool().reset_pose(loop, pose);
   int strokes = 0;
   for (; strokes < 30 && !staged.surface_tree().should_rebuild(); ++strokes) {
-    // Edits with the rebuild deferred, as the collision job makes them while it cuts.
     cut_through_gland(cut_staged, 1, strokes);
-    cut_through_gland(cut_whole, 1, strokes);
-    for (MassSpringTissue* tissue : {&staged, &whole}) {
-      tissue->begin_collision_step();
-      (void)tissue->refit_surface_tree(MassSpringTissue::TreeRebuild::kOnlyWhenOverdue);
-      tissue->search_contact_candidates();
-      tissue->end_collision_step();
-    }
+    cut_through_gland(cut_decayed, 1, strokes);
+    collision_step_deferring_rebuild(staged);
+    collision_step_deferring_rebuild(decayed);
   }
   ASSERT_TRUE(staged.surface_tree().should_rebuild()) << "the cuts decayed the tree (" << strokes << " strokes)";
   ASSERT_FALSE(staged.surface_tree().must_rebuild()) << "not so far that the rebuild cannot wait";
@@ -181,9 +182,9 @@ TEST(TissueEdits, AQuietStepsStagedRebuildKeepsTheCandidatesAndFinishesInAFewSte
     EXPECT_TRUE(staged.refit_surface_tree(MassSpringTissue::TreeRebuild::kWhenDue)) << "step " << steps;
     staged.search_contact_candidates();
     staged.end_collision_step();
-    whole.collision_step();  // kWhenDue as well: must_rebuild() is not reached, so it too stages
-    EXPECT_EQ(testing::published(staged.tool(), true), testing::published(whole.tool(), true)) << "step " << steps;
-    EXPECT_EQ(testing::published(staged.tool(), false), testing::published(whole.tool(), false)) << "step " << steps;
+    collision_step_deferring_rebuild(decayed);  // not overdue: it keeps its decayed tree
+    EXPECT_EQ(testing::published(staged.tool(), true), testing::published(decayed.tool(), true)) << "step " << steps;
+    EXPECT_EQ(testing::published(staged.tool(), false), testing::published(decayed.tool(), false)) << "step " << steps;
     expect_tree_covers_its_leaves(staged.surface_tree());
   }
   EXPECT_EQ(staged.surface_tree_rebuilds(), rebuilds + 1);
