@@ -13,19 +13,21 @@
 
 namespace resecto {
 
-/// The shortest text that reads back as exactly `value` ("230.0001", never a rounded "230").
-inline std::string exact_number(double value) {
-  char buffer[32];
-  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
+namespace detail {
+/// std::to_chars(value, format...) as text ("?" should it not fit, which no double does).
+template <class... Format>
+std::string chars_of(double value, Format... format) {
+  char buffer[48];
+  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value, format...);
   return error == std::errc{} ? std::string(buffer, end) : std::string("?");
 }
+}  // namespace detail
+
+/// The shortest text that reads back as exactly `value` ("230.0001", never a rounded "230").
+inline std::string exact_number(double value) { return detail::chars_of(value); }
 
 /// `value` to `digits` significant digits, as printf's %g: for figures a person reads (12.5 mm^3).
-inline std::string rounded_number(double value, int digits) {
-  char buffer[48];
-  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::general, digits);
-  return error == std::errc{} ? std::string(buffer, end) : std::string("?");
-}
+inline std::string rounded_number(double value, int digits) { return detail::chars_of(value, std::chars_format::general, digits); }
 
 /// True when `value` is a finite number in [lo, hi]; NaN is never in range.
 inline bool in_closed_range(double value, double lo, double hi) { return lo <= value && value <= hi; }
