@@ -234,7 +234,7 @@ bool MassSpringTissue::contact_candidates_still_serve() const {
     tissue_shift2 = std::max(tissue_shift2, glm::dot(d, d));
   }
   // Rounded up, as the tissue's travel is: the sum bounds how much nearer any pair can have come.
-  return tool_shift + std::sqrt(tissue_shift2) * (1.0 + 1e-9) + 1e-15 <= config_.contact_reuse_m;
+  return tool_shift + rounded_up(std::sqrt(tissue_shift2)) <= config_.contact_reuse_m;
 }
 
 void MassSpringTissue::end_collision_step() {
@@ -441,7 +441,7 @@ void MassSpringTissue::add_travel(double largest_step_m) {
   // The positions' own rounding (x += h v, ~1e-17 m a step at the gland's coordinates) can carry a
   // node a hair further than the sum of h |v|; a femtometre a step and a relative part cover it, so
   // the travel bounds every node's displacement outright (about 4 nm of slack after an hour).
-  travel_m_ += largest_step_m * (1.0 + 1e-9) + 1e-15;
+  travel_m_ += rounded_up(largest_step_m);
 }
 
 void MassSpringTissue::note_non_finite(std::size_t node) {

@@ -357,7 +357,7 @@ double ToolContacts::tool_shift_since_search() const {
     }
   }
   // Rounded up, as the tissue's travel is: the shift only ever bounds a distance from above.
-  return std::sqrt(tool_shift2) * (1.0 + 1e-9) + 1e-15;
+  return rounded_up(std::sqrt(tool_shift2));
 }
 
 void ToolContacts::search_candidates(const SphereTree& tissue_tree, const TriangleMesh& surface) {
@@ -415,7 +415,7 @@ double ToolContacts::corners_moved(std::span<const Vec3> x) const {
     largest2 = std::max(largest2, glm::dot(d, d));
   }
   // Rounded up for the subtraction's and the square root's rounding, as the tissue's travel is.
-  return std::sqrt(largest2) * (1.0 + 1e-9) + 1e-15;
+  return rounded_up(std::sqrt(largest2));
 }
 
 void ToolContacts::search_tissue_nodes(std::uint16_t part_index, const SphereTree& tissue_tree, const TriangleMesh& surface) {
