@@ -9,8 +9,10 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <map>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "rtcore/base/checked_number.h"
@@ -37,17 +39,45 @@ class TextLines {
     ++number_;
     return true;
   }
+  /// The next OBJ statement: a line, joined with the lines after it while it ends in a backslash
+  /// (the format's continuation), the backslashes dropped. A joined statement lives in `joined`.
+  bool next_statement(std::string_view& statement, std::string& joined) {
+    if (!next(statement)) return false;
+    if (!continues(statement)) return true;
+    joined.clear();
+    std::string_view line = statement;
+    for (;;) {
+      const std::size_t backslash = line.find_last_of('\\');
+      if (backslash == std::string_view::npos || !continues(line)) {
+        joined.append(line);
+        break;
+      }
+      joined.append(line.substr(0, backslash)).push_back(' ');
+      if (!next(line)) break;  // a backslash on the last line continues into nothing
+    }
+    statement = joined;
+    return true;
+  }
   std::size_t bytes_left() const { return text_.size() - offset_; }
   std::size_t offset() const { return offset_; }
   int number() const { return number_; }
-  /// "name:line:column: what" for a word inside the current line.
+  /// "name:line:column: what" for a word inside the current line ("name:line: what" for a word of a
+  /// statement joined over several lines, whose columns are not the file's).
   Error error_at(std::string_view word, const std::string& what) const {
+    const std::less<const char*> before;
+    if (before(word.data(), text_.data() + line_start_) || before(text_.data() + offset_, word.data())) return error(what);
     const std::size_t column = static_cast<std::size_t>(word.data() - text_.data()) - line_start_ + 1;
     return Error{name_ + ":" + std::to_string(number_) + ":" + std::to_string(column) + ": " + what};
   }
   Error error(const std::string& what) const { return Error{name_ + ":" + std::to_string(number_) + ": " + what}; }
 
  private:
+  /// Whether a line ends in a backslash, after any spaces (and is not a comment).
+  static bool continues(std::string_view line) {
+    const std::size_t last = line.find_last_not_of(" \t\r\f\v");
+    return last != std::string_view::npos && line[last] == '\\' && line.find('#') == std::string_view::npos;
+  }
+
   std::string_view text_;
   const std::string& name_;
   std::size_t offset_ = 0;
@@ -259,7 +289,8 @@ Result<RawMesh> parse_obj(std::string_view text, const std::string& name) {
   RawMesh raw;
   std::vector<int> face_lines;  // each face's line, for an index that turns out out of range
   std::string_view line;
-  while (lines.next(line)) {
+  std::string joined;  // a statement continued over several lines
+  while (lines.next_statement(line, joined)) {
     const std::vector<std::string_view> words = split_words(line, true);
     if (words.empty()) continue;
     const std::string_view keyword = words[0];

@@ -89,6 +89,24 @@ TEST(MeshFiles, PolygonsAreFanTriangulatedInFileOrder) {
   EXPECT_TRUE(validate_closed_surface(*mesh));
 }
 
+TEST(MeshFiles, ObjStatementsContinueOverLinesEndingInABackslash) {
+  // The format's continuation, as some exporters wrap long faces: the same cube as on single lines.
+  std::string obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 \\\n  1\nv 1 1 1\nv 0 1 1\n";
+  for (const auto& t : kCubeFaces) {
+    obj += "f " + std::to_string(t[0] + 1) + " \\  \r\n" + std::to_string(t[1] + 1) + " \\\n" + std::to_string(t[2] + 1) + "\n";
+  }
+  Result<TriangleMesh> mesh = read_surface_mesh(write_file("continued.obj", obj));
+  ASSERT_TRUE(mesh) << mesh.error();
+  ASSERT_EQ(mesh->triangle_count(), 12u);
+  EXPECT_EQ(mesh->triangles[0], (Triangle{0, 2, 1}));
+  EXPECT_EQ(mesh->positions[5], Vec3(1e-3, 0.0, 1e-3));
+  EXPECT_TRUE(validate_closed_surface(*mesh));
+  // A comment ending in a backslash continues nothing; an error in a joined statement names its last line.
+  EXPECT_TRUE(read_surface_mesh(write_file("comment.obj", "# C:\\meshes\\\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")));
+  const std::string error = validation_error(write_file("broken.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 \\\n2 x\n"));
+  EXPECT_NE(error.find("broken.obj:5: corner 'x' is not a vertex index"), std::string::npos) << error;
+}
+
 TEST(MeshFiles, OpenSurfaceNamesTheEdgeAndFace) {
   const std::string error = validation_error(write_file("open.off", cube_off(/*skip_face=*/5)));
   EXPECT_NE(error.find("open surface"), std::string::npos) << error;
