@@ -6,7 +6,9 @@
 # the floor again, and judges each run against the larger of the two floors.
 # Per run it also prints the physics step's p99 by tick phase (tick mod physics steps per collision
 # step; phase 0 is the collision tick, the next ones run beside the collision job), from the run's
-# trace: that is where the misses come from, and what a change to the schedule has to move.
+# trace: that is where the misses come from, and what a change to the schedule has to move. Then the
+# step's median by phase, apart for the steps that ran while the collision job was still running (the
+# helper shares their loops up to the period's middle and leaves the job its processor after it).
 # Usage: benchmarks/realtime_demo.sh [build-dir] [runs] [extra `resecto run` options...]
 #        e.g. benchmarks/realtime_demo.sh build/release 5 --physics-threads 1
 set -euo pipefail
@@ -35,7 +37,7 @@ done
 floor_after="$(floor_misses)"
 echo "floor after:  $floor_after of 9600 deadlines missed"
 python3 - "$out" "$runs" "$floor_before" "$floor_after" <<'PY'
-import json, statistics, sys
+import bisect, json, statistics, sys
 out, runs, before, after = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
 met = 0
 for run in range(1, runs + 1):
@@ -50,9 +52,23 @@ for run in range(1, runs + 1):
     trace = json.load(open(f"{out}/run{run}.trace.json"))
     events = trace["traceEvents"] if isinstance(trace, dict) else trace
     by_phase = [[] for _ in range(per_collision)]
+    # The collision jobs' spans (their stages run on the collision thread, tid 2): a physics step that
+    # starts inside one ran beside the job, with the helper shared or left to the job by phase.
+    jobs = {}
+    for e in events:
+        if e.get("tid") == 2 and "dur" in e and "tick" in e.get("args", {}):
+            begin, end = jobs.get(e["args"]["tick"], (e["ts"], e["ts"]))
+            jobs[e["args"]["tick"]] = (min(begin, e["ts"]), max(end, e["ts"] + e["dur"]))
+    spans = sorted(jobs.values())
+    starts = [begin for begin, _ in spans]
+    alone = [[] for _ in range(per_collision)]
+    beside = [[] for _ in range(per_collision)]
     for e in events:
         if e.get("name") == "physics" and "dur" in e:
-            by_phase[e["args"]["tick"] % per_collision].append(e["dur"])
+            phase = e["args"]["tick"] % per_collision
+            by_phase[phase].append(e["dur"])
+            k = bisect.bisect_right(starts, e["ts"]) - 1
+            (beside if k >= 0 and spans[k][1] > e["ts"] else alone)[phase].append(e["dur"])
     p99 = lambda xs: sorted(xs)[min(len(xs) - 1, int(0.99 * len(xs)))] if xs else 0
     s = lambda k: f"{stages[k]['median_us']:.0f}/{stages[k]['p99_us']:.0f}"
     print(f"run {run}: {deadlines['misses']} of {ticks} missed ({100 * deadlines['miss_fraction']:.3f}%), "
@@ -63,5 +79,8 @@ for run in range(1, runs + 1):
     if helper and helper.get("chunks"):
         print(f"  physics helper: ran {helper['helped']} of the {helper['chunks']} chunks offered to it")
     print("  physics p99 by tick phase (us): " + " ".join(f"{k}:{p99(v):.0f}" for k, v in enumerate(by_phase)))
+    median = lambda xs: f"{statistics.median(xs):.0f}" if xs else "-"
+    print("  physics median by tick phase, alone/beside a running collision job (us; steps beside it): " +
+          " ".join(f"{k}:{median(a)}/{median(b)}({len(b)})" for k, (a, b) in enumerate(zip(alone, beside))))
 print(f"the floor + 0.1% held in {met} of {runs} runs")
 PY
