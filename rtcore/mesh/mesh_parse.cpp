@@ -46,15 +46,11 @@ class TextLines {
     if (!continues(statement)) return true;
     joined.clear();
     std::string_view line = statement;
-    for (;;) {
-      const std::size_t backslash = line.find_last_of('\\');
-      if (backslash == std::string_view::npos || !continues(line)) {
-        joined.append(line);
-        break;
-      }
-      joined.append(line.substr(0, backslash)).push_back(' ');
-      if (!next(line)) break;  // a backslash on the last line continues into nothing
+    while (continues(line)) {
+      joined.append(line.substr(0, line.find_last_of('\\'))).push_back(' ');
+      if (!next(line)) line = {};  // a backslash on the last line continues into nothing
     }
+    joined.append(line);
     statement = joined;
     return true;
   }
