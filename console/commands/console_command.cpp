@@ -49,6 +49,10 @@ void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_r
   cmd.add_option("--height", o.height, "Window height, pixels")->check(CLI::Range(480, 8192))->capture_default_str();
   cmd.add_option("--slow-frame-ms", o.slow_frame_ms, "Make every frame this much slower (to show the core is never held back)")
       ->check(finite_range(0.0, 10000.0));
+  cmd.add_option("--slow-frame-every", o.slow_frame_every,
+                 "Slow only every Nth frame, so the report can set the core's misses during slow frames beside those during the others")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
   cmd.add_option("--view-scale", o.view_scale,
                  "Resolution of the 3-D views relative to their panels (default: 1 on a GPU, 0.5 on a software rasteriser)")
       ->check(finite_range(0.1, 2.0));
@@ -96,6 +100,7 @@ void open_console(const ConsoleCliOptions& o) {
   options.record_path = o.record;
   options.replay_path = o.replay;
   options.slow_frame_ms = o.slow_frame_ms;
+  options.slow_frame_every = o.slow_frame_every;
   options.vsync = !o.no_vsync;
   options.view_scale = o.view_scale;
   Result<nlohmann::ordered_json> report = gui::run_console(options);

@@ -30,6 +30,7 @@ struct ConsoleCliOptions {
   int width = 1600;
   int height = 1000;
   double slow_frame_ms = 0.0;
+  std::uint64_t slow_frame_every = 1;
   bool no_vsync = false;
   double view_scale = 0.0;
   int collision_hz = 60;

@@ -38,6 +38,7 @@ struct RunOptions {
   int physics_threads = default_physics_threads();
   bool raw_input = false;
   std::optional<double> contact_reuse_mm;  ///< unset: TissueConfig's
+  std::optional<double> contact_margin_mm;  ///< unset: TissueConfig's
   std::int64_t spin_us = kDefaultRealtimeSpinUs;
   std::uint64_t seed = 1;
   std::string calibration;
@@ -93,6 +94,7 @@ void run(const RunOptions& o) {
   options.simulation.physics_threads = o.physics_threads;
   options.simulation.input_filter.enabled = !o.raw_input;
   if (o.contact_reuse_mm) options.simulation.tissue.contact_reuse_m = units::mm_to_m(*o.contact_reuse_mm);
+  if (o.contact_margin_mm) options.simulation.tissue.contact_margin_m = units::mm_to_m(*o.contact_margin_mm);
   options.spin_us = o.spin_us;
   options.simulation.parameters = parameters_from_assignments(o.sets);
   if (!o.calibration.empty()) {
@@ -142,6 +144,10 @@ void register_run(CLI::App& app) {
                   "Keep the contact candidates, skipping a collision step's refit and search, while the tool and tissue have moved "
                   "at most this far since they were searched (0: search every step; default 0.3, the tool at most a third of it)")
       ->check(CLI::Range(0.0, 1.5));
+  cmd->add_option("--contact-margin-mm", o->contact_margin_mm,
+                  "How far outside the tool a point may be and still become a contact candidate; it must exceed what tool and "
+                  "tissue move between collision steps (default 1.5)")
+      ->check(CLI::Range(0.1, 10.0));
   cmd->add_option("--spin-us", o->spin_us, "Real time: spin this long before each tick instead of sleeping")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
@@ -154,7 +160,7 @@ void register_run(CLI::App& app) {
     // the emulated device); taking `--device hid` silently would let a user believe hardware drove it.
     if (o->headless) {
       for (const char* console_only : {"--device", "--preset", "--replay", "--actions", "--frames", "--screenshot", "--lockstep", "--insertion-mm",
-                                       "--width", "--height", "--slow-frame-ms", "--view-scale", "--no-vsync"}) {
+                                       "--width", "--height", "--slow-frame-ms", "--slow-frame-every", "--view-scale", "--no-vsync"}) {
         if (cmd->count(console_only) > 0) {
           throw std::runtime_error(std::string(console_only) + " is an option of the operator console; a --headless run follows its procedure through the emulated device");
         }

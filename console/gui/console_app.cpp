@@ -75,6 +75,7 @@ class ConsoleWindow {
   void draw_endoscope_window(const ImVec2& pos, const ImVec2& size);
   void draw_outside_window(const ImVec2& pos, const ImVec2& size);
   int scaled(int pixels) const { return std::max(16, static_cast<int>(std::lround(pixels * options_.view_scale))); }
+  bool slowed(std::uint64_t frame) const { return options_.slow_frame_ms > 0.0 && (frame + 1) % options_.slow_frame_every == 0; }
 
   GLFWwindow* window_;
   const ConsoleOptions& options_;
@@ -312,6 +313,7 @@ Status ConsoleWindow::run() {
     have_frame_ = true;
     const LiveFrame& f = controller_.frame();
     if (fresh) controller_.track_changes();
+    ui_.pacing.frame_begins(f.status.deadline_ticks, f.status.deadline_misses, begin_ns, slowed(ui_.frame));
     ui_.replay.advance(dt_s);
     if (Status chosen = choose_shown(fresh); !chosen) {
       failure = chosen;
@@ -348,7 +350,7 @@ Status ConsoleWindow::run() {
       }
     }
     screenshots_due_.clear();
-    if (options_.slow_frame_ms > 0.0) std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(options_.slow_frame_ms));
+    if (slowed(ui_.frame)) std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(options_.slow_frame_ms));
     glfwSwapBuffers(window_);
 
     const std::int64_t shown_ns = now_ns();
@@ -368,7 +370,7 @@ Status ConsoleWindow::run() {
   return failure;
 }
 
-ordered_json make_report(CoreSession& session, ConsoleUi& ui, double wall_s, int width, int height) {
+ordered_json make_report(CoreSession& session, ConsoleUi& ui, const ConsoleOptions& options, double wall_s, int width, int height) {
   ordered_json r;
   r["frames"] = ui.frame;
   r["wall_s"] = wall_s;
@@ -376,6 +378,16 @@ ordered_json make_report(CoreSession& session, ConsoleUi& ui, double wall_s, int
   r["views"] = {{"endoscope", ui.endoscope_rect}, {"outside", ui.outside_rect}};
   r["frame_ms"] = {{"median", ui.frame_ms_as_us.quantile(0.5) * 1e-3}, {"p99", ui.frame_ms_as_us.quantile(0.99) * 1e-3},
                    {"max", ui.frame_ms_as_us.max() * 1e-3}};
+  const auto pacing = [](const FramePacing::Kind& k) {
+    return ordered_json{{"frames", k.frames},
+                        {"wall_s", k.wall_s},
+                        {"deadline_ticks", k.ticks},
+                        {"deadline_misses", k.misses},
+                        {"miss_fraction", k.ticks ? static_cast<double>(k.misses) / static_cast<double>(k.ticks) : 0.0},
+                        {"ticks_per_s", k.wall_s > 0.0 ? static_cast<double>(k.ticks) / k.wall_s : 0.0}};
+  };
+  r["frame_pacing"] = {{"slow_frame_ms", options.slow_frame_ms}, {"slow_frame_every", options.slow_frame_every},
+                       {"slow_frames", pacing(ui.pacing.slow())}, {"other_frames", pacing(ui.pacing.normal())}};
   r["input_to_photon_ms"] = {{"median", ui.input_to_photon_us.quantile(0.5) * 1e-3}, {"p99", ui.input_to_photon_us.quantile(0.99) * 1e-3},
                              {"max", ui.input_to_photon_us.max() * 1e-3}, {"samples", ui.input_to_photon_us.count()}};
   const Simulation& sim = session.simulation();
@@ -516,7 +528,7 @@ Result<ordered_json> run_console(const ConsoleOptions& options) {
     console.ui().replay.wait_for_verification();
     int w = 0, h = 0;
     glfwGetFramebufferSize(window, &w, &h);
-    report = make_report(session, console.ui(), std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count(), w, h);
+    report = make_report(session, console.ui(), options, std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count(), w, h);
     report["renderer"] = {{"gl_renderer", gl_renderer}, {"view_scale", resolved.view_scale}};
     renderer->reset();  // its GL objects go while the context lives
   }

@@ -25,6 +25,7 @@ struct ConsoleOptions {
   std::string record_path;      ///< --record: record the session from its first tick
   std::string replay_path;      ///< --replay: open this recording in the replay panel
   double slow_frame_ms = 0.0;   ///< every frame takes this much longer (tests of frame pacing)
+  std::uint64_t slow_frame_every = 1;  ///< only every Nth frame is slowed (the others are the comparison)
   bool vsync = true;
   /// The views' resolution relative to their panels (drawn smaller and scaled up when below 1);
   /// 0: 1 on a GPU, 0.5 on a software rasteriser (llvmpipe), where every pixel costs CPU time.

@@ -39,6 +39,43 @@ struct ParameterChange {
   double shown_value = 0.0;
 };
 
+/// The core's deadlines split by the kind of frame the console was drawing while they fell due:
+/// slowed on purpose (--slow-frame-ms, every --slow-frame-every'th frame) or not. What a slow frame
+/// does to the core is the difference between the two kinds' miss fractions in the same run, with
+/// the machine's state shared by both.
+class FramePacing {
+ public:
+  struct Kind {
+    std::uint64_t frames = 0, ticks = 0, misses = 0;
+    double wall_s = 0.0;
+  };
+  /// At the start of each frame, with the core's counts as its newest status gives them: they close
+  /// the previous frame's interval, whose ticks and misses go to that frame's kind (the status lags
+  /// the core by a snapshot at both ends of every interval alike).
+  void frame_begins(std::uint64_t deadline_ticks, std::uint64_t deadline_misses, std::int64_t now_ns, bool this_frame_slow) {
+    if (started_ && deadline_ticks >= ticks_ && deadline_misses >= misses_) {
+      Kind& kind = previous_slow_ ? slow_ : normal_;
+      ++kind.frames;
+      kind.ticks += deadline_ticks - ticks_;
+      kind.misses += deadline_misses - misses_;
+      kind.wall_s += static_cast<double>(now_ns - begin_ns_) * 1e-9;
+    }
+    started_ = true;
+    previous_slow_ = this_frame_slow;
+    ticks_ = deadline_ticks;
+    misses_ = deadline_misses;
+    begin_ns_ = now_ns;
+  }
+  const Kind& slow() const { return slow_; }
+  const Kind& normal() const { return normal_; }
+
+ private:
+  Kind slow_, normal_;
+  bool started_ = false, previous_slow_ = false;
+  std::uint64_t ticks_ = 0, misses_ = 0;
+  std::int64_t begin_ns_ = 0;
+};
+
 /// Per-session UI state.
 struct ConsoleUi {
   OrbitCamera orbit;
@@ -63,6 +100,7 @@ struct ConsoleUi {
   TimingHistogram frame_ms_as_us;       ///< frame time (stored in the histogram's microsecond unit as ms * 1000)
   TimingHistogram input_to_photon_us;   ///< device report received -> the frame that shows it, on screen
   std::array<float, 240> frame_history_ms{};
+  FramePacing pacing;
   std::uint32_t frame_history_next = 0;
   std::int64_t last_counted_sample_ns = 0;
   // Where the views were drawn last frame, window pixels (for screenshots and tests).

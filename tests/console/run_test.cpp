@@ -108,6 +108,26 @@ TEST(RunCommand, ReportsTheCollisionStepsThatKeptTheirContactCandidates) {
   EXPECT_NE(refused.err.find("contact reuse shift 1.5 mm is outside [0, the contact margin 1.5 mm)"), std::string::npos) << refused.err;
 }
 
+TEST(RunCommand, TheContactMarginIsTheUsersToChooseWithinItsRange) {
+  const auto dir = scratch_directory("run_contact_margin");
+  // A wider margin keeps every pair the default keeps and more: the short run's state is the same.
+  std::string hashes[2];
+  for (int k = 0; k < 2; ++k) {
+    const auto path = dir / (k == 0 ? "default.json" : "wide.json");
+    const CommandOutput run = run_resecto(std::string(kShortRun) + (k == 0 ? "" : " --contact-margin-mm 3") + " --report " + path.string());
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    hashes[k] = nlohmann::json::parse(read_text(path)).at("state_hash").get<std::string>();
+  }
+  EXPECT_EQ(hashes[0], hashes[1]);
+  // Below the reuse shift it is refused, naming both; outside its range, named by the option.
+  const CommandOutput below_reuse = run_resecto(std::string(kShortRun) + " --contact-margin-mm 0.2");
+  EXPECT_NE(below_reuse.exit_code, 0);
+  EXPECT_NE(below_reuse.err.find("contact reuse shift 0.3 mm is outside [0, the contact margin 0.2 mm)"), std::string::npos) << below_reuse.err;
+  const CommandOutput out_of_range = run_resecto(std::string(kShortRun) + " --contact-margin-mm 0");
+  EXPECT_NE(out_of_range.exit_code, 0);
+  EXPECT_NE(out_of_range.err.find("--contact-margin-mm"), std::string::npos) << out_of_range.err;
+}
+
 TEST(RunCommand, RealTimeReportsItsDeadlinesAndScheduling) {
   // One real-time second: the figures must be consistent with each other (how many ticks missed is
   // the machine's business, not a test's).
