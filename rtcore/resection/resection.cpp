@@ -526,6 +526,9 @@ void Resection::remove_hanging(ResectionStep& out) {
   // Around every node and edge the last removals touched, in ascending order: a star in more than one
   // face-connected group keeps its largest (ties: the one with the lowest slot) and loses the rest; a
   // node whose star is one group but whose surface there is not one closed fan loses its star.
+  // What goes here goes with the chips (their mass) but is no chip of its own: it is the debris a cut
+  // leaves on the jagged edge of its surface, a tetrahedron or a few, dozens of them a stroke, and a
+  // trainee's count of chips is of the pieces the loop cut free.
   const TetTopology& topo = tissue_->topology();
   for (int round = 0; round < 64; ++round) {
     sort_unique(removed_nodes_);
@@ -539,7 +542,6 @@ void Resection::remove_hanging(ResectionStep& out) {
       for (std::size_t k = 0; k < star_.size(); ++k) {
         if (group_[k] != keep) removing_.push_back(star_[k]);
       }
-      stats_.chips += groups - 1;
     };
     for (std::uint32_t v : removed_nodes_) {
       if (topo.valence(v) == 0) continue;
@@ -551,7 +553,6 @@ void Resection::remove_hanging(ResectionStep& out) {
         drop_all_but_largest(groups);
       } else if (!vertex_fan_is_disk(v)) {
         for (std::uint32_t t : star_) removing_.push_back(t);
-        ++stats_.chips;
       }
     }
     for (std::uint64_t key : removed_edges_) {

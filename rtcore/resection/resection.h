@@ -68,7 +68,7 @@ struct ResectionStats {
   RegionVolumes removed_m3{};  ///< everything that left: cut by the loop, hanging, chips
   RegionVolumes chip_m3{};     ///< the part that left as chips (hanging groups included)
   std::int64_t removed_tetrahedra = 0;
-  std::int64_t chips = 0;
+  std::int64_t chips = 0;  ///< pieces cut free (components holding no anchor); hanging debris goes with their mass, uncounted
   std::int64_t cuts = 0;          ///< strokes (pedal presses) that removed tissue
   std::int64_t perforations = 0;  ///< strokes that opened the outer surface
   std::vector<Vec3> perforation_sites;  ///< where each perforation first opened it (world, metres)
