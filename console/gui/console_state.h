@@ -100,9 +100,9 @@ struct ConsoleUi {
   TimingHistogram frame_ms_as_us;       ///< frame time (stored in the histogram's microsecond unit as ms * 1000)
   TimingHistogram input_to_photon_us;   ///< device report received -> the frame that shows it, on screen
   std::array<float, 240> frame_history_ms{};
-  FramePacing pacing;
   std::uint32_t frame_history_next = 0;
   std::int64_t last_counted_sample_ns = 0;
+  FramePacing pacing;  ///< the core's deadlines during slowed frames and during the others
   // Where the views were drawn last frame, window pixels (for screenshots and tests).
   std::array<float, 4> endoscope_rect{}, outside_rect{};
   std::vector<std::string> screenshots;

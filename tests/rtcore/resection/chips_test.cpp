@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "rtcore/mesh/mesh_validation.h"
 #include "rtcore/resection/resection.h"
@@ -74,7 +75,7 @@ TEST(Chips, AStrokeThatSeversTheBlocksTopCountsItAsOneChipWithItsMass) {
 }
 
 TEST(Chips, AStrokeThatSeversNothingCutsNoChip) {
-  // The same wire half-way through the block and back: a groove, nothing set free.
+  // The same wire from outside the block to half-way through it: a groove, nothing set free.
   const TetMesh block = adenoma_on_capsule();
   MassSpringTissue tissue(block);
   ResectionConfig config;
