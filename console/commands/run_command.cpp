@@ -143,11 +143,11 @@ void register_run(CLI::App& app) {
   cmd->add_option("--contact-reuse-mm", o->contact_reuse_mm,
                   "Keep the contact candidates, skipping a collision step's refit and search, while the tool and tissue have moved "
                   "at most this far since they were searched (0: search every step; default 0.3, the tool at most a third of it)")
-      ->check(CLI::Range(0.0, 1.5));
+      ->check(finite_range(0.0, 1.5));
   cmd->add_option("--contact-margin-mm", o->contact_margin_mm,
                   "How far outside the tool a point may be and still become a contact candidate; it must exceed what tool and "
                   "tissue move between collision steps (default 1.5)")
-      ->check(CLI::Range(0.1, 10.0));
+      ->check(finite_range(0.1, 10.0));
   cmd->add_option("--spin-us", o->spin_us, "Real time: spin this long before each tick instead of sleeping")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
