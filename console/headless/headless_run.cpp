@@ -177,18 +177,15 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
 
   // Real time: the core's thread first, the collision thread next (it has a whole collision period),
   // both before any normal thread of the machine. Batch runs keep normal priority.
-  std::optional<ScopedFifoPriority> core_priority;
+  ScopedFifoPriority core_priority(kCoreFifoPriority, options.realtime);
   bool collision_raised = false;
   bool helper_raised = false;
   bool recorder_raised = false;
-  if (options.realtime) {
-    core_priority.emplace(kCoreFifoPriority);
-    if (core_priority->raised()) {
-      const RaisedThreads raised = raise_simulation_threads(sim);
-      collision_raised = raised.collision;
-      helper_raised = raised.physics_helper;
-    }
-    if (core_priority->raised() && recorder) recorder_raised = raise_to_fifo(recorder->native_handle(), kRecorderFifoPriority);
+  if (core_priority.raised()) {
+    const RaisedThreads raised = raise_simulation_threads(sim);
+    collision_raised = raised.collision;
+    helper_raised = raised.physics_helper;
+    if (recorder) recorder_raised = raise_to_fifo(recorder->native_handle(), kRecorderFifoPriority);
   }
   const auto wall_start = std::chrono::steady_clock::now();
   if (options.realtime) {
@@ -226,8 +223,8 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
     return true;
   });
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  const bool core_raised = core_priority && core_priority->raised();
-  core_priority.reset();
+  const bool core_raised = core_priority.raised();
+  core_priority.restore();
   consumer.stop();
   if (live) live->link().stop();
   // The last collision step's job may still be cutting the other copy: take it in before reading the

@@ -104,12 +104,9 @@ void CoreSession::prepare_for_tick() {
 void CoreSession::run_core() {
   // The core first, the collision thread next, as in the headless real-time run; the console's own
   // thread stays at normal priority, so a slow frame can never hold a tick back.
-  std::optional<ScopedFifoPriority> priority;
-  if (options_.realtime_priority) {
-    priority.emplace(kCoreFifoPriority);
-    if (priority->raised()) raise_simulation_threads(*sim_);
-    priority_held_.store(priority->raised(), std::memory_order_release);
-  }
+  ScopedFifoPriority priority(kCoreFifoPriority, options_.realtime_priority);
+  if (priority.raised()) raise_simulation_threads(*sim_);
+  priority_held_.store(priority.raised(), std::memory_order_release);
   const double period_ns = static_cast<double>(schedule_for(options_).period_ns);
   sim_->set_paced();
   scheduler_.set_wake_hook([](void* session) { static_cast<CoreSession*>(session)->prepare_for_tick(); }, this);
@@ -144,7 +141,7 @@ void CoreSession::run_core() {
     return true;
   });
   if (recorder_) finish_recording();
-  priority.reset();
+  priority.restore();
 }
 
 void CoreSession::start_recording(const std::string& path) {

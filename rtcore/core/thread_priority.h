@@ -24,16 +24,23 @@ bool raise_to_fifo(pthread_t thread, int priority);
 /// Back to the default time-sharing policy.
 void restore_normal_scheduling(pthread_t thread);
 
-/// Raises the calling thread for its lifetime and restores it after.
+/// Raises the calling thread for its lifetime and restores it after. A plain object rather than an
+/// optional one for runs that may not want it: GCC's flow analysis under the sanitizers took an
+/// empty std::optional of it for one read uninitialized (-Wmaybe-uninitialized).
 class ScopedFifoPriority {
  public:
-  explicit ScopedFifoPriority(int priority) : thread_(pthread_self()), raised_(raise_to_fifo(thread_, priority)) {}
-  ~ScopedFifoPriority() {
-    if (raised_) restore_normal_scheduling(thread_);
-  }
+  /// Raises the calling thread only when `wanted` (a real-time run; a batch one keeps its priority).
+  ScopedFifoPriority(int priority, bool wanted) : thread_(pthread_self()), raised_(wanted && raise_to_fifo(thread_, priority)) {}
+  explicit ScopedFifoPriority(int priority) : ScopedFifoPriority(priority, true) {}
+  ~ScopedFifoPriority() { restore(); }
   ScopedFifoPriority(const ScopedFifoPriority&) = delete;
   ScopedFifoPriority& operator=(const ScopedFifoPriority&) = delete;
   bool raised() const { return raised_; }
+  /// Back to normal scheduling now; the destructor then has nothing left to do.
+  void restore() {
+    if (raised_) restore_normal_scheduling(thread_);
+    raised_ = false;
+  }
 
  private:
   pthread_t thread_;
