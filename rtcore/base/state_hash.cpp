@@ -13,16 +13,22 @@ void StateHasher::add_bytes(const void* data, std::size_t size) {
   std::size_t offset = 0;
   if (size >= 32) {
     // Distinct starting points (splitmix64's constants), so equal blocks in different lanes differ.
-    std::uint64_t lanes[4] = {hash_, hash_ ^ 0x9e3779b97f4a7c15ull, hash_ ^ 0xbf58476d1ce4e5b9ull, hash_ ^ 0x94d049bb133111ebull};
+    // Four named lanes, not an array: GCC kept an array's lanes on the stack, and each multiply then
+    // waited on a store and a reload (17 cycles a block, 76 us of a collision tick at 8640).
+    std::uint64_t lane0 = hash_, lane1 = hash_ ^ 0x9e3779b97f4a7c15ull, lane2 = hash_ ^ 0xbf58476d1ce4e5b9ull, lane3 = hash_ ^ 0x94d049bb133111ebull;
+    const auto word_at = [bytes](std::size_t at) {
+      std::uint64_t word;
+      std::memcpy(&word, bytes + at, 8);
+      return word;
+    };
     for (; offset + 32 <= size; offset += 32) {
-      for (std::size_t k = 0; k < 4; ++k) {
-        std::uint64_t word;
-        std::memcpy(&word, bytes + offset + 8 * k, 8);
-        lanes[k] = (lanes[k] ^ word) * kPrime;
-      }
+      lane0 = (lane0 ^ word_at(offset)) * kPrime;
+      lane1 = (lane1 ^ word_at(offset + 8)) * kPrime;
+      lane2 = (lane2 ^ word_at(offset + 16)) * kPrime;
+      lane3 = (lane3 ^ word_at(offset + 24)) * kPrime;
     }
-    hash_ = lanes[0];
-    for (std::size_t k = 1; k < 4; ++k) hash_ = (hash_ ^ lanes[k]) * kPrime;
+    hash_ = lane0;
+    for (const std::uint64_t lane : {lane1, lane2, lane3}) hash_ = (hash_ ^ lane) * kPrime;
   }
   for (; offset + 8 <= size; offset += 8) {
     std::uint64_t word;

@@ -50,6 +50,30 @@ TEST(StateHasher, LongSpansRunFourLanesThenTheRestAsOne) {
   EXPECT_EQ(hasher.value(), expected);
 }
 
+TEST(StateHasher, ManyBlocksKeepEachLaneOnItsOwnWordsAndTheTailAfter) {
+  // 1,000 blocks and 13 bytes more, against the definition written out lane by lane.
+  std::vector<std::uint8_t> bytes(32 * 1000 + 13);
+  for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<std::uint8_t>(i * 131 + 7);
+  StateHasher hasher;
+  hasher.add(std::span<const std::uint8_t>(bytes));
+  const auto word_at = [&](std::size_t at, std::size_t length) {
+    std::uint64_t word = 0;
+    for (std::size_t b = 0; b < length; ++b) word |= static_cast<std::uint64_t>(bytes[at + b]) << (8 * b);
+    return word;
+  };
+  std::uint64_t lanes[4] = {kOffset, kOffset ^ 0x9e3779b97f4a7c15ull, kOffset ^ 0xbf58476d1ce4e5b9ull, kOffset ^ 0x94d049bb133111ebull};
+  std::size_t at = 0;
+  for (; at + 32 <= bytes.size(); at += 32) {
+    for (std::size_t k = 0; k < 4; ++k) lanes[k] = (lanes[k] ^ word_at(at + 8 * k, 8)) * kPrime;
+  }
+  std::uint64_t expected = lanes[0];
+  for (int k = 1; k < 4; ++k) expected = (expected ^ lanes[k]) * kPrime;
+  expected = (expected ^ word_at(at, 8)) * kPrime;  // one whole word, then 5 bytes zero-padded
+  expected = (expected ^ word_at(at + 8, 5)) * kPrime;
+  expected = (expected ^ bytes.size()) * kPrime;
+  EXPECT_EQ(hasher.value(), expected);
+}
+
 TEST(StateHasher, LongSpansSeeEveryBitAndWhichLaneAWordIsIn) {
   std::vector<std::uint64_t> words(64);
   for (std::size_t i = 0; i < words.size(); ++i) words[i] = 0x9e3779b97f4a7c15ull * (i + 1);
