@@ -379,6 +379,7 @@ void Simulation::run_collision_job() {
   other.set_edit_log(nullptr);
   job_edited_ = !lag_log_.empty();
   if (job_edited_ && !cut_job_.cutting) other.set_positions(positions);  // a compaction adds no node
+  other.refresh_mesh_surface();  // for the snapshot of the tick that takes this copy in (fill_snapshot)
   search_timing_.topology_end_ns = FrameProfiler::now_ns();
   // Temporal coherence: while the tool and the tissue have barely moved from where the front's
   // candidates were searched, they serve the next window too, and the step skips its refit and
@@ -478,18 +479,18 @@ void Simulation::fill_snapshot(SimulationSnapshot& snapshot) const {
   snapshot.node_count = static_cast<std::uint32_t>(nodes);
   // The connectivity changes only with topology_version (the two copies of the tissue count their
   // edits alike): a slot that already holds this version's faces keeps them, which spares a pass over
-  // the surface at most collision ticks. The tissue's surface is in its own (locality) numbering and
-  // has free slots; the snapshot speaks mesh ids and lists the live faces in slot order, each with
-  // its tetrahedron's region.
+  // the surface at most collision ticks. The faces come listed in mesh ids with their regions by the
+  // collision job, which relists the copy it edited (MassSpringTissue::refresh_mesh_surface); the
+  // core only copies them, at the tick that takes the edited copy in and has the least room.
   if (snapshot.topology_version != tissue_->topology_version()) {
-    const std::vector<Triangle>& faces = tissue_->surface().triangles;
+    const MassSpringTissue::MeshSurface& listed = tissue_->mesh_surface();
     std::size_t count = 0;
-    for (std::size_t f = 0; f < faces.size() && count < snapshot.surface_triangles.size(); ++f) {
-      const std::int64_t owner = tissue_->surface_face_owner(f);
-      if (owner < 0) continue;
-      for (int c = 0; c < 3; ++c) snapshot.surface_triangles[count][c] = tissue_->mesh_node(faces[f][c]);
-      if (count < snapshot.surface_regions.size()) snapshot.surface_regions[count] = tissue_->topology().region(static_cast<std::uint32_t>(owner / 4));
-      ++count;
+    if (listed.version == tissue_->topology_version()) {
+      count = std::min({listed.count, snapshot.surface_triangles.size(), snapshot.surface_regions.size()});
+      std::copy_n(listed.triangles.begin(), count, snapshot.surface_triangles.begin());
+      std::copy_n(listed.regions.begin(), count, snapshot.surface_regions.begin());
+    } else {  // edited outside a collision job (a test, a tool)
+      count = tissue_->list_mesh_surface(snapshot.surface_triangles, snapshot.surface_regions);
     }
     snapshot.surface_triangle_count = static_cast<std::uint32_t>(count);
     snapshot.topology_version = tissue_->topology_version();

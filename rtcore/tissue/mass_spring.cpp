@@ -80,6 +80,7 @@ MassSpringTissue::MassSpringTissue(OrderedMesh&& ordered_mesh, const TissueParam
   spare_tree_.set_slabs(false);
   reserve_topology(topology_.node_capacity(), topology_.tetrahedron_capacity());
   map_initial_surface();
+  refresh_mesh_surface();
   topology_hash_ = topology_hash();
   update_material();
 }

@@ -218,6 +218,22 @@ class MassSpringTissue {
   std::uint64_t topology_version() const { return topology_version_; }
   /// The live surface, compacted (free slots skipped, in slot order) over the tissue's nodes.
   TriangleMesh live_surface(bool rest_positions) const;
+  /// The live surface as a snapshot shows it: the faces in slot order over mesh node ids, each with
+  /// its tetrahedron's region, as of topology version `version`. Sized once to the surface's capacity.
+  struct MeshSurface {
+    std::vector<Triangle> triangles;
+    std::vector<TissueRegion> regions;
+    std::size_t count = 0;
+    std::uint64_t version = ~std::uint64_t{0};  ///< none listed yet
+  };
+  const MeshSurface& mesh_surface() const { return mesh_surface_; }
+  /// Lists the live faces and their regions as MeshSurface does into `triangles` and `regions`, as many
+  /// as fit in both; returns how many it listed.
+  std::size_t list_mesh_surface(std::span<Triangle> triangles, std::span<TissueRegion> regions) const;
+  /// Relists mesh_surface() if an edit changed the surface since (a pass over the surface, about 0.1 ms
+  /// at 8640 triangles). The editor calls it after its edits, so that the core's publish at the
+  /// collision tick that takes this copy in only copies the list. Allocates nothing.
+  void refresh_mesh_surface();
 
   std::size_t node_count() const { return x_.size(); }
   /// The mesh's index of the tissue's node `node`.
@@ -320,6 +336,7 @@ class MassSpringTissue {
   SphereTree spare_tree_;
   std::uint64_t topology_hash_ = 0;  // of the live tetrahedra and the surface's faces, kept per edit
   std::uint64_t topology_version_ = 0;
+  MeshSurface mesh_surface_;
   std::int64_t surface_tree_rebuilds_ = 0;
   bool surface_tree_edited_ = false;  // an edit since the tree was last judged (or a rebuild deferred)
   TetTopology topology_;

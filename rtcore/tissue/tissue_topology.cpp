@@ -96,6 +96,27 @@ void MassSpringTissue::reserve_topology(std::size_t node_capacity, std::size_t t
   for (SphereTree* tree : {&surface_tree_, &spare_tree_}) {
     tree->reserve(static_cast<std::int32_t>(4 * surface_face_capacity_), static_cast<std::uint32_t>(surface_face_capacity_));
   }
+  mesh_surface_.triangles.resize(surface_face_capacity_);
+  mesh_surface_.regions.resize(surface_face_capacity_);
+}
+
+std::size_t MassSpringTissue::list_mesh_surface(std::span<Triangle> triangles, std::span<TissueRegion> regions) const {
+  const std::size_t room = std::min(triangles.size(), regions.size());
+  std::size_t count = 0;
+  for (std::size_t s = 0; s < surface_.triangles.size() && count < room; ++s) {
+    const std::int64_t owner = face_owner_[s];
+    if (owner < 0) continue;
+    for (int c = 0; c < 3; ++c) triangles[count][c] = mesh_node_[surface_.triangles[s][c]];
+    regions[count] = topology_.region(static_cast<std::uint32_t>(owner / 4));
+    ++count;
+  }
+  return count;
+}
+
+void MassSpringTissue::refresh_mesh_surface() {
+  if (mesh_surface_.version == topology_version_) return;
+  mesh_surface_.count = list_mesh_surface(mesh_surface_.triangles, mesh_surface_.regions);
+  mesh_surface_.version = topology_version_;
 }
 
 void MassSpringTissue::map_initial_surface() {

@@ -67,6 +67,34 @@ TEST(Simulation, TheCollisionThreadChangesNothingButWhereTheSearchRuns) {
   EXPECT_EQ(a, b);
 }
 
+TEST(Simulation, TheSnapshotShowsTheSurfaceTheCutsLeaveAtEveryCollisionStep) {
+  // The faces a snapshot shows come listed by the collision job that edited the copy; a snapshot
+  // refilled at every collision tick must hold the same faces and regions as a fresh listing of the
+  // tissue the physics steps, through every cut.
+  auto sim = Simulation::create(small_config());
+  ASSERT_TRUE(sim) << sim.error();
+  SimulationSnapshot snapshot = (*sim)->make_snapshot();
+  const std::uint64_t version_before = (*sim)->tissue().topology_version();
+  std::vector<Triangle> fresh((*sim)->tissue().surface_face_capacity());
+  std::vector<TissueRegion> fresh_regions(fresh.size());
+  int compared = 0;
+  for (std::uint64_t tick = 0; tick < 3 * 960; ++tick) {
+    (*sim)->step(input_at(tick, (*sim)->config().tick_s()), {});
+    if (!(*sim)->is_collision_tick(tick)) continue;
+    (*sim)->fill_snapshot(snapshot);
+    const std::size_t count = (*sim)->tissue().list_mesh_surface(fresh, fresh_regions);
+    ASSERT_EQ(snapshot.surface_triangle_count, count) << "tick " << tick;
+    for (std::size_t f = 0; f < count; ++f) {
+      ASSERT_EQ(snapshot.surface_triangles[f], fresh[f]) << "tick " << tick << " face " << f;
+      ASSERT_EQ(snapshot.surface_regions[f], fresh_regions[f]) << "tick " << tick << " face " << f;
+    }
+    ++compared;
+  }
+  EXPECT_EQ(compared, 180);
+  EXPECT_GT((*sim)->tissue().topology_version(), version_before) << "the script must cut for this to test anything";
+  EXPECT_GT((*sim)->metrics().cuts, 0u);
+}
+
 TEST(Simulation, ThePhysicsHelperChangesNoBit) {
   // The physics step's loops shared with a helper thread give the lone thread's state at every
   // collision step, through contact and cuts (input_at presses the pedal from 1.5 s), with the search
