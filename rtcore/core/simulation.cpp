@@ -291,18 +291,25 @@ void Simulation::advance_collision_pipeline(std::uint64_t tick, FrameProfiler* p
   // current pose covers. (The tissue's own motion is slower and left to the margin.)
   searching_ = placed_;
   if (config_.predict_search_pose && placed_.present && last_search_present_) {
-    const double lead = 1.5;
     const DeviceJoints& now = placed_joints_;
     const DeviceJoints& before = last_search_joints_;
-    DeviceJoints ahead;
-    ahead.yaw_rad = now.yaw_rad + lead * (now.yaw_rad - before.yaw_rad);
-    ahead.pitch_rad = now.pitch_rad + lead * (now.pitch_rad - before.pitch_rad);
-    ahead.roll_rad = now.roll_rad + lead * (now.roll_rad - before.roll_rad);
-    ahead.insertion_m = now.insertion_m + lead * (now.insertion_m - before.insertion_m);
-    ahead.loop_travel_m = now.loop_travel_m + lead * (now.loop_travel_m - before.loop_travel_m);
-    searching_.poses = resecto::tool_poses(ahead, config_.gimbal);
+    const auto extrapolated = [&](double lead) {
+      DeviceJoints ahead;
+      ahead.yaw_rad = now.yaw_rad + lead * (now.yaw_rad - before.yaw_rad);
+      ahead.pitch_rad = now.pitch_rad + lead * (now.pitch_rad - before.pitch_rad);
+      ahead.roll_rad = now.roll_rad + lead * (now.roll_rad - before.roll_rad);
+      ahead.insertion_m = now.insertion_m + lead * (now.insertion_m - before.insertion_m);
+      ahead.loop_travel_m = now.loop_travel_m + lead * (now.loop_travel_m - before.loop_travel_m);
+      return resecto::tool_poses(ahead, config_.gimbal);
+    };
+    searching_.poses = extrapolated(1.5);
     tissue_->tool().set_query_pose(sheath_part_, searching_.poses.sheath);
     tissue_->tool().set_query_pose(loop_part_, searching_.poses.loop);
+    // The candidates' first physics step is at the next collision tick, one period ahead: the search
+    // certifies the points' clearance where the tool should be then, so that step skips most of them.
+    const ToolPoses at_publish = extrapolated(1.0);
+    tissue_->tool().set_certify_pose(sheath_part_, at_publish.sheath);
+    tissue_->tool().set_certify_pose(loop_part_, at_publish.loop);
   }
   last_search_joints_ = placed_joints_;
   last_search_present_ = placed_.present;

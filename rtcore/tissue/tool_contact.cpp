@@ -124,6 +124,16 @@ ToolContacts::Clearance certify(const Closest& best, const Vec3& at, double tiss
   return {at, best.clearance(), tissue_travel};
 }
 
+/// The search's certificate for a point it found at p, certified at `at` (ToolContacts::set_certify_pose):
+/// every face within the margin of p is a candidate, so a ball around `at` is clear of every face, not
+/// only of the candidates, up to the margin less |at - p| (`reach`). Only a ball clear of every face
+/// proves that the point stays outside the other surface while it is in the ball.
+ToolContacts::Clearance certify_within_candidates(const Closest& best, const Vec3& at, double tissue_travel, double reach) {
+  ToolContacts::Clearance clearance = certify(best, at, tissue_travel);
+  clearance.radius = std::max(0.0, std::min(clearance.radius, reach));
+  return clearance;
+}
+
 }  // namespace
 
 bool ToolContacts::Clearance::holds(const Vec3& point, double tissue_travel_now) const {
@@ -283,7 +293,7 @@ void ToolContacts::keep_within_margin(std::uint32_t first, const Vec3& p, const 
 void ToolContacts::latch_query_poses(double tissue_travel_m) {
   query_tissue_travel_m_ = tissue_travel_m;
   for (Part& part : parts_) {
-    part.query_pose = part.pose;
+    part.query_pose = part.certify_pose = part.pose;
     part.query_enabled = part.enabled;
   }
 }
@@ -303,6 +313,7 @@ void ToolContacts::copy_query_state(const ToolContacts& front) {
   query_tissue_travel_m_ = front.query_tissue_travel_m_;
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     parts_[k].query_pose = front.parts_[k].query_pose;
+    parts_[k].certify_pose = front.parts_[k].certify_pose;
     parts_[k].query_enabled = front.parts_[k].query_enabled;
   }
 }
@@ -468,9 +479,11 @@ void ToolContacts::search_tissue_nodes(std::uint16_t part_index, const SphereTre
       keep_within_margin(first, p, part.mesh.positions, part.mesh.triangles);
       const auto count = static_cast<std::uint32_t>(out.pair_count - first);
       if (count == 0) continue;
-      const Closest best = nearest_tool_face(part.mesh, part.face_normals, part.triangle_spheres, p, &out.pair_triangles[first], count,
-                                             &out.pair_distance[first], 0.0);
-      out.node_clearance[out.node_count] = certify(best, p, 0.0);
+      const Vec3 at = part.certify_pose.inverse_apply_point(surface.positions[n]);
+      const double shift = rounded_up(glm::length(at - p));
+      const Closest best = nearest_tool_face(part.mesh, part.face_normals, part.triangle_spheres, at, &out.pair_triangles[first], count,
+                                             &out.pair_distance[first], shift);
+      out.node_clearance[out.node_count] = certify_within_candidates(best, at, 0.0, margin_m_ - shift);
       out.nodes[out.node_count++] = {n, part_index, first, count, p};
     }
   }
@@ -509,8 +522,10 @@ void ToolContacts::search_tool_vertices(std::uint16_t part_index, const SphereTr
       keep_within_margin(first, w, x, surface.triangles);
       const auto count = static_cast<std::uint32_t>(out.pair_count - first);
       if (count == 0) continue;
-      const Closest best = nearest_tissue_face(x.data(), surface.triangles, w, &out.pair_triangles[first], count, &out.pair_distance[first], 0.0);
-      out.vertex_clearance[out.vertex_count] = certify(best, w, query_tissue_travel_m_);
+      const Vec3 at = part.certify_pose.apply_point(part.mesh.positions[v]);
+      const double shift = rounded_up(glm::length(at - w));
+      const Closest best = nearest_tissue_face(x.data(), surface.triangles, at, &out.pair_triangles[first], count, &out.pair_distance[first], shift);
+      out.vertex_clearance[out.vertex_count] = certify_within_candidates(best, at, query_tissue_travel_m_, margin_m_ - shift);
       out.vertices[out.vertex_count++] = {v, part_index, first, count, w};
     }
   }

@@ -86,6 +86,12 @@ class ToolContacts {
   /// Replaces a part's latched pose with where the search should look for it instead (e.g. where the
   /// part is expected to be while the candidates are in use). Same rules as latch_query_poses().
   void set_query_pose(int part, const RigidPose& pose) { parts_[static_cast<std::size_t>(part)].query_pose = pose; }
+  /// Where the part is expected to be when the search's candidates are published (the latched pose
+  /// unless set): the search certifies each point's clearance there rather than at the query pose,
+  /// so that the first physics step on the new candidates finds most certificates holding. Any pose
+  /// gives sound certificates (each is a ball around a point, clear of every candidate face); a
+  /// good guess only makes more of them hold. Same rules as latch_query_poses().
+  void set_certify_pose(int part, const RigidPose& pose) { parts_[static_cast<std::size_t>(part)].certify_pose = pose; }
   /// Finds, for each part at its latched pose, the tissue surface nodes within the margin of it and
   /// the part's vertices within the margin of the tissue, each with every triangle of the other side
   /// within the margin, from the tissue surface tree (already refitted to `surface`'s positions), into
@@ -168,6 +174,7 @@ class ToolContacts {
     bool enabled = true;
     RigidPose query_pose;  // latched for the search (the search's thread reads only these)
     bool query_enabled = true;
+    RigidPose certify_pose;  // where the search certifies its points' clearance (set_certify_pose)
     RigidPose published_pose;  // the query pose the published candidates were searched at
     bool published_enabled = false;
   };

@@ -93,6 +93,55 @@ TEST(ClearanceCertificates, TissueTravelBoundsEveryNodesDisplacement) {
   EXPECT_GT(pressed, 0.001) << "the loop pressed in";
 }
 
+/// Collision-step hashes of a loop pressed in and withdrawn at `press_s`, searched where it is and
+/// certified at `certify_pose(tick)`; with `certificates` off, every candidate point every step.
+template <class CertifyPose>
+std::vector<std::uint64_t> certified_elsewhere(bool certificates, CertifyPose certify_pose, std::int64_t* skipped = nullptr) {
+  const ProstateTissueModel& model = tissue_model(1296);
+  TissueConfig config;
+  config.clearance_certificates = certificates;
+  MassSpringTissue tissue(model.mesh, TissueParameters{}, config);
+  const int part = tissue.tool().add_part(model.loop);
+  const auto depth_at = [](int tick) { return 0.004 * std::sin(3.14159 * tick / 480.0); };  // in and out in half a second
+  tissue.tool().reset_pose(part, indentation_loop_pose(model.anatomy, model.loop, depth_at(0)));
+  std::vector<std::uint64_t> hashes;
+  double pressed = 0.0;
+  for (int tick = 0; tick < 480; ++tick) {
+    if (tick % 16 == 0) {
+      tissue.begin_collision_step();
+      tissue.tool().set_certify_pose(part, certify_pose(tick));
+      tissue.refit_surface_tree();
+      tissue.search_contact_candidates();
+      tissue.end_collision_step();
+      hashes.push_back(tissue.state_hash());
+    }
+    tissue.tool().set_pose(part, indentation_loop_pose(model.anatomy, model.loop, depth_at(tick)));
+    (void)tissue.physics_step(1.0 / 960.0);
+    pressed = std::max(pressed, tissue.max_displacement_m());
+  }
+  EXPECT_GT(pressed, 0.001) << "the loop pressed in";
+  if (skipped != nullptr) *skipped = tissue.tool().points_skipped();
+  return hashes;
+}
+
+TEST(ClearanceCertificates, CertifiedWhereTheToolWillBeOrAnywhereElseGiveTheBruteForceState) {
+  // The search may certify its points at the pose the tool is expected at when the candidates are
+  // first used (set_certify_pose): a ball clear of every face is a proof wherever it is centred, so a
+  // good guess skips more and a wrong one fewer, and neither changes a force.
+  const ProstateTissueModel& model = tissue_model(1296);
+  const auto ahead = [&](int tick) { return indentation_loop_pose(model.anatomy, model.loop, 0.004 * std::sin(3.14159 * (tick + 16) / 480.0)); };
+  const auto astray = [&](int tick) {
+    RigidPose pose = indentation_loop_pose(model.anatomy, model.loop, 0.004 * std::sin(3.14159 * tick / 480.0));
+    pose.translation += Vec3(0.0008, -0.0005, 0.0003);  // a millimetre off, within the 1.5 mm margin
+    return pose;
+  };
+  const std::vector<std::uint64_t> brute = certified_elsewhere(false, ahead);
+  std::int64_t skipped_ahead = 0, skipped_astray = 0;
+  EXPECT_EQ(certified_elsewhere(true, ahead, &skipped_ahead), brute);
+  EXPECT_EQ(certified_elsewhere(true, astray, &skipped_astray), brute);
+  EXPECT_GT(skipped_ahead, 0);
+}
+
 TEST(ClearanceCertificate, HoldsOnlyWhileTheMotionCannotCloseTheGap) {
   const ToolContacts::Clearance clearance{Vec3(0.0), 1e-3, 2e-4};
   EXPECT_TRUE(clearance.holds(Vec3(0.0), 2e-4));
