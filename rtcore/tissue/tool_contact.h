@@ -122,7 +122,8 @@ class ToolContacts {
   /// Whether evaluate_forces() may skip points whose clearance certificate still holds, and stop a point's
   /// scan at the first face its search distance proves cannot be the nearest (on by default). Off,
   /// every candidate point is tested against every one of its faces at every step: the brute-force
-  /// reference the tests and benchmarks compare against. The forces are the same either way.
+  /// reference the tests and benchmarks compare against. The forces are the same either way while the
+  /// tissue's surface does not fold through itself (docs/commands.md, "Contact costs what is in contact").
   void set_clearance_skipping(bool enabled) { clearance_skipping_ = enabled; }
 
   /// After a topology edit of the tissue (resection), between physics steps with no search running:
