@@ -89,8 +89,9 @@ class ToolContacts {
   /// Where the part is expected to be when the search's candidates are published (the latched pose
   /// unless set): the search certifies each point's clearance there rather than at the query pose,
   /// so that the first physics step on the new candidates finds most certificates holding. Any pose
-  /// gives sound certificates (each is a ball around a point, clear of every candidate face); a
-  /// good guess only makes more of them hold. Same rules as latch_query_poses().
+  /// gives sound certificates: each ball is cut to the margin less the distance from where the point
+  /// was searched, so it is clear of every face, candidate or not; a good guess only makes more of them
+  /// hold. Same rules as latch_query_poses().
   void set_certify_pose(int part, const RigidPose& pose) { parts_[static_cast<std::size_t>(part)].certify_pose = pose; }
   /// Finds, for each part at its latched pose, the tissue surface nodes within the margin of it and
   /// the part's vertices within the margin of the tissue, each with every triangle of the other side
