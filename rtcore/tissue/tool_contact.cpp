@@ -4,6 +4,7 @@
 #include "rtcore/tissue/tool_contact.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -118,6 +119,81 @@ Closest nearest_tissue_face(const Vec3* x, const std::vector<Triangle>& triangle
   return best;
 }
 
+/// A face's corners, for guard_nearest_side: a rigid part's in its frame, the tissue's where they are.
+inline auto tool_corners(const TriangleMesh& mesh) {
+  return [&mesh](std::uint32_t face) {
+    const Triangle& t = mesh.triangles[face];
+    return std::array<Vec3, 3>{mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]};
+  };
+}
+inline auto tissue_corners(const Vec3* x, const std::vector<Triangle>& triangles) {
+  return [x, &triangles](std::uint32_t face) {
+    const Triangle& t = triangles[face];
+    return std::array<Vec3, 3>{x[t[0]], x[t[1]], x[t[2]]};
+  };
+}
+
+/// The brute-force test a certificate stands in for decides a point's side by its nearest candidate
+/// face's plane, and that answer can change without the point crossing any face: where the faces
+/// are a union of overlapping shells (the tool's parts), where the tissue's surface folds through
+/// itself under the loop, or where the nearest point is on an edge whose face tilts. A ball clear of
+/// every face is then not enough; this cuts the certificate's radius so that the brute-force test
+/// would find the point outside wherever the certificate holds (docs/commands.md, "Contact costs what
+/// is in contact", gives the bounds). With the point and the faces having moved s in all, a face at
+/// distance e from `at` can be the nearest only if e - d <= 2s (d the nearest's distance), and the
+/// point stays in front of its plane while s < h (h its height over the plane) for a rigid face. A
+/// moving face's plane also turns: while its corners move less than `travel_cap` the turn is under
+/// 30 degrees, which costs h at most (1 - cos 30°), and the plane moves at the point's foot by its
+/// corners' travel times the foot's barycentric weights' absolute sum L, so the bound is (0.866 h) / L.
+/// Each face within reach bounds the radius by the larger of its two bounds. Faces come nearest first
+/// with their distance at the search (`searched`, or null), nearer now by at most `moved`: past
+/// d + 2 * radius none can overtake, and the scan stops.
+template <typename Corners>
+void guard_nearest_side(ToolContacts::Clearance& clearance, const Closest& best, const std::uint32_t* faces, std::uint32_t count, const double* searched,
+                        double moved, bool faces_move, const Corners& corners) {
+  constexpr double kTieDistance = 1e-9;  // m: Closest::kTie's squared tolerance as a distance, rounded up
+  constexpr double kSlack = kTieDistance + 1e-12;  // and a picometre for the rounding of the tests
+  constexpr double kTurnedHeight = 0.866;  // cos 30°, rounded down
+  const Vec3& at = clearance.at;
+  const double nearest = std::sqrt(best.distance2);
+  double radius = clearance.radius;
+  const double start_radius = radius;
+  double travel_cap = faces_move ? start_radius : std::numeric_limits<double>::infinity();
+  for (std::uint32_t e = 0; e < count && radius > 0.0; ++e) {
+    // The window narrows as the radius is cut; every face within the final one has been weighed.
+    const double reach = nearest + 2.0 * (radius + kSlack);
+    if (searched != nullptr && searched[e] - moved - 1e-12 > reach) break;
+    const std::array<Vec3, 3> c = corners(faces[e]);
+    const Vec3 gap = glm::max(glm::max(glm::min(c[0], glm::min(c[1], c[2])) - at, at - glm::max(c[0], glm::max(c[1], c[2]))), Vec3(0.0));
+    const double gap2 = glm::dot(gap, gap);
+    if (gap2 > reach * reach) continue;
+    const Vec3 a = c[1] - c[0], b = c[2] - c[0], u = at - c[0];
+    const Vec3 n2 = glm::cross(a, b);
+    const double area2 = glm::length(n2);
+    if (!(area2 > 0.0)) {  // a degenerate face has no side to keep
+      radius = 0.0;
+      break;
+    }
+    double height = glm::dot(u, n2) / area2 - 1e-12;
+    if (faces_move && height > 0.0) {
+      // Corners moving t change n2 by at most 2t(|a| + |b|) + 4t^2; under half of |n2|, it turns < 30°.
+      const double aa = glm::dot(a, a), ab = glm::dot(a, b), bb = glm::dot(b, b), ua = glm::dot(u, a), ub = glm::dot(u, b);
+      travel_cap = std::min(travel_cap, 0.5 * area2 / (2.0 * (std::sqrt(aa) + std::sqrt(bb)) + 4.0 * start_radius));
+      const double inverse = 1.0 / (area2 * area2);  // aa * bb - ab^2, Lagrange's identity
+      const double l1 = (bb * ua - ab * ub) * inverse, l2 = (aa * ub - ab * ua) * inverse;
+      const double weights = std::abs(1.0 - l1 - l2) + std::abs(l1) + std::abs(l2);
+      height = kTurnedHeight * height / (weights * (1.0 + 1e-9)) - 1e-12;
+    }
+    if (height >= radius) continue;
+    // The box's distance bounds the face's from below: the closest point only when that is not enough.
+    if (0.5 * (std::sqrt(gap2) - nearest) - kSlack >= radius) continue;
+    const double distance = glm::length(at - closest_point_on_triangle(at, c[0], c[1], c[2]));
+    radius = std::max(0.0, std::min(radius, std::max(height, 0.5 * (distance - nearest) - kSlack)));
+  }
+  clearance.radius = radius;
+  clearance.travel_cap = travel_cap;
+}
+
 /// A point's certificate from its nearest face: none (radius 0) when it is behind that face.
 ToolContacts::Clearance certify(const Closest& best, const Vec3& at, double tissue_travel) {
   if (best.side < 0.0) return {};
@@ -137,7 +213,9 @@ ToolContacts::Clearance certify_within_candidates(const Closest& best, const Vec
 }  // namespace
 
 bool ToolContacts::Clearance::holds(const Vec3& point, double tissue_travel_now) const {
-  const double slack = radius - (tissue_travel_now - tissue_travel);
+  const double travelled = tissue_travel_now - tissue_travel;
+  if (!(travelled < travel_cap)) return false;
+  const double slack = radius - travelled;
   if (!(slack > 0.0)) return false;
   const Vec3 moved = point - at;
   return glm::dot(moved, moved) < slack * slack;
@@ -332,6 +410,8 @@ void ToolContacts::order_points(std::vector<PointCandidates>& points, std::vecto
 }
 
 void ToolContacts::publish_candidates() {
+  static const bool brute = std::getenv("RESECTO_BRUTE") != nullptr;
+  if (brute) clearance_skipping_ = false;
   std::swap(node_candidates_, search_.nodes);
   std::swap(vertex_candidates_, search_.vertices);
   std::swap(pair_triangles_, search_.pair_triangles);
@@ -483,7 +563,9 @@ void ToolContacts::search_tissue_nodes(std::uint16_t part_index, const SphereTre
       const double shift = rounded_up(glm::length(at - p));
       const Closest best = nearest_tool_face(part.mesh, part.face_normals, part.triangle_spheres, at, &out.pair_triangles[first], count,
                                              &out.pair_distance[first], shift);
-      out.node_clearance[out.node_count] = certify_within_candidates(best, at, 0.0, margin_m_ - shift);
+      ToolContacts::Clearance& clearance = out.node_clearance[out.node_count];
+      clearance = certify_within_candidates(best, at, 0.0, margin_m_ - shift);
+      guard_nearest_side(clearance, best, &out.pair_triangles[first], count, &out.pair_distance[first], shift, false, tool_corners(part.mesh));
       out.nodes[out.node_count++] = {n, part_index, first, count, p};
     }
   }
@@ -525,7 +607,9 @@ void ToolContacts::search_tool_vertices(std::uint16_t part_index, const SphereTr
       const Vec3 at = part.certify_pose.apply_point(part.mesh.positions[v]);
       const double shift = rounded_up(glm::length(at - w));
       const Closest best = nearest_tissue_face(x.data(), surface.triangles, at, &out.pair_triangles[first], count, &out.pair_distance[first], shift);
-      out.vertex_clearance[out.vertex_count] = certify_within_candidates(best, at, query_tissue_travel_m_, margin_m_ - shift);
+      ToolContacts::Clearance& clearance = out.vertex_clearance[out.vertex_count];
+      clearance = certify_within_candidates(best, at, query_tissue_travel_m_, margin_m_ - shift);
+      guard_nearest_side(clearance, best, &out.pair_triangles[first], count, &out.pair_distance[first], shift, true, tissue_corners(x.data(), surface.triangles));
       out.vertices[out.vertex_count++] = {v, part_index, first, count, w};
     }
   }
@@ -554,8 +638,7 @@ ToolReaction ToolContacts::evaluate_forces(std::span<const Vec3> x, std::span<co
     const PointCandidates& pc = node_candidates_[i];
     const Part& part = parts_[pc.part];
     const Vec3 p = part.pose.inverse_apply_point(x[pc.point]);
-    Clearance& clearance = node_clearance_[i];
-    if (clearance_skipping_ && clearance.holds(p, 0.0)) {
+    if (clearance_skipping_ && node_clearance_[i].holds(p, 0.0)) {
       ++skipped;
       continue;
     }
@@ -563,7 +646,6 @@ ToolReaction ToolContacts::evaluate_forces(std::span<const Vec3> x, std::span<co
     const double* searched = clearance_skipping_ && distances_valid_ ? &pair_distance_[pc.first] : nullptr;
     const Closest best = nearest_tool_face(part.mesh, part.face_normals, part.triangle_spheres, p, &pair_triangles_[pc.first], pc.count, searched,
                                            glm::length(p - pc.searched_at));
-    clearance = certify(best, p, 0.0);
     if (!(best.side < 0.0)) continue;
     // Along the closest face's normal, by the distance behind its plane: the signed distance's
     // gradient there. (The closest-point direction would turn fast near the wire's centre line, a
@@ -593,8 +675,7 @@ ToolReaction ToolContacts::evaluate_forces(std::span<const Vec3> x, std::span<co
     const PointCandidates& pc = vertex_candidates_[i];
     const Part& part = parts_[pc.part];
     const Vec3 w = part.pose.apply_point(part.mesh.positions[pc.point]);
-    Clearance& clearance = vertex_clearance_[i];
-    if (clearance_skipping_ && clearance.holds(w, tissue_travel_m)) {
+    if (clearance_skipping_ && vertex_clearance_[i].holds(w, tissue_travel_m)) {
       ++skipped;
       continue;
     }
@@ -607,7 +688,6 @@ ToolReaction ToolContacts::evaluate_forces(std::span<const Vec3> x, std::span<co
     }
     const Closest best = nearest_tissue_face(x.data(), surface_triangles, w, &pair_triangles_[pc.first], pc.count, searched,
                                              glm::length(w - pc.searched_at) + faces_moved);
-    clearance = certify(best, w, tissue_travel_m);
     if (!(best.side < 0.0)) continue;
     const Triangle& t = surface_triangles[best.triangle];
     const double depth = std::min(-best.side, margin_m_);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <utility>
 #include <vector>
@@ -45,16 +46,21 @@ struct ToolContactStats {
 /// The tool side of contact: the rigid parts, their proximity grids and vertex clusters, their poses.
 class ToolContacts {
  public:
-  /// Proof that a point cannot touch its candidate triangles yet: at `at` (tool frame for a tissue
-  /// node, world for a tool vertex) it was outside them, at least `radius` from every one, and the
-  /// tissue had travelled `tissue_travel` by then. Distance to a set of triangles changes no faster
-  /// than the point and the triangles' corners move, so while the point has moved less than the
-  /// radius minus the tissue's travel since, no candidate can be nearer than zero: the point is
-  /// still outside and takes no force. radius 0: no proof, test the point.
+  /// Proof that the brute-force test would find a point outside its candidate triangles, so that it
+  /// takes no force: at `at` (tool frame for a tissue node, world for a tool vertex) it was at least
+  /// `radius` from every one, with no candidate able to become its nearest and have it behind its
+  /// plane within that radius, and the tissue had travelled `tissue_travel` by then. Distances and
+  /// heights change no faster than the point and the triangles' corners move, so while the point has
+  /// moved less than the radius minus the tissue's travel since, the test's answer is still
+  /// "outside". Issued by the search only: a tested point is tested until the next search.
+  /// radius 0: no proof, test the point.
   struct Clearance {
     Vec3 at{0.0};
     double radius = 0.0;
     double tissue_travel = 0.0;
+    /// The tissue's travel since beyond which the proof lapses whatever the radius: a moving face
+    /// the point may come nearest to could have turned its plane too far toward the point.
+    double travel_cap = std::numeric_limits<double>::infinity();
     /// Whether the proof still holds for the point now at `point`, the tissue's travel now being
     /// `tissue_travel_now`.
     bool holds(const Vec3& point, double tissue_travel_now) const;
@@ -123,8 +129,8 @@ class ToolContacts {
   /// Whether evaluate_forces() may skip points whose clearance certificate still holds, and stop a point's
   /// scan at the first face its search distance proves cannot be the nearest (on by default). Off,
   /// every candidate point is tested against every one of its faces at every step: the brute-force
-  /// reference the tests and benchmarks compare against. The forces are the same either way while the
-  /// tissue's surface does not fold through itself (docs/commands.md, "Contact costs what is in contact").
+  /// reference the tests and benchmarks compare against. The forces are the same either way, bit for
+  /// bit, folds of the tissue's surface included (docs/commands.md, "Contact costs what is in contact").
   void set_clearance_skipping(bool enabled) { clearance_skipping_ = enabled; }
 
   /// After a topology edit of the tissue (resection), between physics steps with no search running:
@@ -252,7 +258,7 @@ class ToolContacts {
   // bounds how much nearer a vertex's faces can have come since the search.
   std::vector<SearchedCorner> searched_corners_;
   std::size_t corner_count_ = 0;
-  // Per published candidate point, its clearance certificate (the search's, renewed by evaluate_forces()).
+  // Per published candidate point, its clearance certificate (the search's).
   std::vector<Clearance> node_clearance_, vertex_clearance_;
   // evaluate_forces()'s result: each push's share of a node's force and bounds, in the order made.
   struct NodeShare {

@@ -28,8 +28,9 @@ inline constexpr GoldenRun kGoldenRuns[] = {
     // resecto run --headless --procedure demo --seconds 2 --triangles 1296 --json
     {"--procedure demo --seconds 2 --triangles 1296", "f67287b334913e3f", "428b47b5c6643171", 0},
     // resecto run --headless --procedure turp --seconds 4 --triangles 1296 --json (one stroke cuts; two
-    // before turp's moves between strokes were paced, 2026-11-27, which moved these values)
-    {"--procedure turp --seconds 4 --triangles 1296", "9cc56e48f7c6188d", "b718df5b67ba163f", 1},
+    // before turp's moves between strokes were paced, 2026-11-27, which moved these values; moved again
+    // 2026-11-29 when the clearance certificates were made to give the brute-force state at folds)
+    {"--procedure turp --seconds 4 --triangles 1296", "e3e3c772694cee2d", "d6b12fba104e5413", 1},
 };
 
 }  // namespace resecto::testing
