@@ -4,7 +4,6 @@
 #include "rtcore/tissue/tool_contact.h"
 
 #include <algorithm>
-#include <cstdlib>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -410,8 +409,6 @@ void ToolContacts::order_points(std::vector<PointCandidates>& points, std::vecto
 }
 
 void ToolContacts::publish_candidates() {
-  static const bool brute = std::getenv("RESECTO_BRUTE") != nullptr;
-  if (brute) clearance_skipping_ = false;
   std::swap(node_candidates_, search_.nodes);
   std::swap(vertex_candidates_, search_.vertices);
   std::swap(pair_triangles_, search_.pair_triangles);
