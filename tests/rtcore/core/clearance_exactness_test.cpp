@@ -3,8 +3,9 @@
 // (every candidate point tested every step) at every collision step.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <vector>
 
