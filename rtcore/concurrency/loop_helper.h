@@ -52,7 +52,9 @@ class LoopHelper {
   LoopHelper() : thread_([this] { run(); }) {}
   ~LoopHelper() {
     stopping_.store(true, std::memory_order_relaxed);
-    on_call_.store(1, std::memory_order_release);
+    // Not 1: a helper going home by itself swaps an on-call 1 for 0 (run()), and would take this
+    // wake-up with it and sleep through the join. Its swap fails on kStopping.
+    on_call_.store(kStopping, std::memory_order_release);
     futex_wake_one(on_call_);
     thread_.join();
   }
@@ -187,6 +189,7 @@ class LoopHelper {
   std::atomic<void (*)(void*, std::uint32_t)> body_{nullptr};
   std::atomic<void*> context_{nullptr};
   alignas(64) std::atomic<std::uint32_t> finished_{0};
+  static constexpr std::uint32_t kStopping = 2;  // on_call_ from the destructor on
   alignas(64) std::atomic<std::uint32_t> on_call_{0};
   std::atomic<bool> stopping_{false};
   std::atomic<std::uint64_t> helped_{0};
