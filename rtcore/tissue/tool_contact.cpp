@@ -193,19 +193,20 @@ void guard_nearest_side(ToolContacts::Clearance& clearance, const Closest& best,
   clearance.travel_cap = travel_cap;
 }
 
-/// A point's certificate from its nearest face: none (radius 0) when it is behind that face.
-ToolContacts::Clearance certify(const Closest& best, const Vec3& at, double tissue_travel) {
+/// The search's certificate for a point it found at p, certified at `at` (ToolContacts::set_certify_pose),
+/// `shift` = |at - p| away, from its nearest face `best` among its candidates `faces` (nearest first,
+/// at distances `searched` from p): none (radius 0) when it is behind that face. Every face within the
+/// margin of p is a candidate, so a ball around `at` is clear of every face, not only of the
+/// candidates, up to the margin less the shift; only such a ball proves that the point stays outside
+/// the other surface while it is in it. guard_nearest_side() then cuts it so that the brute-force test
+/// answers "outside" throughout.
+template <typename Corners>
+ToolContacts::Clearance certify_within_candidates(const Closest& best, const Vec3& at, double tissue_travel, double shift, double margin,
+                                                  const std::uint32_t* faces, std::uint32_t count, const double* searched, bool faces_move,
+                                                  const Corners& corners) {
   if (best.side < 0.0) return {};
-  return {at, best.clearance(), tissue_travel};
-}
-
-/// The search's certificate for a point it found at p, certified at `at` (ToolContacts::set_certify_pose):
-/// every face within the margin of p is a candidate, so a ball around `at` is clear of every face, not
-/// only of the candidates, up to the margin less |at - p| (`reach`). Only a ball clear of every face
-/// proves that the point stays outside the other surface while it is in the ball.
-ToolContacts::Clearance certify_within_candidates(const Closest& best, const Vec3& at, double tissue_travel, double reach) {
-  ToolContacts::Clearance clearance = certify(best, at, tissue_travel);
-  clearance.radius = std::max(0.0, std::min(clearance.radius, reach));
+  ToolContacts::Clearance clearance{at, std::max(0.0, std::min(best.clearance(), margin - shift)), tissue_travel};
+  guard_nearest_side(clearance, best, faces, count, searched, shift, faces_move, corners);
   return clearance;
 }
 
@@ -560,9 +561,8 @@ void ToolContacts::search_tissue_nodes(std::uint16_t part_index, const SphereTre
       const double shift = rounded_up(glm::length(at - p));
       const Closest best = nearest_tool_face(part.mesh, part.face_normals, part.triangle_spheres, at, &out.pair_triangles[first], count,
                                              &out.pair_distance[first], shift);
-      ToolContacts::Clearance& clearance = out.node_clearance[out.node_count];
-      clearance = certify_within_candidates(best, at, 0.0, margin_m_ - shift);
-      guard_nearest_side(clearance, best, &out.pair_triangles[first], count, &out.pair_distance[first], shift, false, tool_corners(part.mesh));
+      out.node_clearance[out.node_count] = certify_within_candidates(best, at, 0.0, shift, margin_m_, &out.pair_triangles[first], count,
+                                                                     &out.pair_distance[first], false, tool_corners(part.mesh));
       out.nodes[out.node_count++] = {n, part_index, first, count, p};
     }
   }
@@ -604,9 +604,8 @@ void ToolContacts::search_tool_vertices(std::uint16_t part_index, const SphereTr
       const Vec3 at = part.certify_pose.apply_point(part.mesh.positions[v]);
       const double shift = rounded_up(glm::length(at - w));
       const Closest best = nearest_tissue_face(x.data(), surface.triangles, at, &out.pair_triangles[first], count, &out.pair_distance[first], shift);
-      ToolContacts::Clearance& clearance = out.vertex_clearance[out.vertex_count];
-      clearance = certify_within_candidates(best, at, query_tissue_travel_m_, margin_m_ - shift);
-      guard_nearest_side(clearance, best, &out.pair_triangles[first], count, &out.pair_distance[first], shift, true, tissue_corners(x.data(), surface.triangles));
+      out.vertex_clearance[out.vertex_count] = certify_within_candidates(best, at, query_tissue_travel_m_, shift, margin_m_, &out.pair_triangles[first],
+                                                                         count, &out.pair_distance[first], true, tissue_corners(x.data(), surface.triangles));
       out.vertices[out.vertex_count++] = {v, part_index, first, count, w};
     }
   }
