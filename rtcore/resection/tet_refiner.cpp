@@ -45,7 +45,7 @@ const double kMaxClosureDihedralCos = std::cos(kMinClosureDihedralDeg * std::num
 constexpr std::uint32_t kNoNode = 0xffffffffu;
 /// slot_state_ bits: red, waiting in to_judge_, listed in touched_, listed in candidates_ (while
 /// gathering from the topology).
-constexpr std::uint8_t kRed = 1, kQueued = 2, kTouched = 4, kListed = 8;
+constexpr std::uint8_t kRed = 1, kQueued = 2, kTouched = 4;
 /// slot_verdict_: the split-edge mask last judged (6 bits), whether it is known, and whether green.
 constexpr unsigned kVerdictMask = 0x3Fu, kVerdictKnown = 0x40u, kVerdictGreen = 0x80u;
 
@@ -243,22 +243,9 @@ void TetRefiner::gather_candidates(const TetMeshView& mesh) {
   // ascending (a counting sort).
   candidates_.clear();
   const std::uint8_t* covered = node_is_covered_.data();
-  if (mesh.topology != nullptr) {
-    // The same list from the covered nodes' own lists: each slot once, then ascending.
-    for (std::uint32_t n : covered_nodes_) {
-      mesh.topology->for_each_tetrahedron_of(n, [&](std::uint32_t s) {
-        if (slot_state_[s] & kListed) return;
-        slot_state_[s] |= kListed;
-        candidates_.push_back(s);
-      });
-    }
-    for (std::uint32_t s : candidates_) slot_state_[s] &= static_cast<std::uint8_t>(~kListed);
-    std::sort(candidates_.begin(), candidates_.end());
-  } else {
-    for (std::uint32_t s = 0; s < mesh.tetrahedra.size(); ++s) {
-      const Tetrahedron& t = mesh.tetrahedra[s];
-      if ((covered[t[0]] | covered[t[1]] | covered[t[2]] | covered[t[3]]) && mesh.alive[s]) candidates_.push_back(s);
-    }
+  for (std::uint32_t s = 0; s < mesh.tetrahedra.size(); ++s) {
+    const Tetrahedron& t = mesh.tetrahedra[s];
+    if ((covered[t[0]] | covered[t[1]] | covered[t[2]] | covered[t[3]]) && mesh.alive[s]) candidates_.push_back(s);
   }
   incidence_offsets_.assign(covered_nodes_.size() + 1, 0);
   for (std::uint32_t s : candidates_) {
@@ -276,10 +263,34 @@ void TetRefiner::gather_candidates(const TetMeshView& mesh) {
   }
 }
 
+void TetRefiner::split_edge_in(const TetMeshView& mesh, std::uint32_t s, std::uint32_t a, std::uint32_t b) {
+  if (slot_state_[s] & kRed) return;
+  const Tetrahedron& tet = mesh.tetrahedra[s];
+  const int i = static_cast<int>(std::find(tet.begin(), tet.end(), a) - tet.begin());
+  const int j = static_cast<int>(std::find(tet.begin(), tet.end(), b) - tet.begin());
+  slot_mask_[s] |= static_cast<std::uint8_t>(1u << (kMidpoint[i][j] - 4));
+  if (!(slot_state_[s] & kTouched)) {
+    slot_state_[s] |= kTouched;
+    touched_.push_back(s);
+  }
+  if (!(slot_state_[s] & kQueued)) {
+    slot_state_[s] |= kQueued;
+    to_judge_.push_back(s);
+  }
+}
+
 void TetRefiner::split_around(const TetMeshView& mesh, std::uint32_t red_slot) {
   const Tetrahedron& red = mesh.tetrahedra[red_slot];
   for (const auto& edge : kTetEdges) {
     const std::uint32_t a = red[edge[0]], b = red[edge[1]];
+    if (mesh.topology != nullptr) {
+      // The slots holding edge (a, b): those of a's live tetrahedra that hold b too.
+      mesh.topology->for_each_tetrahedron_of(a, [&](std::uint32_t s) {
+        const Tetrahedron& tet = mesh.tetrahedra[s];
+        if (tet[0] == b || tet[1] == b || tet[2] == b || tet[3] == b) split_edge_in(mesh, s, a, b);
+      });
+      continue;
+    }
     // The slots holding edge (a, b): the intersection of a's and b's ascending slot lists.
     const std::uint32_t* x = incidence_.data() + incidence_offsets_[node_covered_[a]];
     const std::uint32_t* x_end = incidence_.data() + incidence_offsets_[node_covered_[a] + 1];
@@ -291,21 +302,8 @@ void TetRefiner::split_around(const TetMeshView& mesh, std::uint32_t red_slot) {
       } else if (*y < *x) {
         ++y;
       } else {
-        const std::uint32_t s = *x;
+        split_edge_in(mesh, *x, a, b);
         ++x, ++y;
-        if (slot_state_[s] & kRed) continue;
-        const Tetrahedron& tet = mesh.tetrahedra[s];
-        const int i = static_cast<int>(std::find(tet.begin(), tet.end(), a) - tet.begin());
-        const int j = static_cast<int>(std::find(tet.begin(), tet.end(), b) - tet.begin());
-        slot_mask_[s] |= static_cast<std::uint8_t>(1u << (kMidpoint[i][j] - 4));
-        if (!(slot_state_[s] & kTouched)) {
-          slot_state_[s] |= kTouched;
-          touched_.push_back(s);
-        }
-        if (!(slot_state_[s] & kQueued)) {
-          slot_state_[s] |= kQueued;
-          to_judge_.push_back(s);
-        }
       }
     }
   }
@@ -347,15 +345,19 @@ const RefinementEdit& TetRefiner::plan(const TetMeshView& mesh, std::span<const 
   if (red_slots_.empty()) return edit_;
   std::size_t quality_upgrades_left = kQualityUpgradesPerMark * red_slots_.size();
 
-  // Refinement is decided among the candidates: every live slot touching a covered node, listed
-  // under each covered node it holds. Covered at first: the marked slots' nodes (one pass over the
-  // slots). Every slot holding a split edge shares a node with a red slot, so while every red node
-  // is covered the candidates hold all that refinement can reach; a red node outside widens the
-  // cover by every candidate's nodes, one ring, with one more pass over the slots.
-  for (std::uint32_t s : red_slots_) {
-    for (std::uint32_t n : mesh.tetrahedra[s]) cover(n);
+  // With the tissue's node-to-tetrahedra lists, the slots holding a split edge are read off its
+  // nodes' lists. Without them, refinement is decided among the candidates: every live slot touching
+  // a covered node, listed under each covered node it holds. Covered at first: the marked slots'
+  // nodes (one pass over the slots). Every slot holding a split edge shares a node with a red slot,
+  // so while every red node is covered the candidates hold all that refinement can reach; a red node
+  // outside widens the cover by every candidate's nodes, one ring, with one more pass over the slots.
+  const bool by_topology = mesh.topology != nullptr;
+  if (!by_topology) {
+    for (std::uint32_t s : red_slots_) {
+      for (std::uint32_t n : mesh.tetrahedra[s]) cover(n);
+    }
+    gather_candidates(mesh);
   }
-  gather_candidates(mesh);
 
   // Closure to a fixed point. Each round splits the edges of the slots that turned red in every slot
   // holding them, then judges those slots in ascending slot order: one whose split edges admit no
@@ -363,7 +365,7 @@ const RefinementEdit& TetRefiner::plan(const TetMeshView& mesh, std::span<const 
   std::size_t processed = 0;
   while (processed < red_slots_.size()) {
     bool outside = false;
-    for (std::size_t r = processed; r < red_slots_.size(); ++r) {
+    for (std::size_t r = processed; r < red_slots_.size() && !by_topology; ++r) {
       for (std::uint32_t n : mesh.tetrahedra[red_slots_[r]]) outside |= !node_is_covered_[n];
     }
     to_judge_.clear();

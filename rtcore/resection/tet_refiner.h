@@ -21,7 +21,7 @@ struct TetMeshView {
   std::span<const std::uint8_t> alive;      ///< per slot: 1 live, 0 dead (ignored)
   std::span<const TissueRegion> regions;    ///< per slot
   /// The live tetrahedra around each node, when the caller keeps them (the tissue does): the plan
-  /// then reads only the refined region's neighbourhood instead of passing over every slot.
+  /// then reads only the lists of the split edges' nodes instead of passing over every slot.
   const TetTopology* topology = nullptr;
 };
 
@@ -39,9 +39,10 @@ struct RefinementEdit {
   std::int32_t closure_tetrahedra = 0;            ///< split only to close the conforming mesh
 };
 
-/// Cost: proportional to the refined region when the view carries the topology; otherwise one pass
-/// over the slots (two when the closure spreads beyond the marked slots' neighbours, and one more
-/// for each further ring), the rest proportional to the refined region. Per-node and
+/// Cost: proportional to the refined region when the view carries the topology (the slots around
+/// each split edge's first node); otherwise one pass over the slots (two when the closure spreads
+/// beyond the marked slots' neighbours, and one more for each further ring), the rest proportional
+/// to the refined region. Per-node and
 /// per-slot scratch is sized at construction (and grows if a mesh outgrows it); per-plan lists are
 /// sized for plans of about a thousand slots and grow once when a plan is larger, then stay: after
 /// the first plans, plan() allocates nothing. The returned edit lives until the next plan().
@@ -57,11 +58,13 @@ class TetRefiner {
 
  private:
   void cover(std::uint32_t node);
-  /// Lists every live slot touching a covered node (candidates_), and under each covered node the
-  /// candidates holding it (incidence_), in one pass over the slots.
+  /// Without the topology: lists every live slot touching a covered node (candidates_), and under
+  /// each covered node the candidates holding it (incidence_), in one pass over the slots.
   void gather_candidates(const TetMeshView& mesh);
-  /// Marks the red slot's edges split in every candidate holding them and queues those for judging.
+  /// Marks the red slot's edges split in every live slot holding them and queues those for judging.
   void split_around(const TetMeshView& mesh, std::uint32_t red_slot);
+  /// Marks edge (a, b) split in slot s (unless red) and queues it for judging.
+  void split_edge_in(const TetMeshView& mesh, std::uint32_t s, std::uint32_t a, std::uint32_t b);
 
   RefinementEdit edit_;
   std::vector<std::uint8_t> slot_state_;          // per slot: red, queued, touched bits
