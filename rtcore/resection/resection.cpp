@@ -12,6 +12,7 @@ namespace resecto {
 namespace {
 
 constexpr std::uint32_t kNoNode = 0xffffffffu;
+constexpr std::size_t kNoLimit = std::numeric_limits<std::size_t>::max();
 
 template <typename T>
 void sort_unique(std::vector<T>& values) {
@@ -377,10 +378,13 @@ int Resection::refine_near(const SweptVolume& sweep) {
     if (marked_.empty()) break;
     const TetMeshView view{tissue_->rest_positions(), topo.tetrahedra(), topo.alive_flags(), topo.regions(), &topo};
     if (marked_.size() > config_.max_refined_per_step) keep_nearest_the_start(sweep, config_.max_refined_per_step);
-    const RefinementEdit* plan = &refiner_.plan(view, marked_);
-    while (static_cast<std::size_t>(plan->red_tetrahedra + plan->closure_tetrahedra) > config_.max_refined_per_step && marked_.size() > 1) {
+    // A plan past the limit is abandoned as soon as it is (its spread is what costs); a single
+    // marked tetrahedron is refined whatever its closure takes.
+    const std::size_t limit = config_.max_refined_per_step;
+    const RefinementEdit* plan = &refiner_.plan(view, marked_, marked_.size() > 1 ? limit : kNoLimit);
+    while (plan->exceeded) {
       keep_nearest_the_start(sweep, marked_.size() / 2);
-      plan = &refiner_.plan(view, marked_);
+      plan = &refiner_.plan(view, marked_, marked_.size() > 1 ? limit : kNoLimit);
     }
     const RefinementEdit& edit = *plan;
     if (!tissue_->can_edit(edit.new_node_parents.size(), edit.added_tetrahedra.size(), edit.removed_tetrahedra.size())) {

@@ -309,7 +309,7 @@ void TetRefiner::split_around(const TetMeshView& mesh, std::uint32_t red_slot) {
   }
 }
 
-const RefinementEdit& TetRefiner::plan(const TetMeshView& mesh, std::span<const std::uint32_t> marked) {
+const RefinementEdit& TetRefiner::plan(const TetMeshView& mesh, std::span<const std::uint32_t> marked, std::size_t limit) {
   const std::size_t slot_count = mesh.tetrahedra.size();
   const std::size_t node_count = mesh.rest_positions.size();
   if (slot_state_.size() < slot_count) {
@@ -329,6 +329,7 @@ const RefinementEdit& TetRefiner::plan(const TetMeshView& mesh, std::span<const 
   edit_.added_regions.clear();
   edit_.added_parent.clear();
   edit_.red_tetrahedra = edit_.closure_tetrahedra = 0;
+  edit_.exceeded = false;
   red_slots_.clear();
   closure_slots_.clear();
   touched_.clear();
@@ -381,6 +382,13 @@ const RefinementEdit& TetRefiner::plan(const TetMeshView& mesh, std::span<const 
       processed = 0;
     }
     for (; processed < red_slots_.size(); ++processed) split_around(mesh, red_slots_[processed]);
+    // Every touched slot ends red or closed, and the touched set only grows: past the limit already,
+    // the plan would be too; stop here rather than spread it further.
+    if (touched_.size() > limit) {
+      edit_.exceeded = true;
+      clear_scratch();
+      return edit_;
+    }
     std::sort(to_judge_.begin(), to_judge_.end());
     for (std::uint32_t s : to_judge_) {
       slot_state_[s] &= static_cast<std::uint8_t>(~kQueued);
@@ -459,14 +467,18 @@ const RefinementEdit& TetRefiner::plan(const TetMeshView& mesh, std::span<const 
   edit_.red_tetrahedra = static_cast<std::int32_t>(red_slots_.size());
   edit_.closure_tetrahedra = static_cast<std::int32_t>(closure_slots_.size());
 
-  // Leave the scratch all zero (nothing covered) for the next plan, touching only what this one set.
+  clear_scratch();
+  return edit_;
+}
+
+void TetRefiner::clear_scratch() {
+  // All zero (nothing covered) for the next plan, touching only what this one set.
   for (std::uint32_t s : touched_) slot_state_[s] = slot_mask_[s] = slot_verdict_[s] = 0;
   for (std::uint32_t n : covered_nodes_) {
     node_is_covered_[n] = 0;
     node_covered_[n] = kNoNode;
   }
   covered_nodes_.clear();
-  return edit_;
 }
 
 }  // namespace resecto

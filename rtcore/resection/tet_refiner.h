@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -37,6 +38,9 @@ struct RefinementEdit {
   std::vector<std::uint32_t> added_parent;        ///< the removed slot each child came from
   std::int32_t red_tetrahedra = 0;                ///< split regularly 1:8 (marked + upgraded)
   std::int32_t closure_tetrahedra = 0;            ///< split only to close the conforming mesh
+  /// The plan would split more than the limit plan() was given: it was abandoned, and the lists
+  /// above are empty.
+  bool exceeded = false;
 };
 
 /// Cost: proportional to the refined region when the view carries the topology (the slots around
@@ -54,7 +58,11 @@ class TetRefiner {
   /// tetrahedron that shares a split edge closed conformingly, so no hanging node exists. The edit's
   /// result has exactly the volume of the removed tetrahedra (to rounding) and is deterministic
   /// (same view and marks -> same edit, byte for byte). `marked` may be unsorted/duplicated.
-  const RefinementEdit& plan(const TetMeshView& mesh, std::span<const std::uint32_t> marked);
+  /// `limit`: the most tetrahedra (red and closures) the caller would apply; a plan growing past it
+  /// stops there and comes back `exceeded`, costing about the limit's worth of planning instead of
+  /// the whole spread.
+  const RefinementEdit& plan(const TetMeshView& mesh, std::span<const std::uint32_t> marked,
+                             std::size_t limit = std::numeric_limits<std::size_t>::max());
 
  private:
   void cover(std::uint32_t node);
@@ -65,6 +73,8 @@ class TetRefiner {
   void split_around(const TetMeshView& mesh, std::uint32_t red_slot);
   /// Marks edge (a, b) split in slot s (unless red) and queues it for judging.
   void split_edge_in(const TetMeshView& mesh, std::uint32_t s, std::uint32_t a, std::uint32_t b);
+  /// Leaves the per-slot and per-node scratch as the next plan expects it.
+  void clear_scratch();
 
   RefinementEdit edit_;
   std::vector<std::uint8_t> slot_state_;          // per slot: red, queued, touched bits

@@ -467,6 +467,38 @@ TEST(TetRefiner, PlansFromTheTopologyEqualThePassOverSlots) {
   }
 }
 
+TEST(TetRefiner, APlanPastItsLimitIsAbandonedAndLeavesNothingBehind) {
+  // Resection asks for at most so many split tetrahedra a step and halves its marks until the plan
+  // fits: a plan past the limit comes back marked and empty, and the plans after it are those a
+  // fresh refiner makes (the abandoned one left no scratch set), with or without the topology.
+  PlainMesh m = from_tet_mesh(tissue_model(1296).mesh);
+  TetTopology topology(m.tets, m.regions, m.rest.size(), m.tets.size(), m.rest.size());
+  TetMeshView with_topology = m.view();
+  with_topology.topology = &topology;
+  const std::vector<std::uint32_t> live = live_slots(m);
+  const Tetrahedron& centre = m.tets[live[live.size() / 2]];
+  const std::vector<std::uint32_t> marked =
+      slots_near(m, (m.rest[centre[0]] + m.rest[centre[1]] + m.rest[centre[2]] + m.rest[centre[3]]) * 0.25, 12);
+  for (const TetMeshView& view : {m.view(), with_topology}) {
+    TetRefiner fresh(m.rest.size(), m.tets.size()), limited(m.rest.size(), m.tets.size());
+    const RefinementEdit whole = fresh.plan(view, marked);
+    const auto size = static_cast<std::size_t>(whole.red_tetrahedra + whole.closure_tetrahedra);
+    ASSERT_GT(size, marked.size());
+    EXPECT_FALSE(whole.exceeded);
+    expect_same_edit(whole, limited.plan(view, marked, size));  // exactly at the limit: fits
+    const RefinementEdit& over = limited.plan(view, marked, size - 1);
+    EXPECT_TRUE(over.exceeded);
+    EXPECT_TRUE(over.removed_tetrahedra.empty());
+    EXPECT_TRUE(over.added_tetrahedra.empty());
+    EXPECT_TRUE(over.new_node_parents.empty());
+    EXPECT_EQ(over.red_tetrahedra + over.closure_tetrahedra, 0);
+    const std::vector<std::uint32_t> half(marked.begin(), marked.begin() + static_cast<std::ptrdiff_t>(marked.size() / 2));
+    TetRefiner another(m.rest.size(), m.tets.size());
+    expect_same_edit(another.plan(view, half), limited.plan(view, half));
+    expect_same_edit(whole, limited.plan(view, marked));
+  }
+}
+
 TEST(TetRefiner, DeadSlotsAreIgnored) {
   PlainMesh m = tetgen_box();
   // Kill the half x > 12 mm: those slots are resected and never touched again.
