@@ -32,6 +32,27 @@ void add_padding_rows(std::vector<SpringForce>& f) {
   f.push_back(kMinusZeroRow);
 }
 
+/// The longest of group g's four lists.
+std::uint32_t group_longest(const std::vector<std::uint32_t>& list_first, std::size_t g) {
+  const std::size_t n = g * kSpringSumGroup;
+  std::uint32_t longest = 0;
+  for (std::size_t k = 0; k < kSpringSumGroup; ++k) longest = std::max(longest, list_first[n + k + 1] - list_first[n + k]);
+  return longest;
+}
+
+/// Writes group g's four lists into its block at `group`, each padded to `longest` with `padding`.
+template <class SpringAt>
+void write_group(const std::vector<std::uint32_t>& list_first, SpringAt spring_at, std::uint32_t padding, std::size_t g, std::uint32_t longest,
+                 std::uint32_t* group) {
+  for (std::size_t k = 0; k < kSpringSumGroup; ++k) {
+    const std::size_t n = g * kSpringSumGroup + k;
+    const std::uint32_t first = list_first[n], count = list_first[n + 1] - first;
+    std::uint32_t e = 0;
+    for (; e < count; ++e) group[kSpringSumGroup * e + k] = spring_at(first + e);
+    for (; e < longest; ++e) group[kSpringSumGroup * e + k] = padding;
+  }
+}
+
 /// A node list of every group, padded to the group's longest and interleaved (SpringIncidence).
 /// `spring_at(p)` is the spring at position p of `list_first`'s lists. Offsets first, then each
 /// node's list copied into its lane and padded: no test per entry (this runs once per batch of edits
@@ -42,25 +63,44 @@ void interleave_groups(const std::vector<std::uint32_t>& list_first, SpringAt sp
   const std::size_t groups = (list_first.size() - 1) / kSpringSumGroup;
   offsets.resize(groups + 1);
   offsets[0] = 0;
-  for (std::size_t g = 0; g < groups; ++g) {
-    const std::size_t n = g * kSpringSumGroup;
-    std::uint32_t longest = 0;
-    for (std::size_t k = 0; k < kSpringSumGroup; ++k) longest = std::max(longest, list_first[n + k + 1] - list_first[n + k]);
-    offsets[g + 1] = offsets[g] + longest;
-  }
+  for (std::size_t g = 0; g < groups; ++g) offsets[g + 1] = offsets[g] + group_longest(list_first, g);
   entries.resize(kSpringSumGroup * offsets[groups]);  // within the reserved room
   std::uint32_t* out = entries.data();
+  for (std::size_t g = 0; g < groups; ++g) write_group(list_first, spring_at, padding, g, offsets[g + 1] - offsets[g], out + kSpringSumGroup * offsets[g]);
+}
+
+/// interleave_groups() again after lists have only grown: the lists of the groups flagged in
+/// `changed` (one byte per group; groups past the old count are new) are written afresh, every other
+/// group's block is moved, whole runs at a time, to where the longer groups before it put it. The
+/// result is the one interleave_groups() makes, for a copy of the blocks instead of a pass per entry.
+template <class SpringAt>
+void regroup_grown(const std::vector<std::uint32_t>& list_first, SpringAt spring_at, std::uint32_t padding, const std::vector<std::uint8_t>& changed,
+                   std::vector<std::uint32_t>& offsets, std::vector<std::uint32_t>& entries, std::vector<std::uint32_t>& new_offsets) {
+  const std::size_t groups = (list_first.size() - 1) / kSpringSumGroup;
+  const std::size_t old_groups = offsets.size() - 1;
+  new_offsets.resize(groups + 1);
+  new_offsets[0] = 0;
   for (std::size_t g = 0; g < groups; ++g) {
-    const std::uint32_t longest = offsets[g + 1] - offsets[g];
-    std::uint32_t* group = out + kSpringSumGroup * offsets[g];
-    for (std::size_t k = 0; k < kSpringSumGroup; ++k) {
-      const std::size_t n = g * kSpringSumGroup + k;
-      const std::uint32_t first = list_first[n], count = list_first[n + 1] - first;
-      std::uint32_t e = 0;
-      for (; e < count; ++e) group[kSpringSumGroup * e + k] = spring_at(first + e);
-      for (; e < longest; ++e) group[kSpringSumGroup * e + k] = padding;
-    }
+    const bool kept = g < old_groups && !changed[g];
+    new_offsets[g + 1] = new_offsets[g] + (kept ? offsets[g + 1] - offsets[g] : group_longest(list_first, g));
   }
+  entries.resize(kSpringSumGroup * new_offsets[groups]);  // within the reserved room; only grows
+  // Back to front: every block moves up (lists only grow), never onto one not yet moved.
+  std::size_t g = groups;
+  while (g > 0) {
+    --g;
+    if (g < old_groups && !changed[g]) {
+      const std::size_t run_end = g + 1;
+      while (g > 0 && !changed[g - 1]) --g;  // the run of unchanged groups [g, run_end): one shift
+      if (new_offsets[g] != offsets[g]) {
+        std::copy_backward(entries.begin() + kSpringSumGroup * offsets[g], entries.begin() + kSpringSumGroup * offsets[run_end],
+                           entries.begin() + kSpringSumGroup * new_offsets[run_end]);
+      }
+      continue;
+    }
+    write_group(list_first, spring_at, padding, g, new_offsets[g + 1] - new_offsets[g], entries.data() + kSpringSumGroup * new_offsets[g]);
+  }
+  offsets.swap(new_offsets);
 }
 
 }  // namespace
@@ -75,6 +115,7 @@ SpringForces::SpringForces(const SpringNetwork& network) {
   arrays_.c.assign(count, 0.0);
   arrays_.f.assign(count, SpringForce{});
   add_padding_rows(arrays_.f);
+  padding_row_ = count;
   arrays_.compressed.assign(count, 0);
   for (std::size_t s = 0; s < count; ++s) {
     arrays_.i[s] = network.spring_nodes[2 * s];
@@ -90,7 +131,15 @@ void SpringForces::reserve(std::size_t spring_capacity, std::size_t node_capacit
   arrays_.rest_m.reserve(spring_capacity);
   arrays_.k.reserve(spring_capacity);
   arrays_.c.reserve(spring_capacity);
-  arrays_.f.reserve(spring_capacity + kPaddingRows);
+  // The padding rows go past the room for springs, where appends never move them: the groups'
+  // padding entries then stay valid, and an edit relists only the groups whose lists grew.
+  if (spring_capacity > padding_row_) {
+    arrays_.f.resize(padding_row_);
+    arrays_.f.resize(spring_capacity, SpringForce{});
+    add_padding_rows(arrays_.f);
+    padding_row_ = spring_capacity;
+    groups_stale_ = true;
+  }
   arrays_.compressed.reserve(spring_capacity);
   incidence_.second_springs.reserve(spring_capacity);
   incidence_.second_first.reserve(node_capacity + 1);
@@ -101,7 +150,10 @@ void SpringForces::reserve(std::size_t spring_capacity, std::size_t node_capacit
     incidence_.group_first.reserve(kSpringSumGroup * spring_capacity);
     incidence_.group_second_first.reserve(node_capacity / kSpringSumGroup + 1);
     incidence_.group_first_first.reserve(node_capacity / kSpringSumGroup + 1);
+    new_group_offsets_.reserve(node_capacity / kSpringSumGroup + 1);
+    group_grew_.reserve(node_capacity / kSpringSumGroup + 1);
   }
+  grown_nodes_.reserve(2 * spring_capacity);
   fill_.reserve(node_capacity + 1);
   listed_per_chunk_.reserve(chunks_covering(spring_capacity, kSpringsPerChunk));
 }
@@ -129,13 +181,19 @@ std::size_t SpringForces::compute(const Vec3* x, const Vec3* v, LoopHelper* help
 }
 
 void SpringForces::append(std::uint32_t i, std::uint32_t j, double rest_m) {
+  const std::size_t s = arrays_.i.size();
   arrays_.i.push_back(i);
   arrays_.j.push_back(j);
   arrays_.rest_m.push_back(rest_m);
   arrays_.k.push_back(0.0);
   arrays_.c.push_back(0.0);
-  arrays_.f.insert(arrays_.f.end() - kPaddingRows, SpringForce{});  // before the padding rows
-  groups_stale_ = true;  // the padding rows' indices moved
+  if (s < padding_row_) {
+    arrays_.f[s] = SpringForce{};
+  } else {  // past the reserved room: the padding rows move up, and every group's padding with them
+    arrays_.f.insert(arrays_.f.end() - kPaddingRows, SpringForce{});
+    padding_row_ = s + 1;
+    groups_stale_ = true;
+  }
   arrays_.compressed.push_back(0);
 }
 
@@ -160,9 +218,28 @@ void SpringForces::rebuild_incidence(std::size_t nodes) {
 }
 
 void SpringForces::refresh_groups() {
-  if (!groups_stale_) return;
-  rebuild_groups();
-  groups_stale_ = false;
+  if (groups_stale_) {
+    rebuild_groups();
+  } else if (!grown_nodes_.empty() || lists_extended_) {
+    regroup_grown_nodes();
+  }
+  groups_stale_ = lists_extended_ = false;
+  grown_nodes_.clear();
+}
+
+void SpringForces::regroup_grown_nodes() {
+  SpringIncidence& in = incidence_;
+  if (!spring_sums_in_groups()) return;  // no groups to keep (rebuild_groups)
+  const std::size_t old_groups = in.group_second_first.size() - 1;
+  group_grew_.assign(std::max(old_groups, (in.first_first.size() - 1) / kSpringSumGroup), 0);
+  for (std::uint32_t n : grown_nodes_) {
+    const std::size_t g = n / kSpringSumGroup;
+    if (g < group_grew_.size()) group_grew_[g] = 1;
+  }
+  const auto plus_zero = static_cast<std::uint32_t>(padding_row_);
+  regroup_grown(in.second_first, [&](std::uint32_t at) { return in.second_springs[at]; }, plus_zero, group_grew_, in.group_second_first, in.group_second,
+                new_group_offsets_);
+  regroup_grown(in.first_first, [](std::uint32_t at) { return at; }, plus_zero + 1, group_grew_, in.group_first_first, in.group_first, new_group_offsets_);
 }
 
 void SpringForces::rebuild_groups() {
@@ -174,7 +251,7 @@ void SpringForces::rebuild_groups() {
     in.group_first.clear();
     return;
   }
-  const auto plus_zero = static_cast<std::uint32_t>(spring_count());
+  const auto plus_zero = static_cast<std::uint32_t>(padding_row_);
   interleave_groups(in.second_first, [&](std::uint32_t at) { return in.second_springs[at]; }, plus_zero, in.group_second_first, in.group_second);
   interleave_groups(in.first_first, [](std::uint32_t at) { return at; }, plus_zero + 1, in.group_first_first, in.group_first);
 }
@@ -190,8 +267,8 @@ void SpringForces::keep(std::span<const std::uint32_t> kept, std::size_t node_co
   compact(arrays_.rest_m);
   compact(arrays_.k);
   compact(arrays_.c);
-  compact(arrays_.f);  // the padding rows are no spring's: put back after
-  add_padding_rows(arrays_.f);
+  // The forces' rows in place: the padding rows stay past the reserved room.
+  for (std::size_t k = 0; k < kept.size(); ++k) arrays_.f[k] = arrays_.f[kept[k]];
   arrays_.compressed.resize(kept.size());
   rebuild_incidence(node_count);
 }
@@ -202,7 +279,7 @@ void SpringForces::add_nodes(std::size_t count) {
     incidence_.first_first.push_back(incidence_.first_first.back());
     incidence_.second_first.push_back(incidence_.second_first.back());
   }
-  groups_stale_ = true;
+  lists_extended_ = true;  // a group completed by new nodes is listed at the next refresh
 }
 
 void SpringForces::add_appended_to_incidence(std::size_t first_new) {
@@ -233,7 +310,15 @@ void SpringForces::add_appended_to_incidence(std::size_t first_new) {
     fill_[n] = static_cast<std::uint32_t>(end + shift);  // where n's appended springs go
   }
   for (std::size_t t = first_new; t < count; ++t) in.second_springs[fill_[arrays_.j[t]]++] = static_cast<std::uint32_t>(t);
-  groups_stale_ = true;
+  // Only the appended springs' nodes' lists grew: their groups are relisted at the next refresh.
+  for (std::size_t t = first_new; t < count && !groups_stale_; ++t) {
+    if (grown_nodes_.size() + 2 > grown_nodes_.capacity()) {
+      groups_stale_ = true;  // past the reserved room: relist every group instead
+      break;
+    }
+    grown_nodes_.push_back(arrays_.i[t]);
+    grown_nodes_.push_back(arrays_.j[t]);
+  }
 }
 
 void SpringForces::add_compression_bounds(const Vec3* x, double* stiffness_bound, std::size_t count) const {

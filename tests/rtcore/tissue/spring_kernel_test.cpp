@@ -98,7 +98,8 @@ TEST(SpringKernel, NodeSumsAddEachSpringOnceWithOppositeSigns) {
 
 TEST(SpringIncidence, AppendedSpringsListedAsARebuildListsThem) {
   // Resection appends nodes, then springs whose node i is newer than any before (refinement's
-  // midpoints); the incremental listing must be exactly the counting sort's, list for list.
+  // midpoints); the incremental listing must be exactly the counting sort's, list for list, and the
+  // interleaved groups, relisted only where lists grew after the first round, exactly a full rebuild's.
   const ProstateTissueModel& model = tissue_model(1296);
   const SpringNetwork network = build_spring_network(model.mesh);
   SpringForces incremental(network), rebuilt(network);
