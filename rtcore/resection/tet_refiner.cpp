@@ -43,8 +43,7 @@ constexpr std::size_t kQualityUpgradesPerMark = 4;
 const double kMaxClosureDihedralCos = std::cos(kMinClosureDihedralDeg * std::numbers::pi / 180.0);
 
 constexpr std::uint32_t kNoNode = 0xffffffffu;
-/// slot_state_ bits: red, waiting in to_judge_, listed in touched_, listed in candidates_ (while
-/// gathering from the topology).
+/// slot_state_ bits: red, waiting in to_judge_, listed in touched_.
 constexpr std::uint8_t kRed = 1, kQueued = 2, kTouched = 4;
 /// slot_verdict_: the split-edge mask last judged (6 bits), whether it is known, and whether green.
 constexpr unsigned kVerdictMask = 0x3Fu, kVerdictKnown = 0x40u, kVerdictGreen = 0x80u;

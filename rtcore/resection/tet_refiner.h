@@ -46,10 +46,10 @@ struct RefinementEdit {
 /// Cost: proportional to the refined region when the view carries the topology (the slots around
 /// each split edge's first node); otherwise one pass over the slots (two when the closure spreads
 /// beyond the marked slots' neighbours, and one more for each further ring), the rest proportional
-/// to the refined region. Per-node and
-/// per-slot scratch is sized at construction (and grows if a mesh outgrows it); per-plan lists are
-/// sized for plans of about a thousand slots and grow once when a plan is larger, then stay: after
-/// the first plans, plan() allocates nothing. The returned edit lives until the next plan().
+/// to the refined region. Per-node and per-slot scratch is sized at construction (and grows if a
+/// mesh outgrows it); per-plan lists are sized for plans of about a thousand slots and grow once when
+/// a plan is larger, then stay: after the first plans, plan() allocates nothing. The returned edit
+/// lives until the next plan().
 class TetRefiner {
  public:
   /// Reserves scratch for meshes up to these sizes so plan() does not allocate in steady use.
