@@ -34,23 +34,24 @@ row() {  # triangles label report.json: one console row
     "$(field "$r" 'r["metrics"]["resected_g"]["total"]')"
 }
 declare -A console_miss headless_miss
-# Each size at the default 960 Hz physics, and 34560 also at 240 Hz (4 physics steps per collision step):
-# where the core cannot hold 960 Hz even headless, both runs miss nearly every deadline and their
-# parity says nothing, so the slower rate, which the core can hold, is measured too.
-for run in 8640:16 34560:16 34560:4; do
-  tri="${run%%:*}" substeps="${run##*:}" key="$run"
+# Each size at the default 960 Hz physics, and 34560 also at 240 Hz (4 physics steps per 60 Hz collision
+# step): where the core cannot hold 960 Hz even headless, both runs miss nearly every deadline and their
+# parity says nothing, so the slower rate, which the core can hold, is measured too. TRIANGLES:SUBSTEPS.
+runs=(8640:16 34560:16 34560:4)
+for run in "${runs[@]}"; do
+  tri="${run%%:*}" substeps="${run##*:}"
   rate=$((60 * substeps))
   xvfb-run -a -s '-screen 0 1920x1200x24' "$bin" console --device emulator --procedure demo --triangles "$tri" --substeps "$substeps" --frames "$frames" \
     --report "$out/console-$tri-$substeps.json" >/dev/null
   r="$out/console-$tri-$substeps.json"
   row "$tri" "console ${rate} Hz ($(field "$r" 'r["renderer"]["view_scale"]')x views)" "$r"
-  console_miss[$key]="$(field "$r" '100*r["core"]["miss_fraction"]')"
+  console_miss[$run]="$(field "$r" '100*r["core"]["miss_fraction"]')"
   seconds="$(field "$r" "round(r['core']['ticks']/$rate.0, 1)")"
   "$bin" run --headless --realtime --procedure demo --triangles "$tri" --substeps "$substeps" --seconds "$seconds" --report "$out/headless-$tri-$substeps.json" >/dev/null
   h="$out/headless-$tri-$substeps.json"
   printf '%-9s %-26s %8s %8s %8s %8s %9s %9s %8.3f %10.2f\n' "$tri" "headless ${rate} Hz" - - - - "$(field "$h" 'r["deadlines"]["ticks"]')" \
     "$(field "$h" 'r["deadlines"]["misses"]')" "$(field "$h" '100*r["deadlines"]["miss_fraction"]')" "$(field "$h" 'r["metrics"]["resected_g"]["total"]')"
-  headless_miss[$key]="$(field "$h" '100*r["deadlines"]["miss_fraction"]')"
+  headless_miss[$run]="$(field "$h" '100*r["deadlines"]["miss_fraction"]')"
 done
 # Frame pacing: every other frame made 100 ms slower on purpose. The console's report splits the
 # core's deadlines by the frame being drawn when they fell due, so the slowed frames' misses stand
@@ -69,7 +70,7 @@ echo "the machine's floor (same schedule, each tick 300 us of busy waiting, 10 s
 "$floor" --benchmark_filter='BM_DeadlineFloor/300/' 2>/dev/null | tail -2 | tee "$out/floor.txt"
 floor_miss="$(awk '$3 == "|" { sub("%", "", $6); print $6; exit }' "$out/floor.txt")"
 echo "parity (the core's miss % with the console open against the headless run's, within the floor's ${floor_miss}%):"
-for key in 8640:16 34560:16 34560:4; do
+for run in "${runs[@]}"; do
   python3 -c "
 import sys
 c, h, f = map(float, sys.argv[3:6])
@@ -78,7 +79,7 @@ if c > 50 and h > 50:
 else:
     verdict = 'within the floor' if abs(c - h) <= f else ('the console run missed more' if c > h else 'the headless run missed more')
 print(f'  {sys.argv[1]:>6} triangles at {sys.argv[2]:>3} Hz: console {c:.3f}%, headless {h:.3f}%, difference {c - h:+.3f} points: {verdict}')
-" "${key%%:*}" "$((60 * ${key##*:}))" "${console_miss[$key]}" "${headless_miss[$key]}" "$floor_miss"
+" "${run%%:*}" "$((60 * ${run##*:}))" "${console_miss[$run]}" "${headless_miss[$run]}" "$floor_miss"
 done
 echo "frame pacing (the core's miss % while the console drew frames slowed by 100 ms against while it drew the others, one run):"
 python3 -c "

@@ -380,11 +380,11 @@ int Resection::refine_near(const SweptVolume& sweep) {
     if (marked_.size() > config_.max_refined_per_step) keep_nearest_the_start(sweep, config_.max_refined_per_step);
     // A plan past the limit is abandoned as soon as it is (its spread is what costs); a single
     // marked tetrahedron is refined whatever its closure takes.
-    const std::size_t limit = config_.max_refined_per_step;
-    const RefinementEdit* plan = &refiner_.plan(view, marked_, marked_.size() > 1 ? limit : kNoLimit);
+    auto plan_marked = [&] { return &refiner_.plan(view, marked_, marked_.size() > 1 ? config_.max_refined_per_step : kNoLimit); };
+    const RefinementEdit* plan = plan_marked();
     while (plan->exceeded) {
       keep_nearest_the_start(sweep, marked_.size() / 2);
-      plan = &refiner_.plan(view, marked_, marked_.size() > 1 ? limit : kNoLimit);
+      plan = plan_marked();
     }
     const RefinementEdit& edit = *plan;
     if (!tissue_->can_edit(edit.new_node_parents.size(), edit.added_tetrahedra.size(), edit.removed_tetrahedra.size())) {

@@ -262,6 +262,22 @@ void TetRefiner::gather_candidates(const TetMeshView& mesh) {
   }
 }
 
+bool TetRefiner::widen_cover(const TetMeshView& mesh, std::size_t first_unsplit) {
+  bool outside = false;
+  for (std::size_t r = first_unsplit; r < red_slots_.size(); ++r) {
+    for (std::uint32_t n : mesh.tetrahedra[red_slots_[r]]) outside |= !node_is_covered_[n];
+  }
+  if (!outside) return false;
+  for (std::size_t c = 0, count = candidates_.size(); c < count; ++c) {
+    for (std::uint32_t n : mesh.tetrahedra[candidates_[c]]) cover(n);
+  }
+  for (std::uint32_t s : red_slots_) {
+    for (std::uint32_t n : mesh.tetrahedra[s]) cover(n);
+  }
+  gather_candidates(mesh);
+  return true;
+}
+
 void TetRefiner::split_edge_in(const TetMeshView& mesh, std::uint32_t s, std::uint32_t a, std::uint32_t b) {
   if (slot_state_[s] & kRed) return;
   const Tetrahedron& tet = mesh.tetrahedra[s];
@@ -364,22 +380,9 @@ const RefinementEdit& TetRefiner::plan(const TetMeshView& mesh, std::span<const 
   // good green closure turns red. The red set only grows, so this ends.
   std::size_t processed = 0;
   while (processed < red_slots_.size()) {
-    bool outside = false;
-    for (std::size_t r = processed; r < red_slots_.size() && !by_topology; ++r) {
-      for (std::uint32_t n : mesh.tetrahedra[red_slots_[r]]) outside |= !node_is_covered_[n];
-    }
     to_judge_.clear();
-    if (outside) {
-      // Rare: widen, then split every red slot's edges again over the larger candidate set.
-      for (std::size_t c = 0, count = candidates_.size(); c < count; ++c) {
-        for (std::uint32_t n : mesh.tetrahedra[candidates_[c]]) cover(n);
-      }
-      for (std::uint32_t s : red_slots_) {
-        for (std::uint32_t n : mesh.tetrahedra[s]) cover(n);
-      }
-      gather_candidates(mesh);
-      processed = 0;
-    }
+    // Rare: widened, every red slot's edges are split again over the larger candidate set.
+    if (!by_topology && widen_cover(mesh, processed)) processed = 0;
     for (; processed < red_slots_.size(); ++processed) split_around(mesh, red_slots_[processed]);
     // Every touched slot ends red or closed, and the touched set only grows: past the limit already,
     // the plan would be too; stop here rather than spread it further.

@@ -69,6 +69,9 @@ class TetRefiner {
   /// Without the topology: lists every live slot touching a covered node (candidates_), and under
   /// each covered node the candidates holding it (incidence_), in one pass over the slots.
   void gather_candidates(const TetMeshView& mesh);
+  /// Without the topology: when a red slot from `first_unsplit` on has a node outside the cover,
+  /// widens the cover by every candidate's nodes (one ring) and gathers again; returns whether it did.
+  bool widen_cover(const TetMeshView& mesh, std::size_t first_unsplit);
   /// Marks the red slot's edges split in every live slot holding them and queues those for judging.
   void split_around(const TetMeshView& mesh, std::uint32_t red_slot);
   /// Marks edge (a, b) split in slot s (unless red) and queues it for judging.

@@ -220,11 +220,16 @@ void SpringForces::rebuild_incidence(std::size_t nodes) {
 void SpringForces::refresh_groups() {
   if (groups_stale_) {
     rebuild_groups();
-  } else if (!grown_nodes_.empty() || lists_extended_) {
+  } else if (!grown_nodes_.empty() || groups_behind_nodes()) {
     regroup_grown_nodes();
   }
-  groups_stale_ = lists_extended_ = false;
+  groups_stale_ = false;
   grown_nodes_.clear();
+}
+
+bool SpringForces::groups_behind_nodes() const {
+  // Nodes added since the groups were listed may have completed a group of four.
+  return spring_sums_in_groups() && incidence_.group_second_first.size() < (incidence_.first_first.size() - 1) / kSpringSumGroup + 1;
 }
 
 void SpringForces::regroup_grown_nodes() {
@@ -274,12 +279,12 @@ void SpringForces::keep(std::span<const std::uint32_t> kept, std::size_t node_co
 }
 
 void SpringForces::add_nodes(std::size_t count) {
-  // A new node holds no spring yet: empty ranges at the end.
+  // A new node holds no spring yet: empty ranges at the end (a group they complete is listed at the
+  // next refresh: groups_behind_nodes).
   for (std::size_t k = 0; k < count; ++k) {
     incidence_.first_first.push_back(incidence_.first_first.back());
     incidence_.second_first.push_back(incidence_.second_first.back());
   }
-  lists_extended_ = true;  // a group completed by new nodes is listed at the next refresh
 }
 
 void SpringForces::add_appended_to_incidence(std::size_t first_new) {

@@ -83,12 +83,13 @@ class SpringForces {
   void rebuild_groups();
   /// Relists only the groups of grown_nodes_ and of nodes added since (the others' blocks move).
   void regroup_grown_nodes();
+  /// Whether nodes added since the groups were listed make a group the lists do not have yet.
+  bool groups_behind_nodes() const;
 
   SpringArrays arrays_;
   SpringIncidence incidence_;
   std::size_t padding_row_ = 0;  // the +0 padding row of arrays_.f (the -0 one follows it)
   bool groups_stale_ = false;    // every group must be relisted (the padding moved, or a recount)
-  bool lists_extended_ = false;  // nodes were added since the groups were listed
   std::vector<std::uint32_t> grown_nodes_;  // nodes whose lists grew since the groups were listed
   std::vector<std::uint8_t> group_grew_;    // scratch of regroup_grown_nodes(): per group
   std::vector<std::uint32_t> new_group_offsets_;  // scratch of regroup_grown_nodes()
