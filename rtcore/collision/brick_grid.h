@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 
 #include "rtcore/geometry/vec3.h"
 
@@ -20,22 +21,25 @@ class BrickGrid {
   BrickGrid() = default;
   /// Cells of side `cell_m` from `lower`, enough to cover `extent` (one more than it needs on each
   /// axis, so the box's upper faces are inside).
-  /// Never more than kMaxCellsPerAxis + 1 a side: a box or cell that is not finite (NaN, infinity)
-  /// gets a single cell rather than an unbounded count.
+  /// Never more than kMaxCellsPerAxis + 1 a side: a box or cell that is not finite (NaN, infinity),
+  /// or a cell with no size, gets a single cell rather than an unbounded count.
   BrickGrid(const Vec3& lower, const Vec3& extent, double cell_m) : lower_(lower), cell_m_(cell_m), inverse_cell_(1.0 / cell_m) {
+    const bool sized = cell_m > 0.0 && std::isfinite(inverse_cell_);
     for (std::size_t a = 0; a < 3; ++a) {
-      const double span = extent[static_cast<int>(a)] * inverse_cell_;
+      const double span = sized ? extent[static_cast<int>(a)] * inverse_cell_ : 0.0;
       dims_[a] = (span >= 0.0 ? static_cast<std::size_t>(std::min(span, kMaxCellsPerAxis)) : 0) + 1;
       bricks_[a] = (dims_[a] + kBrick - 1) / kBrick;
     }
   }
 
   /// The side of cubic cells of which about `cells` fill a box of `extent`. The volume overflows
-  /// to infinity past 1e102 on a side, so then the sides' cube roots are taken apart (the finite
-  /// form is kept as it was: the tool grids' values, and so the golden hashes, depend on it).
+  /// to infinity past 1e102 on a side and underflows to zero (or loses its digits) below 1e-102, so
+  /// then the sides' cube roots are taken apart (the normal form is kept as it was: the tool grids'
+  /// values, and so the golden hashes, depend on it). A zero side came out as a zero cell, and a grid
+  /// of zero cells as 65,537 cells a side: a tool 1e-110 mm across asked for terabytes.
   static double cell_side_for(const Vec3& extent, double cells) {
     const double volume = extent.x * extent.y * extent.z;
-    if (std::isfinite(volume)) return std::cbrt(volume / cells);
+    if (std::isfinite(volume) && volume >= std::numeric_limits<double>::min()) return std::cbrt(volume / cells);
     return std::cbrt(extent.x) * std::cbrt(extent.y) * std::cbrt(extent.z) / std::cbrt(cells);
   }
 

@@ -110,6 +110,16 @@ TEST_F(HostileInput, CollideNeverWritesItsPairsOverAnInput) {
   expect_clean_failure(run_resecto_bounded(collide_args(arg("p.off")) + " --pairs " + arg("missing/pairs.csv")), "does not exist", "missing folder");
 }
 
+TEST_F(HostileInput, CollideWithAToolFarBelowAMillimetreStaysBounded) {
+  // A triangle 1e-110 mm across: its box's volume underflowed to zero, and so did the tool grids'
+  // cells, which then numbered 65,537 a side (terabytes; the run grew past 12 GB before it was killed).
+  for (const char* side : {"1e-110", "5e-324"}) {
+    write_bytes(path("speck.off"), std::string("OFF\n3 1 0\n0 0 0\n") + side + " 0 0\n0 " + side + " 0\n3 0 1 2\n");
+    const CommandOutput run = run_resecto_bounded("collide --tissue " + arg("p.off") + " --tool " + arg("speck.off") + " --poses " + arg("pose.txt"));
+    EXPECT_EQ(run.exit_code, 0) << side << ": " << run.err;
+  }
+}
+
 TEST_F(HostileInput, ProcedureFromADeviceIsRefusedAtOnce) {
   expect_clean_failure(run_resecto_bounded("run --headless --procedure /dev/urandom"), "/dev/urandom: not a regular file", "urandom");
   write_bytes(path("past_travel.txt"), "0 0 0 0 230.0001 0 0 0\n");

@@ -82,5 +82,16 @@ TEST(ToolClearanceGrid, HugeCoordinatesKeepTheCellCountBounded) {
   }
 }
 
+TEST(ToolClearanceGrid, TinyToolsKeepTheCellCountBounded) {
+  // Below 1e-102 a side the box's volume underflowed to zero, and so did the cell side: a grid of
+  // zero cells had 65,537 a side, and `resecto collide` with a tool 1e-110 mm across ran out of memory.
+  for (const double side : {1e-110, 1e-160, 1e-300, 5e-324}) {
+    ToolClearanceGrid grid;
+    grid.build(testing::corner_tetrahedron(side), 4096);
+    EXPECT_LE(grid.cell_count(), 16u * 4096u) << side;
+    EXPECT_GT(grid.cell_count(), 0u) << side;
+  }
+}
+
 }  // namespace
 }  // namespace resecto

@@ -8,6 +8,7 @@
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/geometry/closest_point.h"
 #include "rtcore/collision/tool_proximity_grid.h"
+#include "scene.h"
 
 namespace resecto {
 namespace {
@@ -54,6 +55,16 @@ TEST(ToolProximityGrid, AnEmptyMeshHasNoCandidates) {
   ToolProximityGrid grid;
   grid.build(TriangleMesh{}, 0.0015);
   EXPECT_TRUE(grid.candidates(Vec3(0.0)).empty());
+}
+
+TEST(ToolProximityGrid, ATinyToolKeepsTheCellCountBounded) {
+  // A box whose volume underflows (sides below 1e-102) once gave zero-sized cells and 65,537 a side.
+  for (const double side : {1e-110, 1e-300}) {
+    ToolProximityGrid grid;
+    grid.build(testing::corner_tetrahedron(side), side, 4096);
+    EXPECT_LE(grid.cell_count(), 2u * 4096u) << side;
+    EXPECT_FALSE(grid.candidates(Vec3(0.25 * side)).empty()) << side;
+  }
 }
 
 }  // namespace
