@@ -66,12 +66,17 @@ Result<std::size_t> FaultInjectingTransport::read_report(std::span<std::uint8_t>
   std::size_t length = 0;
   if (deliver_pending(buffer, length)) return length;
 
-  for (;;) {
+  // Dropped and delayed reports are read past within this call, but never past its timeout: with
+  // every report dropped (or held back) the loop would otherwise never return, and the link thread
+  // that called it would never see its stop request (`device monitor --drop 1` hung).
+  const std::int64_t deadline_ns = clock_.now_ns() + std::max<std::int64_t>(timeout_ns, 0);
+  for (bool first = true;; first = false) {
     if (config_.unplug_probability > 0.0 && random_.uniform() < config_.unplug_probability) unplug_now();
     if (!open_) return Error{describe() + ": device unplugged (injected)"};
 
     std::array<std::uint8_t, kMaxRawReportBytes> bytes{};
-    Result<std::size_t> got = inner_.read_report(bytes, timeout_ns);
+    const std::int64_t remaining_ns = deadline_ns - clock_.now_ns();
+    Result<std::size_t> got = first || remaining_ns > 0 ? inner_.read_report(bytes, std::max<std::int64_t>(remaining_ns, 0)) : Result<std::size_t>{0};
     if (!got) return got;
     if (*got == 0) {
       // Silence from the device releases what is held back rather than keeping it forever.
@@ -103,6 +108,12 @@ Result<std::size_t> FaultInjectingTransport::read_report(std::span<std::uint8_t>
       ++injected_.delayed;
       report.release_after = std::max(1, config_.delay_reports);
       pending_.push_back(report);
+      // Held back for later ones that, when every report is delayed, never go out: past a few
+      // reports' worth the oldest goes out now, late, rather than the queue growing without end.
+      if (pending_.size() > kMaxHeldReports) {
+        pending_.front().release_after = 0;
+        if (deliver_pending(buffer, length)) return length;
+      }
       continue;  // this read returns the next report instead
     }
     length = std::min(report.length, buffer.size());

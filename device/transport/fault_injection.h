@@ -87,6 +87,8 @@ class FaultInjectingTransport final : public DeviceTransport {
   FaultConfig config_;
   SplitMix64 random_;
   InjectedFaults injected_;
+  /// Delayed reports held at once, at most: a delay of a few reports, not a growing backlog.
+  static constexpr std::size_t kMaxHeldReports = 16;
   std::deque<HeldReport> pending_;  ///< duplicates and delayed reports waiting their turn
   std::int64_t unplugged_until_ns_ = -1;
   bool open_ = false;

@@ -73,6 +73,14 @@ TEST_F(HostileInput, DeviceMonitorChecksThePathIsAHidrawNode) {
   }
 }
 
+TEST_F(HostileInput, DeviceMonitorEndsOnTimeWhateverIsInjected) {
+  // With every report dropped or delayed, a read never returned and the monitor never ended.
+  for (const std::string faults : {"--drop 1", "--delay 1", "--drop 0.5 --delay 0.5"}) {
+    const CommandOutput run = run_resecto_bounded("device monitor --device emulator --seconds 0.3 --json " + faults);
+    EXPECT_EQ(run.exit_code, 0) << faults << ": " << run.err;
+  }
+}
+
 TEST_F(HostileInput, OffHeadersWithoutUsableCountsAreBoundedErrors) {
   const std::pair<const char*, std::string> cases[] = {
       {"empty_header.off", "OFF"},
