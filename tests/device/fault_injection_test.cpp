@@ -165,24 +165,33 @@ TEST(FaultInjection, SameSeedSameFaults) {
   EXPECT_NE(a.counters.lost * 1000 + a.counters.rejected, c.counters.lost * 1000 + c.counters.rejected);
 }
 
+/// The emulated board behind a fault wrapper that applies `config` to every report, on a virtual clock.
+struct FaultyBoard {
+  explicit FaultyBoard(const FaultConfig& config) : faulty(board, clock, config) { emulator.set_motion(&smooth_motion); }
+  VirtualHostClock clock;
+  firmware::Emulator emulator;
+  EmulatorTransport board{emulator, clock};
+  FaultInjectingTransport faulty;
+};
+
+constexpr std::int64_t kReadTimeoutNs = 20 * kNanosecondsPerMillisecond;
+
 TEST(FaultInjection, EveryReportDroppedStillEndsEachReadAtItsTimeout) {
   // A read skipped dropped reports until one came through: with every one dropped it never returned,
   // and `device monitor --drop 1` hung, its link thread never seeing the stop request.
-  VirtualHostClock clock;
-  firmware::Emulator emulator;
-  EmulatorTransport board(emulator, clock);
   FaultConfig config;
   config.drop_probability = 1.0;
-  FaultInjectingTransport faulty(board, clock, config);
+  FaultyBoard setup(config);
+  VirtualHostClock& clock = setup.clock;
+  FaultInjectingTransport& faulty = setup.faulty;
   ASSERT_TRUE(faulty.open());
   std::array<std::uint8_t, kMaxRawReportBytes> buffer{};
-  constexpr std::int64_t kTimeoutNs = 20 * kNanosecondsPerMillisecond;
   for (int read = 0; read < 5; ++read) {
     const std::int64_t start_ns = clock.now_ns();
-    const Result<std::size_t> got = faulty.read_report(buffer, kTimeoutNs);
+    const Result<std::size_t> got = faulty.read_report(buffer, kReadTimeoutNs);
     ASSERT_TRUE(got);
     EXPECT_EQ(*got, 0u) << "nothing gets through";
-    EXPECT_LE(clock.now_ns() - start_ns, kTimeoutNs + kNanosecondsPerMillisecond) << "read " << read;
+    EXPECT_LE(clock.now_ns() - start_ns, kReadTimeoutNs + kNanosecondsPerMillisecond) << "read " << read;
   }
   EXPECT_GT(faulty.injected().dropped, 50u);
 }
@@ -190,22 +199,19 @@ TEST(FaultInjection, EveryReportDroppedStillEndsEachReadAtItsTimeout) {
 TEST(FaultInjection, EveryReportDelayedStillFlowsInOrderWithABoundedBacklog) {
   // Held back until later reports went out, which never happened when all were held: the reads never
   // returned and the queue grew without end. Now they come out late, each once, in the board's order.
-  VirtualHostClock clock;
-  firmware::Emulator emulator;
-  emulator.set_motion(&testing::smooth_motion);
-  EmulatorTransport board(emulator, clock);
   FaultConfig config;
   config.delay_probability = 1.0;
-  FaultInjectingTransport faulty(board, clock, config);
+  FaultyBoard setup(config);
+  VirtualHostClock& clock = setup.clock;
+  FaultInjectingTransport& faulty = setup.faulty;
   ASSERT_TRUE(faulty.open());
   std::array<std::uint8_t, kMaxRawReportBytes> buffer{};
-  constexpr std::int64_t kTimeoutNs = 20 * kNanosecondsPerMillisecond;
   int delivered = 0;
   for (int read = 0; read < 200; ++read) {
     const std::int64_t start_ns = clock.now_ns();
-    const Result<std::size_t> got = faulty.read_report(buffer, kTimeoutNs);
+    const Result<std::size_t> got = faulty.read_report(buffer, kReadTimeoutNs);
     ASSERT_TRUE(got);
-    EXPECT_LE(clock.now_ns() - start_ns, kTimeoutNs + kNanosecondsPerMillisecond) << "read " << read;
+    EXPECT_LE(clock.now_ns() - start_ns, kReadTimeoutNs + kNanosecondsPerMillisecond) << "read " << read;
     if (*got > 0) ++delivered;
   }
   EXPECT_GT(delivered, 150) << "most reads deliver a report, late";
