@@ -5,10 +5,14 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <filesystem>
 #include <limits>
 #include <string>
 
 #include <CLI/CLI.hpp>
+
+#include "rtcore/scenes/procedure.h"
+#include "rtcore/tissue/tissue_parameters.h"
 
 #include "rtcore/base/checked_number.h"
 
@@ -78,6 +82,48 @@ inline CLI::Validator unsigned_64() {
         return std::string();
       },
       "UINT64");
+}
+
+/// Accepts a path that exists; a missing input is a command line that cannot be run (exit 2). What
+/// it is (a folder, a device, a file of the wrong kind) the command that reads it says, in its words.
+inline CLI::Validator existing_path() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::error_code error;
+        return std::filesystem::exists(text, error) ? std::string() : text + ": no such file";
+      },
+      "FILE");
+}
+
+/// Accepts a built-in procedure's name or the path of a file that exists: a name that is neither is a
+/// command line that cannot be run (exit 2), like any other missing input; what the file holds is
+/// checked when it is read.
+inline CLI::Validator procedure_name_or_file() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        if (text.find('/') == std::string::npos && text.find('.') == std::string::npos) {
+          const Result<Procedure> builtin = builtin_procedure(text);
+          return builtin ? std::string() : builtin.error();
+        }
+        std::error_code error;
+        if (!std::filesystem::exists(text, error)) return text + ": no such file (and not a built-in procedure)";
+        return std::string();
+      },
+      "NAME|FILE");
+}
+
+/// Accepts KEY=VALUE for a live parameter in its range (`resecto params`).
+inline CLI::Validator parameter_assignment() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        TissueParameters parameters;
+        const Status set = parameters.set_from_assignment(text);
+        if (set) return std::string();
+        // CLI11 names the option itself.
+        const std::string repeated = "--set " + text + ": ";
+        return set.error().starts_with(repeated) ? set.error().substr(repeated.size()) : set.error();
+      },
+      "KEY=VALUE");
 }
 
 }  // namespace resecto::cli

@@ -15,7 +15,7 @@ namespace resecto::cli {
 
 void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_run) {
   if (!shared_with_run) {
-    cmd.add_option("--procedure", o.procedure, "Built-in procedure (demo) or a procedure file the emulated device follows")->capture_default_str();
+    cmd.add_option("--procedure", o.procedure, "Built-in procedure (demo, turp) or a procedure file the emulated device follows")->check(procedure_name_or_file())->capture_default_str();
     cmd.add_option("--triangles", o.triangles, "Prostate surface triangles")->check(CLI::Range(200, 1000000))->capture_default_str();
     cmd.add_option("--report", o.report, "Write the session's JSON report here when the console closes");
     add_parameter_option(cmd, o.sets);
@@ -27,7 +27,7 @@ void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_r
         ->check(CLI::Range(1, 2))
         ->capture_default_str();
     cmd.add_option("--seed", o.seed, "Seed of the emulated sensors' noise")->check(unsigned_64())->capture_default_str();
-    cmd.add_option("--calibration", o.calibration, "Device calibration file (default: the reference device's)");
+    cmd.add_option("--calibration", o.calibration, "Device calibration file (default: the reference device's)")->check(existing_path());
   }
   cmd.add_option("--device", o.device,
                  "emulator: the emulated board follows the procedure; keyboard: you drive it (keys, mouse, gamepad, sliders); "
@@ -35,9 +35,9 @@ void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_r
       ->check(CLI::IsMember({"emulator", "keyboard", "hid"}))
       ->capture_default_str();
   cmd.add_option("--preset", o.preset, "Tissue parameter preset (JSON) to start from");
-  cmd.add_option("--replay", o.replay, "Open this recording in the replay panel and show it in the views");
+  cmd.add_option("--replay", o.replay, "Open this recording in the replay panel and show it in the views")->check(existing_path());
   if (!shared_with_run) cmd.add_option("--record", o.record, "Record the session from its first tick to this file (replayable and verifiable)");
-  cmd.add_option("--actions", o.actions, "Scripted UI actions, one 'frame N VERB ...' per line (docs/commands.md, \"Operator console\")");
+  cmd.add_option("--actions", o.actions, "Scripted UI actions, one 'frame N VERB ...' per line (docs/commands.md, \"Operator console\")")->check(existing_path());
   CLI::Option* frames = cmd.add_option("--frames", o.frames, "Quit after this many frames")->check(CLI::Range(1, 100000000));
   cmd.add_option("--screenshot", o.screenshot, "Write a PNG of the whole window after the last of --frames")->needs(frames);
   cmd.add_flag("--lockstep", o.lockstep,

@@ -127,7 +127,7 @@ void register_resectoscope(CLI::App& mesh) {
 void register_check(CLI::App& mesh) {
   auto path = std::make_shared<std::string>();
   CLI::App* cmd = mesh.add_subcommand("check", "Validate a surface: closed, manifold, oriented outward, no degenerate or crossing faces");
-  cmd->add_option("file", *path, "Mesh file (.off, .obj, .ply, .stl), millimetres")->required();
+  cmd->add_option("file", *path, "Mesh file (.off, .obj, .ply, .stl), millimetres")->required()->check(existing_path());
   cmd->callback([path] {
     Result<TriangleMesh> mesh = read_surface_mesh(*path);
     if (!mesh) fail(mesh.error());
@@ -149,7 +149,7 @@ void register_tetra(CLI::App& mesh) {
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = mesh.add_subcommand("tetra", "Fill a closed surface with tetrahedra (TetGen), labelled capsule or adenoma");
-  cmd->add_option("input", options->input, "Closed surface (.off, .obj, .ply, .stl), millimetres")->required();
+  cmd->add_option("input", options->input, "Closed surface (.off, .obj, .ply, .stl), millimetres")->required()->check(existing_path());
   cmd->add_option("-o,--output", options->output, "Tetrahedral mesh, legacy VTK (.vtk), millimetres")->required();
   CLI::Option* radius_edge = cmd->add_option("--radius-edge", options->radius_edge, "Largest radius-edge ratio TetGen may leave (-q); too tight for the surface is an error after a bounded refinement")
       ->check(finite_range(1.0, 10.0))->capture_default_str();

@@ -3,10 +3,13 @@
 
 #include <stdexcept>
 
+#include "console/commands/checked_options.h"
+
 namespace resecto::cli {
 
 void add_parameter_option(CLI::App& command, std::vector<std::string>& assignments) {
   command.add_option("--set", assignments, "Set a live parameter, KEY=VALUE in the units of `resecto params` (repeatable)")
+      ->check(parameter_assignment())
       ->type_name("KEY=VALUE")
       ->allow_extra_args(false);
 }

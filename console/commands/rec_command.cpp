@@ -190,24 +190,24 @@ void register_rec(CLI::App& app) {
 
   auto info_options = std::make_shared<InfoOptions>();
   CLI::App* info_cmd = family.add_subcommand("info", "Duration, ticks, chunks and bytes by type, keyframes, index, damage");
-  info_cmd->add_option("FILE", info_options->file, "Recording")->required();
+  info_cmd->add_option("FILE", info_options->file, "Recording")->required()->check(existing_path());
   info_cmd->add_flag("--json", info_options->json, "Print JSON (duration_s, ticks, chunks, keyframes, bytes, damaged_chunks, index_present)");
   info_cmd->callback([info_options] { info(*info_options); });
 
   auto verify_file = std::make_shared<std::string>();
   CLI::App* verify_cmd = family.add_subcommand("verify", "Check every chunk's CRC; exit 1 naming each damaged chunk and its byte offset");
-  verify_cmd->add_option("FILE", *verify_file, "Recording")->required();
+  verify_cmd->add_option("FILE", *verify_file, "Recording")->required()->check(existing_path());
   verify_cmd->callback([verify_file] { verify(*verify_file); });
 
   auto recover_files = std::make_shared<std::pair<std::string, std::string>>();
   CLI::App* recover_cmd = family.add_subcommand("recover", "Write a complete file (index rebuilt) from every intact chunk of IN");
-  recover_cmd->add_option("IN", recover_files->first, "Damaged, cut or killed recording")->required();
+  recover_cmd->add_option("IN", recover_files->first, "Damaged, cut or killed recording")->required()->check(existing_path());
   recover_cmd->add_option("OUT", recover_files->second, "Recovered recording")->required();
   recover_cmd->callback([recover_files] { recover(recover_files->first, recover_files->second); });
 
   auto export_options = std::make_shared<ExportOptions>();
   CLI::App* export_cmd = family.add_subcommand("export", "A keyframe's surface (.drc .ply .obj .off .stl) or the per-tick inputs (.csv)");
-  export_cmd->add_option("FILE", export_options->file, "Recording")->required();
+  export_cmd->add_option("FILE", export_options->file, "Recording")->required()->check(existing_path());
   export_cmd->add_option("--keyframe", export_options->keyframe, "Keyframe number (0-based)")->check(index_up_to(std::numeric_limits<int>::max()));
   export_cmd->add_option("--time", export_options->time_s, "The last keyframe at or before this simulated time, seconds")->check(finite_at_least(0.0));
   export_cmd->add_flag("--inputs", export_options->inputs, "Export the per-tick inputs as CSV instead");

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "console/commands/checked_options.h"
 #include "console/commands/command_registry.h"
 #include "console/headless/headless_run.h"
 #include "recordings/replay.h"
@@ -94,7 +95,7 @@ void replay(const ReplayOptions& o) {
 void register_replay(CLI::App& app) {
   auto o = std::make_shared<ReplayOptions>();
   CLI::App* cmd = app.add_subcommand("replay", "Re-simulate a recording through the core; --verify compares every collision step's hash");
-  cmd->add_option("FILE", o->file, "Recording (from `run --record`)")->required();
+  cmd->add_option("FILE", o->file, "Recording (from `run --record`)")->required()->check(existing_path());
   cmd->add_flag("--verify", o->verify, "Compare the state hash at every collision step; exit 1 naming the first tick that differs");
   cmd->add_flag("--json", o->json, "Print ticks, verified_hashes, mismatches, state_hash as JSON");
   cmd->callback([o] { replay(*o); });

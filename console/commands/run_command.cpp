@@ -121,7 +121,7 @@ void register_run(CLI::App& app) {
   auto o = std::make_shared<RunOptions>();
   CLI::App* cmd = app.add_subcommand("run", "Run the simulator: the operator console, or with --headless a scripted procedure and its report");
   cmd->add_flag("--headless", o->headless, "No display: drive the core with a procedure and report");
-  cmd->add_option("--procedure", o->procedure, "Built-in procedure (demo, turp) or a procedure file")->capture_default_str();
+  cmd->add_option("--procedure", o->procedure, "Built-in procedure (demo, turp) or a procedure file")->check(procedure_name_or_file())->capture_default_str();
   cmd->add_option("--seconds", o->seconds, "Simulated seconds (default: the procedure's length)")->check(positive_up_to(86400.0));
   cmd->add_flag("--realtime", o->realtime, "Real time: the device link on its own thread, ticks at their deadlines");
   cmd->add_option("--report", o->report, "Write the JSON report here");
@@ -151,7 +151,7 @@ void register_run(CLI::App& app) {
   cmd->add_option("--spin-us", o->spin_us, "Real time: spin this long before each tick instead of sleeping")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
-  cmd->add_option("--calibration", o->calibration, "Device calibration file (default: the reference device's)");
+  cmd->add_option("--calibration", o->calibration, "Device calibration file (default: the reference device's)")->check(existing_path());
   cmd->add_option("--seed", o->seed, "Seed of the emulated sensors' noise")->check(unsigned_64())->capture_default_str();
   cmd->add_flag("--json", o->json, "Print the JSON report instead of the summary");
   add_console_options(*cmd, o->console, true);

@@ -81,6 +81,34 @@ TEST_F(HostileInput, DeviceMonitorEndsOnTimeWhateverIsInjected) {
   }
 }
 
+TEST_F(HostileInput, MissingInputsAndUnknownNamesAreUsageErrors) {
+  // docs/commands.md: exit 2 for a command line that cannot be run, before anything runs; most of
+  // these exited 1 after the command had started.
+  const std::string missing = arg("missing.file");
+  const std::pair<std::string, std::string> cases[] = {
+      {"mesh check " + missing, "no such file"},
+      {"mesh tetra " + missing + " -o " + arg("t.vtk"), "no such file"},
+      {"rec info " + missing, "no such file"},
+      {"rec verify " + missing, "no such file"},
+      {"rec recover " + missing + " " + arg("out.rsrec"), "no such file"},
+      {"rec export " + missing + " -o " + arg("out.off"), "no such file"},
+      {"replay " + missing, "no such file"},
+      {"run --headless --procedure " + missing, "no such file"},
+      {"run --headless --procedure nosuchname", "no built-in procedure 'nosuchname'"},
+      {"run --headless --calibration " + missing, "no such file"},
+      {"run --headless --set stiffness=-5", "stiffness = -5 is out of range"},
+      {"run --headless --set nonsense=1", "unknown parameter 'nonsense'"},
+      {"console --replay " + missing, "no such file"},
+  };
+  for (const auto& [args, expected] : cases) {
+    const CommandOutput run = run_resecto_bounded(args);
+    EXPECT_EQ(run.exit_code, 2) << args << ": " << run.err;
+    expect_clean_failure(run, expected, args);
+  }
+  EXPECT_FALSE(std::filesystem::exists(path("t.vtk")));
+  EXPECT_FALSE(std::filesystem::exists(path("out.rsrec")));
+}
+
 TEST_F(HostileInput, OffHeadersWithoutUsableCountsAreBoundedErrors) {
   const std::pair<const char*, std::string> cases[] = {
       {"empty_header.off", "OFF"},
