@@ -99,8 +99,19 @@ std::vector<std::string_view> split_words(std::string_view line, bool hash_comme
 
 std::string quoted(std::string_view word) {
   // Appended, not `"'" + std::string(...)`: GCC 12 at -O3 warns falsely (-Wrestrict) on that form.
+  // A control byte is written as \xNN: a NUL in the word cut the printed message short at it.
   std::string text = "'";
-  text.append(word.substr(0, 24));
+  for (const char c : word.substr(0, 24)) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x20 && byte != 0x7f) {
+      text.push_back(c);
+      continue;
+    }
+    constexpr char kHex[] = "0123456789abcdef";
+    text += "\\x";
+    text.push_back(kHex[byte >> 4]);
+    text.push_back(kHex[byte & 15]);
+  }
   text += word.size() > 24 ? "...'" : "'";
   return text;
 }
@@ -258,7 +269,8 @@ Result<RawMesh> parse_off(std::string_view text, const std::string& name) {
     }
     for (std::size_t c = 1; c <= n; ++c) {
       const std::optional<std::int64_t> index = parse_integer(words[c]);
-      if (!index || *index < 0 || static_cast<std::uint64_t>(*index) >= vertex_count) {
+      if (!index) return lines.error_at(words[c], "face " + std::to_string(raw.face_count()) + ": vertex index " + quoted(words[c]) + " is not a whole number");
+      if (*index < 0 || static_cast<std::uint64_t>(*index) >= vertex_count) {
         return lines.error_at(words[c], "face " + std::to_string(raw.face_count()) + ": vertex index " + quoted(words[c]) +
                                             " is not in [0, " + std::to_string(vertex_count) + ")");
       }
@@ -278,6 +290,19 @@ Result<RawMesh> parse_off(std::string_view text, const std::string& name) {
 
 // ---- OBJ ----
 
+/// What follows a face corner's vertex index: nothing, "/vt", "//vn" or "/vt/vn", each an integer.
+/// The texture and normal indices are not used, but a corner such as "1/x/3" is no corner at all.
+bool texture_and_normal_indices_well_formed(std::string_view rest) {
+  if (rest.empty()) return true;
+  if (rest.front() != '/') return false;
+  rest.remove_prefix(1);
+  const std::size_t slash = rest.find('/');
+  const std::string_view texture = rest.substr(0, slash);
+  if (slash == std::string_view::npos) return parse_integer(texture).has_value();  // v/vt
+  const std::string_view normal = rest.substr(slash + 1);
+  return (texture.empty() || parse_integer(texture).has_value()) && parse_integer(normal).has_value();
+}
+
 Result<RawMesh> parse_obj(std::string_view text, const std::string& name) {
   // Statements a surface does not need; anything else unknown is an error, not silently skipped.
   static constexpr std::string_view kIgnored[] = {"vt", "vn", "vp", "g", "o", "s", "usemtl", "mtllib", "l", "p", "lod", "shadow_obj", "trace_obj", "mg"};
@@ -291,7 +316,10 @@ Result<RawMesh> parse_obj(std::string_view text, const std::string& name) {
     if (words.empty()) continue;
     const std::string_view keyword = words[0];
     if (keyword == "v") {
-      if (words.size() < 4 || words.size() > 8) return lines.error("a vertex needs x y z (optionally w, or r g b), found " + std::to_string(words.size() - 1) + " numbers");
+      // x y z, then w, or r g b (some writers put both): five numbers is none of these.
+      if (words.size() < 4 || words.size() > 8 || words.size() == 6) {
+        return lines.error("a vertex needs x y z (optionally w, or r g b), found " + std::to_string(words.size() - 1) + " numbers");
+      }
       if (raw.points.size() == kMaxMeshVertices) return lines.error("more than " + std::to_string(kMaxMeshVertices) + " vertices");
       double xyz[3];
       for (std::size_t i = 1; i < words.size(); ++i) {
@@ -307,7 +335,9 @@ Result<RawMesh> parse_obj(std::string_view text, const std::string& name) {
       for (std::size_t c = 1; c < words.size(); ++c) {
         const std::string_view corner = words[c].substr(0, words[c].find('/'));  // "v", "v/vt", "v//vn", "v/vt/vn"
         const std::optional<std::int64_t> index = parse_integer(corner);
-        if (!index) return lines.error_at(words[c], "corner " + quoted(words[c]) + " is not a vertex index");
+        if (!index || !texture_and_normal_indices_well_formed(words[c].substr(corner.size()))) {
+          return lines.error_at(words[c], "corner " + quoted(words[c]) + " is not a vertex index (v, v/vt, v//vn or v/vt/vn)");
+        }
         // OBJ counts from 1; a negative index counts back from the latest vertex.
         const std::int64_t resolved = *index > 0 ? *index - 1 : static_cast<std::int64_t>(raw.points.size()) + *index;
         if (*index == 0 || resolved < 0 || resolved >= static_cast<std::int64_t>(kMaxMeshVertices)) {
@@ -411,6 +441,19 @@ class PlyBody {
       case PlyType::float64: { double v; std::memcpy(&v, bytes, 8); return v; }
     }
     return 0.0;
+  }
+
+  /// ASCII: a row is one line, so after its last property only spaces may stand before the line's
+  /// end. Read as one stream of words, a row with a value too many shifted every later one, and
+  /// the error named some later face instead of this row.
+  Status expect_row_end(const std::string& row, std::size_t properties) {
+    if (!ascii()) return Ok{};
+    while (offset_ < body_.size() && (body_[offset_] == ' ' || body_[offset_] == '\t' || body_[offset_] == '\r')) ++offset_;
+    if (offset_ >= body_.size() || body_[offset_] == '\n') return Ok{};
+    std::size_t end = offset_;
+    while (end < body_.size() && !is_space(body_[end])) ++end;
+    return Error{name_ + ": byte " + std::to_string(body_offset_ + offset_) + ": " + row + " has a value past its " + std::to_string(properties) +
+                 (properties == 1 ? " property: " : " properties: ") + quoted(body_.substr(offset_, end - offset_)) + " (an ASCII row is one line)"};
   }
 
   /// Nothing but whitespace (ASCII) or nothing at all (binary) may follow the last element.
@@ -575,6 +618,9 @@ Result<RawMesh> parse_ply(std::string_view text, const std::string& name) {
         }
         if (corners) raw.end_face();
       }
+      if (Status row_end = body.expect_row_end(std::string(element.name) + " " + std::to_string(row), element.properties.size()); !row_end) {
+        return Error{row_end.error()};
+      }
       if (is_vertex) raw.points.push_back(Vec3(xyz[0], xyz[1], xyz[2]));
     }
   }
@@ -703,8 +749,11 @@ Result<RawMesh> parse_stl(std::string_view bytes, const std::string& name) {
     const std::uint32_t declared = little_endian_u32(bytes, 80);
     if (84 + 50 * std::uint64_t{declared} == bytes.size()) return parse_binary_stl(bytes, name);
   }
-  const std::size_t first = bytes.find_first_not_of(" \t\r\n");
-  if (first != std::string_view::npos && bytes.substr(first, 5) == "solid") return parse_ascii_stl(bytes, name);
+  // An editor may put a UTF-8 byte-order mark before "solid" (the other formats' readers drop it
+  // earlier; a binary STL's header may begin with those bytes, so here only ahead of the text).
+  const std::string_view text = bytes.starts_with("\xEF\xBB\xBF") ? bytes.substr(3) : bytes;
+  const std::size_t first = text.find_first_not_of(" \t\r\n");
+  if (first != std::string_view::npos && text.substr(first, 5) == "solid") return parse_ascii_stl(text, name);
   if (bytes.size() >= 84) return parse_binary_stl(bytes, name);
   return Error{name + ": neither ASCII STL (no 'solid') nor binary STL (" + std::to_string(bytes.size()) + " bytes, under the 84-byte header)"};
 }

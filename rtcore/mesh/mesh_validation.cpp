@@ -5,9 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <numbers>
 #include <numeric>
-#include <tuple>
+#include <span>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "rtcore/base/units.h"
@@ -223,6 +226,39 @@ Status check_self_intersections(const TriangleMesh& mesh) {
   return Ok{};
 }
 
+/// The winding number of the closed surface made of `faces` around p: 1 inside an outward shell,
+/// 0 outside (the sum of the faces' solid angles over 4 pi, Van Oosterom and Strackee's formula).
+double winding_number(const TriangleMesh& mesh, std::span<const std::uint32_t> faces, const Vec3& p) {
+  double solid_angle = 0.0;
+  for (const std::uint32_t f : faces) {
+    const Triangle& t = mesh.triangles[f];
+    const Vec3 a = mesh.positions[t[0]] - p, b = mesh.positions[t[1]] - p, c = mesh.positions[t[2]] - p;
+    const double la = length(a), lb = length(b), lc = length(c);
+    const double numerator = dot(a, cross(b, c));
+    const double denominator = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+    solid_angle += 2.0 * std::atan2(numerator, denominator);
+  }
+  return solid_angle / (4.0 * std::numbers::pi);
+}
+
+/// Several closed shells are several solids side by side; one inside another would be read as two
+/// solids overlapping (its volume counted twice, and lost when tetrahedralized), and a cavity,
+/// wound inward, is refused with the orientation. So no shell may lie inside another.
+Status check_no_nested_shells(const TriangleMesh& mesh, DisjointSets& components, const std::vector<std::uint32_t>& component_first_face) {
+  std::map<std::uint32_t, std::vector<std::uint32_t>> shells;  // by component root, in order: the same report every run
+  for (std::uint32_t f = 0; f < mesh.triangle_count(); ++f) shells[components.find(mesh.triangles[f][0])].push_back(f);
+  for (const auto& [inner_root, inner_faces] : shells) {
+    // The shells do not intersect (checked before), so one vertex tells where the whole shell is.
+    const Vec3& probe = mesh.positions[mesh.triangles[inner_faces.front()][0]];
+    for (const auto& [outer_root, outer_faces] : shells) {
+      if (outer_root == inner_root || winding_number(mesh, outer_faces, probe) < 0.5) continue;
+      return Error{"nested shells: the component containing " + face_name(component_first_face[inner_root]) + " lies inside the component containing " +
+                   face_name(component_first_face[outer_root]) + "; a solid with a cavity is not read (each component must be a solid of its own, outside the others)"};
+    }
+  }
+  return Ok{};
+}
+
 }  // namespace
 
 Result<SurfaceReport> validate_closed_surface(const TriangleMesh& mesh, const ValidationOptions& options) {
@@ -286,6 +322,9 @@ Result<SurfaceReport> validate_closed_surface(const TriangleMesh& mesh, const Va
   }
   if (options.check_self_intersections) {
     if (Status s = check_self_intersections(mesh); !s) return Error{s.error()};
+  }
+  if (report.components > 1) {
+    if (Status s = check_no_nested_shells(mesh, components, component_first_face); !s) return Error{s.error()};
   }
   return report;
 }

@@ -176,6 +176,79 @@ TEST(MeshFiles, BadIndexAndBadFilesAreNamed) {
   EXPECT_NE(validation_error(write_file("mesh.xyz", "1 2 3\n")).find("unsupported"), std::string::npos);
 }
 
+TEST(MeshFiles, MalformedWordsAreNamedForWhatTheyAre) {
+  // Each once gave a wrong or cut-off message, or was read silently.
+  const std::string cube = cube_off();
+  std::string with_nul = cube;
+  with_nul.insert(with_nul.find("1 1 1\n") + 5, std::string(1, '\0'));
+  EXPECT_NE(validation_error(write_file("nul.off", with_nul)).find("'1\\x00' is not a finite number"), std::string::npos) << "the NUL printed, not cutting the message";
+  std::string fractional = cube;
+  fractional.replace(fractional.find("3 1 6 5"), 7, "3 1 6.0 5");
+  EXPECT_NE(validation_error(write_file("fraction.off", fractional)).find("vertex index '6.0' is not a whole number"), std::string::npos);
+  std::string obj;
+  for (const char* v : {"0 0 0", "1 0 0", "1 1 0", "0 1 0", "0 0 1", "1 0 1", "1 1 1", "0 1 1"}) obj += std::string("v ") + v + "\n";
+  for (const auto& t : kCubeFaces) obj += "f " + std::to_string(t[0] + 1) + " " + std::to_string(t[1] + 1) + " " + std::to_string(t[2] + 1) + "\n";
+  for (const char* corner : {"1/x/3", "1/2/3/4", "1/", "1//"}) {
+    std::string bad = obj;
+    bad.replace(bad.find("f 1 3 2"), 7, std::string("f ") + corner + " 3 2");
+    EXPECT_NE(validation_error(write_file("corner.obj", bad)).find("is not a vertex index (v, v/vt, v//vn or v/vt/vn)"), std::string::npos) << corner;
+  }
+  std::string forms = obj;
+  forms.replace(forms.find("f 1 3 2"), 7, "f 1/1/1 3//2 2/5");
+  EXPECT_EQ(validation_error(write_file("forms.obj", forms)), "");
+  std::string five = obj;
+  five.replace(0, 7, "v 0 0 0 1 1");
+  EXPECT_NE(validation_error(write_file("five.obj", five)).find("found 5 numbers"), std::string::npos);
+  std::string ply = "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\nelement face 12\n"
+                    "property list uchar int vertex_indices\nend_header\n";
+  for (const char* v : {"0 0 0", "1 0 0", "1 1 0", "0 1 0", "0 0 1", "1 0 1", "1 1 1", "0 1 1"}) ply += std::string(v) + " 7\n";
+  for (const auto& t : kCubeFaces) ply += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + "\n";
+  EXPECT_NE(validation_error(write_file("extra.ply", ply)).find("vertex 0 has a value past its 3 properties: '7'"), std::string::npos);
+}
+
+TEST(MeshFiles, AsciiStlMayStartWithAByteOrderMark) {
+  std::string stl = "solid cube\n";
+  const Vec3 corners[8] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  for (const auto& t : kCubeFaces) {
+    stl += "facet normal 0 0 0\nouter loop\n";
+    for (const int v : t) stl += "vertex " + std::to_string(corners[v].x) + " " + std::to_string(corners[v].y) + " " + std::to_string(corners[v].z) + "\n";
+    stl += "endloop\nendfacet\n";
+  }
+  stl += "endsolid cube\n";
+  EXPECT_EQ(validation_error(write_file("bom.stl", "\xEF\xBB\xBF" + stl)), "");
+}
+
+/// Two outward unit-cube shells in one OFF file, the second scaled by `scale` and moved by `offset`.
+std::string two_cubes_off(double scale, double offset) {
+  const double corners[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  std::string text = "OFF\n16 24 0\n";
+  for (int shell = 0; shell < 2; ++shell) {
+    for (const auto& c : corners) {
+      for (const double x : c) text += std::to_string(shell == 0 ? x : offset + scale * x) + " ";
+      text += "\n";
+    }
+  }
+  for (int shell = 0; shell < 2; ++shell) {
+    for (const auto& t : kCubeFaces) {
+      text += "3 " + std::to_string(t[0] + 8 * shell) + " " + std::to_string(t[1] + 8 * shell) + " " + std::to_string(t[2] + 8 * shell) + "\n";
+    }
+  }
+  return text;
+}
+
+TEST(MeshFiles, AShellInsideAnotherIsRefusedAndShellsSideBySideAreRead) {
+  // One outward shell inside another was read as valid with its volume counted twice, and
+  // tetrahedralizing it then lost that volume without a word.
+  const std::string nested = validation_error(write_file("nested.off", two_cubes_off(0.2, 0.4)));
+  EXPECT_NE(nested.find("nested shells: the component containing face 12 lies inside the component containing face 0"), std::string::npos) << nested;
+  Result<TriangleMesh> apart = read_surface_mesh(write_file("apart.off", two_cubes_off(0.5, 2.0)));
+  ASSERT_TRUE(apart) << apart.error();
+  Result<SurfaceReport> report = validate_closed_surface(*apart);
+  ASSERT_TRUE(report) << report.error();
+  EXPECT_EQ(report->components, 2);
+  EXPECT_NEAR(report->volume_m3, (1.0 + 0.125) * 1e-9, 1e-21);
+}
+
 TEST(MeshFiles, WriteThenReadRoundTripsEveryFormat) {
   Result<TriangleMesh> cube = read_surface_mesh(write_file("rt.off", cube_off()));
   ASSERT_TRUE(cube);
