@@ -2,6 +2,7 @@
 #include "recordings/chunk_format.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 
 #include <zlib.h>
@@ -68,6 +69,19 @@ void append_chunk(std::vector<std::uint8_t>& out, ChunkType type, std::uint32_t 
   w.put(crc32_of(std::span<const std::uint8_t>(out.data() + frame_at, 16)));
   w.put_bytes(payload);
   w.put(crc32_of(payload));
+}
+
+std::string describe(const DamagedRange& range) {
+  char text[256];
+  if (range.frame_intact) {
+    std::snprintf(text, sizeof text, "%s chunk %u at byte %llu (%llu bytes): payload CRC mismatch",
+                  std::string(chunk_type_name(range.type)).c_str(), range.sequence, static_cast<unsigned long long>(range.offset),
+                  static_cast<unsigned long long>(range.bytes));
+  } else {
+    std::snprintf(text, sizeof text, "%llu bytes at byte %llu hold no intact chunk (a damaged frame, or a chunk cut off)",
+                  static_cast<unsigned long long>(range.bytes), static_cast<unsigned long long>(range.offset));
+  }
+  return text;
 }
 
 ChunkScan scan_chunks(std::span<const std::uint8_t> file) {

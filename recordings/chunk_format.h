@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -69,6 +70,10 @@ struct DamagedRange {
   std::uint32_t sequence = 0;
   bool frame_intact = false;
 };
+
+/// One line saying what a damaged range is and where ("keyframe chunk 80 at byte 223687 (3601 bytes):
+/// payload CRC mismatch"), as `rec info`, `rec verify` and the keyframe lookup print it.
+std::string describe(const DamagedRange& range);
 
 /// What a scan of a whole file found.
 struct ChunkScan {

@@ -2,6 +2,7 @@
 #include "recordings/recording_reader.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <exception>
 #include <filesystem>
 
@@ -103,6 +104,7 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
   std::stable_sort(r.commands_.begin(), r.commands_.end(), [](const ParameterCommand& a, const ParameterCommand& b) { return a.apply_tick < b.apply_tick; });
   const double tick_s = r.header_.simulation.tick_s();
   for (KeyframeInfo& k : r.keyframes_) k.time_s = static_cast<double>(k.tick) * tick_s;
+  r.number_keyframes();
 
   const auto start = static_cast<std::uint64_t>(r.header_.start_tick);
   std::uint64_t next = start;
@@ -114,6 +116,106 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
   r.replayable_ticks_ = next - start;
   return r;
 }
+
+void Recording::number_keyframes() {
+  // Numbered by the recorder's schedule (a keyframe on every keyframe_every_steps-th collision step,
+  // recorder.cpp), not by their place in the file: a keyframe lost to damage, dropped by `rec recover`
+  // or lost by a full recorder must not renumber those after it, and the schedule needs only the
+  // header and each keyframe's own tick, so a file whose index is lost or rebuilt numbers them alike.
+  const int per_collision = header_.simulation.physics_per_collision;
+  const std::uint64_t period =
+      per_collision >= 1 ? static_cast<std::uint64_t>(per_collision) * static_cast<std::uint64_t>(header_.keyframe_every_steps) : 0;
+  const auto start = static_cast<std::uint64_t>(header_.start_tick);
+  bool on_schedule = period > 0;
+  for (const KeyframeInfo& k : keyframes_) on_schedule = on_schedule && k.tick >= start && k.tick % period == 0;
+  // Keyframes off the schedule were not written by this recorder: file order is all there is.
+  keyframe_period_ticks_ = on_schedule ? period : 0;
+  first_keyframe_slot_ = on_schedule ? start / period + (start % period != 0 ? 1 : 0) : 0;
+  for (std::size_t k = 0; k < keyframes_.size(); ++k) {
+    keyframes_[k].number = on_schedule ? keyframes_[k].tick / period - first_keyframe_slot_ : k;
+  }
+}
+
+Result<std::size_t> Recording::find_keyframe(std::uint64_t number) const {
+  const auto at =
+      std::lower_bound(keyframes_.begin(), keyframes_.end(), number, [](const KeyframeInfo& k, std::uint64_t n) { return k.number < n; });
+  const auto next = static_cast<std::size_t>(at - keyframes_.begin());
+  if (at != keyframes_.end() && at->number == number) return next;
+  return Error{why_keyframe_missing(number, next)};
+}
+
+std::string Recording::why_keyframe_missing(std::uint64_t number, std::size_t next) const {
+  const std::string recorded = std::to_string(keyframes_.size()) + " recorded";
+  if (keyframe_period_ticks_ == 0) return name_ + ": keyframe " + std::to_string(number) + " does not exist (" + recorded + ")";
+  char text[160];
+  const double time_s = (static_cast<double>(first_keyframe_slot_) + static_cast<double>(number)) *
+                        static_cast<double>(keyframe_period_ticks_) * header_.simulation.tick_s();
+  std::snprintf(text, sizeof text, "keyframe %llu (at %.3f s)", static_cast<unsigned long long>(number), time_s);
+  const std::string keyframe = text;
+  std::string last = "none intact";
+  if (!keyframes_.empty()) {
+    std::snprintf(text, sizeof text, "the last intact is keyframe %llu at %.3f s",
+                  static_cast<unsigned long long>(keyframes_.back().number), keyframes_.back().time_s);
+    last = text;
+  }
+  // The damaged ranges between the intact keyframes on either side of it that could have been a
+  // keyframe chunk (a chunk whose frame survived names its type).
+  const std::uint64_t from = next > 0 ? scan_.chunks[keyframes_[next - 1].chunk].end() : 0;
+  const std::uint64_t to = next < keyframes_.size() ? scan_.chunks[keyframes_[next].chunk].offset : scan_.file_bytes;
+  std::vector<DamagedRange> suspects;
+  for (const DamagedRange& d : scan_.damaged) {
+    if (d.offset >= from && d.offset < to && (!d.frame_intact || d.type == static_cast<std::uint16_t>(ChunkType::kKeyframe)))
+      suspects.push_back(d);
+  }
+  const bool past_end = next == keyframes_.size();
+  const std::optional<std::uint64_t> written = summary_count("keyframes"), lost = summary_count("lost.keyframes");
+  if (past_end && written && number >= *written + lost.value_or(0)) {
+    return name_ + ": keyframe " + std::to_string(number) + " does not exist (the recorder wrote " + std::to_string(*written) + "; " +
+           last + ")";
+  }
+  if (!suspects.empty() && !past_end) {
+    return keyframe + " is in a damaged range of " + name_ + ": " + describe(suspects.front()) +
+           (suspects.size() > 1 ? " (or one of the " + std::to_string(suspects.size() - 1) + " after it, before the next intact keyframe)"
+                                : "");
+  }
+  if (!suspects.empty())
+    return keyframe + " is not in " + name_ + ": " + last + ", and after it the file is damaged: " + describe(suspects.front());
+  if (const std::uint64_t dropped = recovered_damaged_ranges(); dropped > 0) {
+    return keyframe + " is not in " + name_ + ": `rec recover` made it from a damaged recording and left out its " +
+           std::to_string(dropped) + " damaged ranges" + (past_end ? " (" + last + ")" : "");
+  }
+  if (!past_end && lost.value_or(0) > 0) {
+    return keyframe + " is not in " + name_ + ": the recorder lost " + std::to_string(*lost) + " keyframes (no free slot: it fell behind)";
+  }
+  if (!past_end) return keyframe + " is not in " + name_ + " (" + recorded + ")";
+  return name_ + ": keyframe " + std::to_string(number) + " does not exist (" + recorded + "; " + last + ")";
+}
+
+std::vector<std::pair<std::uint64_t, std::uint64_t>> Recording::missing_keyframes() const {
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> missing;
+  std::uint64_t expected = 0;
+  for (const KeyframeInfo& k : keyframes_) {
+    if (k.number > expected) missing.emplace_back(expected, k.number - 1);
+    expected = k.number + 1;
+  }
+  return missing;
+}
+
+std::optional<std::uint64_t> Recording::summary_count(std::string_view key) const {
+  const nlohmann::ordered_json* at = &summary_;
+  // "lost.keyframes": one level of nesting is all the summary has.
+  for (std::string_view rest = key; !rest.empty();) {
+    const std::size_t dot = rest.find('.');
+    const std::string part(rest.substr(0, dot));
+    if (!at->is_object() || !at->contains(part)) return std::nullopt;
+    at = &(*at)[part];
+    rest = dot == std::string_view::npos ? std::string_view() : rest.substr(dot + 1);
+  }
+  if (!at->is_number_unsigned()) return std::nullopt;
+  return at->get<std::uint64_t>();
+}
+
+std::uint64_t Recording::recovered_damaged_ranges() const { return summary_count("recovered.damaged_ranges").value_or(0); }
 
 std::span<const std::uint8_t> Recording::payload(const ChunkLocation& chunk) const {
   return std::span<const std::uint8_t>(bytes_).subspan(chunk.payload_offset(), chunk.payload_bytes);
@@ -132,7 +234,8 @@ std::span<const std::uint8_t> Recording::keyframe_draco(std::size_t k) const {
 
 std::string Recording::keyframe_place(std::size_t k) const {
   const ChunkLocation& chunk = scan_.chunks[keyframes_[k].chunk];
-  return name_ + ": keyframe " + std::to_string(k) + " (chunk " + std::to_string(chunk.sequence) + " at byte " + std::to_string(chunk.offset) + ")";
+  return name_ + ": keyframe " + std::to_string(keyframes_[k].number) + " (chunk " + std::to_string(chunk.sequence) + " at byte " +
+         std::to_string(chunk.offset) + ")";
 }
 
 Result<SurfaceFrame> Recording::decode_keyframe(std::size_t k) const {

@@ -11,6 +11,8 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -34,6 +36,11 @@ struct KeyframeInfo {
   std::uint32_t triangle_count = 0;
   std::uint32_t draco_bytes = 0;
   std::size_t chunk = 0;         ///< into chunks()
+  /// The recording's number for it (`rec export --keyframe N`): its place in the recorder's schedule,
+  /// one every keyframe_every_steps collision steps from the header's start tick, so a keyframe lost
+  /// to damage leaves its number unused rather than renumbering those after it. Not its index in
+  /// keyframes() once one is lost.
+  std::uint64_t number = 0;
 };
 
 class Recording {
@@ -58,15 +65,30 @@ class Recording {
   std::uint64_t replayable_ticks() const { return replayable_ticks_; }
   std::span<const StepRecord> steps() const { return steps_; }
   std::span<const ParameterCommand> commands() const { return commands_; }
+  /// The intact keyframes, by tick. Indices into this (`k` below) are not keyframe numbers once one
+  /// is lost: find_keyframe() turns a number into an index.
   std::span<const KeyframeInfo> keyframes() const { return keyframes_; }
+  /// The index of the keyframe numbered `number` (KeyframeInfo::number), or why the file does not
+  /// hold it: in a damaged range (named), left out by `rec recover`, lost by the recorder, or past the end.
+  Result<std::size_t> find_keyframe(std::uint64_t number) const;
+  /// The runs of keyframe numbers (first, last) before the last intact keyframe that the file lacks.
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> missing_keyframes() const;
   /// The keyframe nearest before or at `time_s` (none before the first).
   std::optional<std::size_t> keyframe_at_time(double time_s) const;
-  /// Decodes keyframe `k` to positions (with their node ids) and triangles over the positions.
+  /// Decodes keyframe `k` (an index into keyframes()) to positions (with their node ids) and triangles
+  /// over the positions.
   Result<SurfaceFrame> decode_keyframe(std::size_t k) const;
   /// The keyframe's Draco bytes as stored (a valid .drc file).
   std::span<const std::uint8_t> keyframe_draco(std::size_t k) const;
   /// The summary chunk's JSON (null when the run did not close the file).
   const nlohmann::ordered_json& summary() const { return summary_; }
+  /// A count the recorder wrote in its summary (`ticks`, `steps`, `commands`, `keyframes`, or
+  /// `lost.<kind>`): what it wrote, which the file may no longer hold. None when the file was never
+  /// closed (a cut or killed run, or a recovery of one) or its summary is lost.
+  std::optional<std::uint64_t> summary_count(std::string_view key) const;
+  /// The damaged ranges `rec recover` left out when it made this file, over every recovery of it; 0
+  /// for a file no recovery made. What they held is lost, though the file itself is sound.
+  std::uint64_t recovered_damaged_ranges() const;
 
   /// Simulated seconds the ticks cover.
   double duration_s() const;
@@ -81,6 +103,10 @@ class Recording {
  private:
   /// Where keyframe k's errors point: the file, the keyframe and its chunk's place in the file.
   std::string keyframe_place(std::size_t k) const;
+  /// Sets every keyframe's number from its tick (after the keyframes are sorted).
+  void number_keyframes();
+  /// find_keyframe's error for a number the file lacks; `next` indexes the first keyframe numbered after it.
+  std::string why_keyframe_missing(std::uint64_t number, std::size_t next) const;
 
   std::string name_;
   std::vector<std::uint8_t> bytes_;
@@ -91,6 +117,9 @@ class Recording {
   std::vector<StepRecord> steps_;
   std::vector<ParameterCommand> commands_;
   std::vector<KeyframeInfo> keyframes_;
+  /// Ticks from one scheduled keyframe to the next, and the schedule's slot of keyframe 0; a period
+  /// of 0 when the keyframes are off the schedule (not this recorder's) and numbered in file order.
+  std::uint64_t keyframe_period_ticks_ = 0, first_keyframe_slot_ = 0;
   nlohmann::ordered_json summary_;
   std::vector<std::string> content_errors_;
 };

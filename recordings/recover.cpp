@@ -57,8 +57,10 @@ std::vector<std::uint8_t> recovered_bytes(const Recording& recording, RecoverRep
     add(static_cast<ChunkType>(chunk.type), payload, first_tick_of(chunk.type, payload));
   }
   nlohmann::ordered_json summary = recording.summary().is_object() ? recording.summary() : nlohmann::ordered_json::object();
+  // A recovery of a recovered file keeps the count of what earlier recoveries left out: replay and
+  // score judge by it whether the recording is whole.
   summary["recovered"] = {{"chunks_kept", report.chunks_kept},
-                          {"damaged_ranges", recording.damaged().size()},
+                          {"damaged_ranges", recording.recovered_damaged_ranges() + recording.damaged().size()},
                           {"replayable_ticks", recording.replayable_ticks()},
                           {"index_was_present", recording.index_present()}};
   const std::string text = summary.dump();

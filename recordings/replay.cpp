@@ -1,6 +1,8 @@
 // Re-simulation of a recording and the hash comparison at every collision step.
 #include "recordings/replay.h"
 
+#include <algorithm>
+
 namespace resecto::rec {
 
 Result<std::unique_ptr<Replayer>> Replayer::create(const Recording& recording) {
@@ -51,6 +53,49 @@ std::uint64_t Replayer::run_to(std::uint64_t tick) {
     }
   }
   return sim_->tick();
+}
+
+namespace {
+
+/// Why some recorded hashes were never compared, or empty (unverified_hashes adds the file and count).
+std::string uncompared_hashes(const Recording& recording, std::uint64_t reached) {
+  if (!recording.damaged().empty() || !recording.content_errors().empty()) {
+    return "the recording is damaged (" + std::to_string(recording.damaged().size()) + " damaged ranges, " +
+           std::to_string(recording.content_errors().size()) + " undecodable chunks; `resecto rec verify` names them)";
+  }
+  const std::uint64_t in_file = recording.steps().size();
+  const std::optional<std::uint64_t> written = recording.summary_count("steps");
+  const std::uint64_t dropped = recording.recovered_damaged_ranges();
+  const std::string by_recovery = dropped > 0 ? " (`resecto rec recover` left out the damaged chunks that held them)" : "";
+  if (written && *written > in_file) {
+    return std::to_string(*written - in_file) + " of the " + std::to_string(*written) +
+           " collision steps' hashes the recorder wrote are not in the file" + by_recovery;
+  }
+  // Hashes of collision steps the replay never reached: the inputs end or break first (a ticks chunk
+  // lost, or the file cut after a steps chunk and before the ticks it covers).
+  const auto steps = recording.steps();
+  const auto past = static_cast<std::uint64_t>(
+      steps.end() - std::lower_bound(steps.begin(), steps.end(), reached, [](const StepRecord& s, std::uint64_t t) { return s.tick < t; }));
+  if (past > 0) {
+    return std::to_string(past) + " of the " + std::to_string(in_file) + " recorded hashes are of collision steps at or past tick " +
+           std::to_string(reached) + ", where the recorded inputs end or break";
+  }
+  // A recovery of a cut or killed file: the recorder never said how many hashes it wrote, and the
+  // damaged ranges the recovery left out (a cut end among them, perhaps) may have held some.
+  if (dropped > 0 && !written) {
+    return "`resecto rec recover` made it from a damaged recording that was never closed (" + std::to_string(dropped) +
+           " damaged ranges left out): how many hashes those held is unknown";
+  }
+  return {};
+}
+
+}  // namespace
+
+std::string unverified_hashes(const Recording& recording, const Replayer& replayer) {
+  const std::string why = uncompared_hashes(recording, replayer.simulation().tick());
+  if (why.empty()) return why;
+  return recording.name() + ": " + why + ": only " + std::to_string(replayer.verified_hashes()) +
+         " collision steps' hashes could be compared";
 }
 
 }  // namespace resecto::rec

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "recordings/recording_reader.h"
 #include "rtcore/base/result.h"
@@ -47,5 +48,10 @@ class Replayer {
   std::uint64_t first_recorded_ = 0, first_replayed_ = 0;
   std::vector<ParameterCommand> tick_commands_;
 };
+
+/// Why a replay run to its end (run_to(end_tick())) cannot vouch for the whole recording though no
+/// hash it compared differed: recorded hashes it never compared (in damaged chunks, left out by
+/// `rec recover`, or past where the inputs end or break). Empty when it compared every one.
+std::string unverified_hashes(const Recording& recording, const Replayer& replayer);
 
 }  // namespace resecto::rec

@@ -26,19 +26,6 @@ rec::Recording open_recording(const std::string& file) {
   return std::move(*recording);
 }
 
-std::string describe(const rec::DamagedRange& d) {
-  char text[256];
-  if (d.frame_intact) {
-    std::snprintf(text, sizeof text, "%s chunk %u at byte %llu (%llu bytes): payload CRC mismatch",
-                  std::string(rec::chunk_type_name(d.type)).c_str(), d.sequence, static_cast<unsigned long long>(d.offset),
-                  static_cast<unsigned long long>(d.bytes));
-  } else {
-    std::snprintf(text, sizeof text, "%llu bytes at byte %llu hold no intact chunk (a damaged frame, or a chunk cut off)",
-                  static_cast<unsigned long long>(d.bytes), static_cast<unsigned long long>(d.offset));
-  }
-  return text;
-}
-
 struct InfoOptions {
   std::string file;
   bool json = false;
@@ -58,12 +45,20 @@ void info(const InfoOptions& o) {
   byte_counts["file"] = r.bytes().size();
   ordered_json damaged = ordered_json::array();
   for (const rec::DamagedRange& d : r.damaged()) {
-    damaged.push_back({{"offset", d.offset}, {"bytes", d.bytes}, {"description", describe(d)}});
+    damaged.push_back({{"offset", d.offset}, {"bytes", d.bytes}, {"description", rec::describe(d)}});
   }
   const rec::SessionHeader& h = r.header();
-  const double keyframe_hz = r.keyframes().size() > 1
-                                 ? static_cast<double>(r.keyframes().size() - 1) / (r.keyframes().back().time_s - r.keyframes().front().time_s)
-                                 : 0.0;
+  // By number, so a lost keyframe does not lower the rate the recorder kept.
+  const auto keyframes = r.keyframes();
+  const double keyframe_hz = keyframes.size() > 1 ? static_cast<double>(keyframes.back().number - keyframes.front().number) /
+                                                        (keyframes.back().time_s - keyframes.front().time_s)
+                                                  : 0.0;
+  ordered_json missing = ordered_json::array();
+  std::string missing_text;
+  for (const auto& [first, last] : r.missing_keyframes()) {
+    missing.push_back({first, last});
+    missing_text += (missing_text.empty() ? "; missing " : ", ") + std::to_string(first) + (last > first ? "-" + std::to_string(last) : "");
+  }
   ordered_json out = {{"file", o.file},
                       {"build", h.build},
                       {"procedure", h.procedure},
@@ -75,6 +70,7 @@ void info(const InfoOptions& o) {
                       {"commands", r.commands().size()},
                       {"keyframes", r.keyframes().size()},
                       {"keyframe_hz", keyframe_hz},
+                      {"missing_keyframes", missing},
                       {"chunks", chunk_counts},
                       {"bytes", byte_counts},
                       {"index_present", r.index_present()},
@@ -89,8 +85,8 @@ void info(const InfoOptions& o) {
   std::printf("%s: %s recording of '%s' by %s\n", o.file.c_str(), h.mode.c_str(), h.procedure.c_str(), h.build.c_str());
   std::printf("  duration   %.2f s, %zu ticks (%llu replayable), %zu collision steps, %zu commands\n", r.duration_s(), r.ticks().size(),
               static_cast<unsigned long long>(r.replayable_ticks()), r.steps().size(), r.commands().size());
-  std::printf("  keyframes  %zu (%.1f Hz), grid %d bits over %.1f mm\n", r.keyframes().size(), keyframe_hz, h.grid.bits,
-              static_cast<double>(h.grid.range) * 1e3);
+  std::printf("  keyframes  %zu (%.1f Hz%s), grid %d bits over %.1f mm\n", r.keyframes().size(), keyframe_hz, missing_text.c_str(),
+              h.grid.bits, static_cast<double>(h.grid.range) * 1e3);
   std::printf("  chunks     %zu:", r.chunks().size());
   for (const auto& [name, count] : chunk_counts.items()) {
     if (name != "total" && count.get<std::uint64_t>() > 0) std::printf(" %s %llu", name.c_str(), static_cast<unsigned long long>(count.get<std::uint64_t>()));
@@ -100,14 +96,14 @@ void info(const InfoOptions& o) {
     if (name != "file" && count.get<std::uint64_t>() > 0) std::printf(" %s %llu", name.c_str(), static_cast<unsigned long long>(count.get<std::uint64_t>()));
   }
   std::printf("\n  index      %s; %zu damaged ranges\n", r.index_present() ? "present" : "absent (not closed: `rec recover` rebuilds it)", r.damaged().size());
-  for (const rec::DamagedRange& d : r.damaged()) std::printf("  damaged    %s\n", describe(d).c_str());
+  for (const rec::DamagedRange& d : r.damaged()) std::printf("  damaged    %s\n", rec::describe(d).c_str());
 }
 
 void verify(const std::string& file) {
   const rec::Recording r = open_recording(file);
   std::size_t problems = 0;
   for (const rec::DamagedRange& d : r.damaged()) {
-    std::fprintf(stderr, "%s: damaged: %s\n", file.c_str(), describe(d).c_str());
+    std::fprintf(stderr, "%s: damaged: %s\n", file.c_str(), rec::describe(d).c_str());
     ++problems;
   }
   for (const std::string& e : r.content_errors()) {
@@ -172,16 +168,23 @@ void export_recording(const ExportOptions& o) {
     std::printf("%s: %zu ticks' inputs\n", o.out.c_str(), r.ticks().size());
     return;
   }
-  std::size_t k = static_cast<std::size_t>(o.keyframe);
+  std::size_t k = 0;
   if (o.time_s >= 0.0) {
     const std::optional<std::size_t> at = r.keyframe_at_time(o.time_s);
     if (!at) throw std::runtime_error(o.file + ": no keyframe at or before " + std::to_string(o.time_s) + " s");
     k = *at;
+  } else {
+    // N is the recording's keyframe number, not a place among the keyframes that survived: a damaged
+    // one is refused by name rather than answered with its neighbour.
+    const Result<std::size_t> found = r.find_keyframe(static_cast<std::uint64_t>(o.keyframe));
+    if (!found) throw std::runtime_error(found.error());
+    k = *found;
   }
   if (Status written = rec::export_keyframe(r, k, o.out); !written) throw std::runtime_error(written.error());
   const rec::KeyframeInfo& info = r.keyframes()[k];
-  std::printf("%s: keyframe %zu at %.3f s (tick %llu), %u vertices, %u triangles\n", o.out.c_str(), k, info.time_s,
-              static_cast<unsigned long long>(info.tick), info.vertex_count, info.triangle_count);
+  std::printf("%s: keyframe %llu at %.3f s (tick %llu), %u vertices, %u triangles\n", o.out.c_str(),
+              static_cast<unsigned long long>(info.number), info.time_s, static_cast<unsigned long long>(info.tick), info.vertex_count,
+              info.triangle_count);
 }
 
 void register_rec(CLI::App& app) {
@@ -208,7 +211,10 @@ void register_rec(CLI::App& app) {
   auto export_options = std::make_shared<ExportOptions>();
   CLI::App* export_cmd = family.add_subcommand("export", "A keyframe's surface (.drc .ply .obj .off .stl) or the per-tick inputs (.csv)");
   export_cmd->add_option("FILE", export_options->file, "Recording")->required()->check(existing_path());
-  export_cmd->add_option("--keyframe", export_options->keyframe, "Keyframe number (0-based)")->check(index_up_to(std::numeric_limits<int>::max()));
+  export_cmd
+      ->add_option("--keyframe", export_options->keyframe,
+                   "Keyframe number (0-based, the recording's own: a lost keyframe keeps its number)")
+      ->check(index_up_to(std::numeric_limits<int>::max()));
   export_cmd->add_option("--time", export_options->time_s, "The last keyframe at or before this simulated time, seconds")->check(finite_at_least(0.0));
   export_cmd->add_flag("--inputs", export_options->inputs, "Export the per-tick inputs as CSV instead");
   export_cmd->add_option("-o,--output", export_options->out, "Output file; format by extension")->required();

@@ -206,8 +206,9 @@ void ConsoleWindow::draw_endoscope_window(const ImVec2& pos, const ImVec2& size)
   if (shown_ != &f.snapshot) {
     // The replay's pose, as the recording has it (the live core keeps running behind it).
     const Vec3 tip = shown_->tool.sheath.translation;
-    std::snprintf(text, sizeof text, "REPLAY %.2f s (keyframe %zu)   sheath tip %.1f %.1f %.1f mm", ui_.replay.time_s(),
-                  ui_.replay.keyframe_shown().value_or(0) + 1, units::m_to_mm(tip.x), units::m_to_mm(tip.y), units::m_to_mm(tip.z));
+    std::snprintf(text, sizeof text, "REPLAY %.2f s (keyframe %llu)   sheath tip %.1f %.1f %.1f mm", ui_.replay.time_s(),
+                  static_cast<unsigned long long>(ui_.replay.keyframe_number_shown().value_or(0)), units::m_to_mm(tip.x),
+                  units::m_to_mm(tip.y), units::m_to_mm(tip.z));
     draw->AddText(ImVec2(origin.x + 8, origin.y + 6), IM_COL32(120, 220, 255, 255), text);
   } else {
     std::snprintf(text, sizeof text, "roll %+.0f deg  insertion %.1f mm  loop %.1f mm", units::rad_to_deg(f.status.joints.roll_rad),
@@ -438,11 +439,15 @@ ordered_json make_report(CoreSession& session, ConsoleUi& ui, const ConsoleOptio
                     {"message", std::string(status.recording_message.data())}};
   if (ui.replay.is_open()) {
     ordered_json replay = {{"path", ui.replay.path()}, {"time_s", ui.replay.time_s()}, {"step_tick", ui.replay.step_tick_shown()}};
-    if (ui.replay.keyframe_shown()) replay["keyframe"] = *ui.replay.keyframe_shown();
+    if (ui.replay.keyframe_number_shown()) replay["keyframe"] = *ui.replay.keyframe_number_shown();
     const RigidPose& sheath = ui.replay.shown_tool().sheath;
     replay["sheath_tip_m"] = {sheath.translation.x, sheath.translation.y, sheath.translation.z};
     if (const ReplayVerification* v = ui.replay.verification()) {
-      replay["verification"] = {{"error", v->error}, {"ticks", v->ticks}, {"verified", v->verified}, {"mismatches", v->mismatches}};
+      replay["verification"] = {{"error", v->error},
+                                {"ticks", v->ticks},
+                                {"verified", v->verified},
+                                {"mismatches", v->mismatches},
+                                {"unverified", v->unverified}};
     }
     r["replay"] = replay;
   }

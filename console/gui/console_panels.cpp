@@ -307,12 +307,16 @@ void draw_replay_panel(ConsoleController& console) {
     ui.show_replay = true;
   }
   if (replay.keyframe_shown()) {
-    ImGui::TextDisabled("keyframe %zu of %zu, tool at collision step tick %" PRIu64, *replay.keyframe_shown() + 1, r.keyframes().size(),
-                        replay.step_tick_shown());
+    // The recording's own keyframe number (a lost keyframe keeps its number), as `rec export` takes it.
+    ImGui::TextDisabled("keyframe %" PRIu64 " (at %.2f s), tool at collision step tick %" PRIu64, *replay.keyframe_number_shown(),
+                        r.keyframes()[*replay.keyframe_shown()].time_s, replay.step_tick_shown());
   }
   if (const ReplayVerification* v = replay.verification()) {
     if (!v->error.empty()) {
       ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.3f, 1.0f), "verify: %s", v->error.c_str());
+    } else if (v->mismatches == 0 && !v->unverified.empty()) {
+      ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.3f, 1.0f), "%" PRIu64 " hashes match, but not the whole recording: %s", v->verified,
+                         v->unverified.c_str());
     } else if (v->mismatches == 0) {
       ImGui::TextColored(ImVec4(0.4f, 1.0f, 0.4f, 1.0f), "verified: %" PRIu64 " of %" PRIu64 " hashes match (%" PRIu64 " ticks)", v->verified,
                          v->verified, v->ticks);

@@ -121,6 +121,7 @@ void ReplayBrowser::start_verification() {
       result.verified = r.verified_hashes();
       result.mismatches = r.mismatches();
       result.first_mismatch_tick = r.first_mismatch_tick();
+      result.unverified = rec::unverified_hashes(*recording, r);
     }
     result.done = true;
     verification_ = std::move(result);

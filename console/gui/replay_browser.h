@@ -26,6 +26,7 @@ struct ReplayVerification {
   std::string error;  ///< the replay could not run (e.g. the recording starts mid-session)
   std::uint64_t ticks = 0, verified = 0, mismatches = 0;
   std::optional<std::uint64_t> first_mismatch_tick;
+  std::string unverified;  ///< recorded hashes it could not compare (rec::unverified_hashes); empty when none
 };
 
 class ReplayBrowser {
@@ -58,8 +59,14 @@ class ReplayBrowser {
   /// The snapshot to draw for the current time: tissue of the keyframe at or before it, tool and
   /// metrics of the collision step at or before it. Decodes a keyframe only when it changes.
   const SimulationSnapshot& snapshot();
-  /// The keyframe and collision step shown (after snapshot()).
+  /// The keyframe (an index into recording().keyframes(), whose `number` is the one to show) and
+  /// collision step shown (after snapshot()).
   std::optional<std::size_t> keyframe_shown() const { return keyframe_shown_; }
+  /// The recording's number of the keyframe shown, as `rec export --keyframe` takes it.
+  std::optional<std::uint64_t> keyframe_number_shown() const {
+    if (!keyframe_shown_) return std::nullopt;
+    return recording_->keyframes()[*keyframe_shown_].number;
+  }
   std::uint64_t step_tick_shown() const { return step_tick_shown_; }
   /// The tool as last shown by snapshot().
   const ToolPoses& shown_tool() const { return snapshot_.tool; }

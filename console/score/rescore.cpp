@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <memory>
+#include <optional>
+#include <string>
 
 #include "recordings/replay.h"
 
@@ -52,6 +54,21 @@ void for_each_scalar(const ScoreMetrics& m, Visit&& visit) {
 bool is_count(const char* name) {
   const std::string n = name;
   return n == "cuts" || n == "chips" || n == "perforations" || n == "sphincter_zone_violations";
+}
+
+/// What a sound file (no damage left in it) lacks of the procedure it was recorded from, or empty: a
+/// recovery's left-out damaged ranges, unless the recorder's summary shows every tick and command it
+/// wrote still there (the ranges held only keyframes or hashes, which the score does not use).
+std::string lost_part_of_procedure(const rec::Recording& recording) {
+  const std::uint64_t dropped = recording.recovered_damaged_ranges();
+  if (dropped == 0) return {};
+  const std::optional<std::uint64_t> ticks = recording.summary_count("ticks"), commands = recording.summary_count("commands");
+  if (ticks && commands && *ticks == recording.ticks().size() && *commands == recording.commands().size()) return {};
+  return "recovered (`rec recover`) from a damaged recording, " + std::to_string(dropped) + " damaged ranges left out" +
+         (ticks && commands
+              ? ": " + std::to_string(recording.ticks().size()) + " of the " + std::to_string(*ticks) + " ticks and " +
+                    std::to_string(recording.commands().size()) + " of the " + std::to_string(*commands) + " commands recorded remain"
+              : ", and the recording was never closed, so how much of the procedure they held is unknown");
 }
 
 }  // namespace
@@ -111,6 +128,8 @@ Result<RecordingScore> score_recording(const std::filesystem::path& path, const 
                  std::to_string(d.offset) + "); a score from part of a procedure would mislead"};
   }
   if (!recording->content_errors().empty()) return Error{name + ": " + recording->content_errors().front()};
+  if (std::string lost = lost_part_of_procedure(*recording); !lost.empty())
+    return Error{name + ": " + lost + "; a score from part of a procedure would mislead"};
   if (recording->replayable_ticks() == 0) return Error{name + ": no recorded input to replay"};
   if (recording->replayable_ticks() != recording->ticks().size()) {
     return Error{name + ": recorded input breaks at tick " + std::to_string(recording->replayable_ticks())};

@@ -150,10 +150,75 @@ TEST(RecordingCommands, VerifyNamesADamagedChunkAndRecoverRepairsIt) {
   const auto recovered = dir / "recovered.rsrec";
   ASSERT_EQ(run_resecto("rec recover " + damaged.string() + " " + recovered.string()).exit_code, 0);
   EXPECT_EQ(run_resecto("rec verify " + recovered.string()).exit_code, 0);
-  // A lost ticks chunk ends the replay there; what precedes it still verifies.
+  // The lost chunk is a keyframe: every tick and every hash the recorder wrote is still there, so the
+  // recovered file verifies as a whole. (A lost ticks chunk leaves the hashes after it uncompared, and
+  // fails --verify: recordings/recording_file_test.cpp.)
+  ASSERT_EQ(victim.type, static_cast<std::uint16_t>(rec::ChunkType::kKeyframe));
   const testing::CommandOutput replay = run_resecto("replay " + recovered.string() + " --verify --json");
   EXPECT_EQ(replay.exit_code, 0) << replay.err;
   EXPECT_EQ(json_of(replay)["mismatches"], 0);
+}
+
+// A recording cut short and recovered: every hash left in it matches, but the cut took the rest of
+// the procedure and the recorder's summary, so --verify says how many matched and exits 1 (it printed
+// "45 of 90 recorded hashes verified, 0 mismatches" and exited 0).
+TEST(RecordingCommands, ACutRecordingRecoveredDoesNotVerifyAsWhole) {
+  const auto [dir, file, r] = record_and_open("recording_cut_recovered", "--seconds 2");
+  ASSERT_TRUE(r);
+  const std::string bytes = testing::read_text(file);
+  const auto cut = dir / "cut.rsrec", recovered = dir / "recovered.rsrec";
+  std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  ASSERT_EQ(run_resecto("rec recover " + cut.string() + " " + recovered.string()).exit_code, 0);
+  EXPECT_EQ(run_resecto("rec verify " + recovered.string()).exit_code, 0) << "the recovered file itself is sound";
+  const testing::CommandOutput replay = run_resecto("replay " + recovered.string() + " --verify");
+  EXPECT_EQ(replay.exit_code, 1) << replay.out;
+  EXPECT_NE(replay.out.find(" recorded hashes verified, 0 mismatches"), std::string::npos) << replay.out;
+  // Which reason it gives depends on where the cut fell (in a ticks chunk whose hashes are already in
+  // the file, or after both): the recorder thread's timing decides the chunks' order.
+  EXPECT_EQ(replay.err.rfind("resecto: " + recovered.string() + ": ", 0), 0u) << replay.err;
+  EXPECT_NE(replay.err.find(" collision steps' hashes could be compared"), std::string::npos) << replay.err;
+  const nlohmann::json out = json_of(run_resecto("replay " + recovered.string() + " --verify --json"));
+  EXPECT_EQ(out["mismatches"], 0);
+  EXPECT_GT(out["verified_hashes"].get<int>(), 0);
+  EXPECT_TRUE(out["unverified"].is_string());
+  // Without --verify the replay is what it was: what the file holds, exit 0.
+  EXPECT_EQ(run_resecto("replay " + recovered.string()).exit_code, 0);
+  EXPECT_TRUE(json_of(run_resecto("replay " + file.string() + " --verify --json"))["unverified"].is_null());
+}
+
+// A keyframe damaged in the middle of a recording: `rec export --keyframe N` gives keyframe N of the
+// recording (it gave N + 1 past the damaged one, printing N), refuses the damaged one by name, and
+// `rec info` lists it missing; after `rec recover` the numbers are the same.
+TEST(RecordingCommands, ExportingKeyframeNFromADamagedRecordingGivesKeyframeN) {
+  const auto [dir, file, r] = record_and_open("recording_damaged_keyframe", "--seconds 1");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->keyframes().size(), 10u);
+  const rec::ChunkLocation victim = r->chunks()[r->keyframes()[4].chunk];
+  const auto damaged = dir / "damaged.rsrec", recovered = dir / "recovered.rsrec";
+  write_with_a_bit_flipped(*r, victim, 0x08, damaged);
+  ASSERT_EQ(run_resecto("rec recover " + damaged.string() + " " + recovered.string()).exit_code, 0);
+  ASSERT_EQ(run_resecto("rec export " + file.string() + " --keyframe 5 -o " + (dir / "k5.off").string()).exit_code, 0);
+  for (const auto& source : {damaged, recovered}) {
+    const auto out = dir / (source.stem().string() + "_k5.off");
+    const testing::CommandOutput exported = run_resecto("rec export " + source.string() + " --keyframe 5 -o " + out.string());
+    ASSERT_EQ(exported.exit_code, 0) << exported.err;
+    EXPECT_NE(exported.out.find("keyframe 5 at 0.500 s"), std::string::npos) << exported.out;
+    EXPECT_EQ(testing::read_text(out), testing::read_text(dir / "k5.off")) << source;
+    const auto refused_out = dir / (source.stem().string() + "_k4.off");
+    const testing::CommandOutput refused = run_resecto("rec export " + source.string() + " --keyframe 4 -o " + refused_out.string());
+    EXPECT_EQ(refused.exit_code, 1) << source;
+    EXPECT_NE(refused.err.find("keyframe 4 (at 0.400 s) "), std::string::npos) << refused.err;
+    EXPECT_FALSE(std::filesystem::exists(refused_out));
+    const nlohmann::json info = json_of(run_resecto("rec info " + source.string() + " --json"));
+    EXPECT_EQ(info["keyframes"], 9);
+    EXPECT_EQ(info["missing_keyframes"], nlohmann::json::parse("[[4, 4]]")) << source;
+    EXPECT_NEAR(info["keyframe_hz"].get<double>(), 10.0, 1e-9);
+  }
+  const testing::CommandOutput named = run_resecto("rec export " + damaged.string() + " --keyframe 4 -o " + (dir / "x.off").string());
+  EXPECT_NE(named.err.find("keyframe 4 (at 0.400 s) is in a damaged range of " + damaged.string() + ": keyframe chunk " +
+                           std::to_string(victim.sequence) + " at byte " + std::to_string(victim.offset)),
+            std::string::npos)
+      << named.err;
 }
 
 TEST(RecordingCommands, ARecoveryWithoutSomeStepHashesDoesNotVerifyAsWhole) {

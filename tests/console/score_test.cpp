@@ -148,6 +148,41 @@ TEST(ScoreCommand, CohortCsvSkipsTheDamagedRecording) {
   EXPECT_EQ(read_text(dir / "cohort.csv").find("damaged"), std::string::npos);
 }
 
+// A recording cut short is skipped as damaged; once `rec recover` has made a sound file of it, it is
+// still part of a procedure (it was scored as a whole one) and is skipped with the reason. A recovery
+// that lost only a keyframe kept every tick and command the recorder wrote, and scores.
+TEST(ScoreCommand, ARecoveredCutRecordingIsSkippedLikeTheCutOne) {
+  const auto dir = scratch_directory("score_recovered");
+  const auto file = dir / "whole.resecto";
+  run_and_record("demo", file, " --seconds 1.2");
+  const std::string bytes = read_text(file);
+  const auto cut = dir / "cut.resecto", recovered = dir / "recovered.resecto";
+  std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  ASSERT_EQ(run_resecto("rec recover " + cut.string() + " " + recovered.string()).exit_code, 0);
+  const CommandOutput scored = run_resecto("score --quiet " + cut.string() + " " + recovered.string());
+  EXPECT_EQ(scored.exit_code, 1);
+  EXPECT_NE(scored.err.find("skipped: " + cut.string() + ": damaged"), std::string::npos) << scored.err;
+  EXPECT_NE(
+      scored.err.find("skipped: " + recovered.string() + ": recovered (`rec recover`) from a damaged recording, 1 damaged ranges left out"),
+      std::string::npos)
+      << scored.err;
+  EXPECT_NE(scored.err.find("a score from part of a procedure would mislead"), std::string::npos) << scored.err;
+  EXPECT_NE(scored.err.find("2 of 2 recordings skipped"), std::string::npos) << scored.err;
+  EXPECT_EQ(scored.out, "");
+
+  // The last keyframe's chunk damaged (payload bytes overwritten; its frame holds): only that is lost.
+  const std::size_t last_keyframe = bytes.rfind(std::string("CHNK\x05\x00", 6));
+  ASSERT_NE(last_keyframe, std::string::npos);
+  std::string keyframe_damaged = bytes;
+  for (std::size_t i = last_keyframe + 40; i < last_keyframe + 48; ++i) keyframe_damaged[i] = static_cast<char>(keyframe_damaged[i] ^ 0xff);
+  const auto damaged = dir / "keyframe_damaged.resecto", kept = dir / "keyframe_recovered.resecto";
+  std::ofstream(damaged, std::ios::binary) << keyframe_damaged;
+  ASSERT_EQ(run_resecto("rec recover " + damaged.string() + " " + kept.string()).exit_code, 0);
+  const json both = score_json(file.string() + " " + kept.string());
+  ASSERT_EQ(both.at("scored").size(), 2u);
+  EXPECT_EQ(both["scored"][0]["metrics"], both["scored"][1]["metrics"]);
+}
+
 TEST(ScoreCommand, RecordingsOfOneNameFromTwoFoldersGetAPageEach) {
   const auto dir = scratch_directory("score_same_name");
   std::filesystem::create_directories(dir / "trainee1");

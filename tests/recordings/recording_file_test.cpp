@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "recordings/recover.h"
 #include "recordings/replay.h"
@@ -190,6 +192,117 @@ TEST(RecordingFile, AFlippedBitInChunkKLosesChunkKOnly) {
       }
     }
   }
+}
+
+/// `bytes` with one bit flipped in the middle of `chunk`'s payload: its CRC fails and it alone is lost.
+std::vector<std::uint8_t> with_payload_damaged(std::vector<std::uint8_t> bytes, const ChunkLocation& chunk) {
+  bytes[chunk.payload_offset() + chunk.payload_bytes / 2] ^= 0x10;
+  return bytes;
+}
+
+// A damaged keyframe leaves its number unused: the keyframes after it keep theirs (the reader
+// renumbered them, so `rec export --keyframe 1` gave keyframe 2), asking for it names the damaged
+// range, and the numbers hold with the index lost and after `rec recover` has dropped the chunk.
+TEST(RecordingFile, KeyframesAfterADamagedOneKeepTheirNumbers) {
+  const testing::LiveRun& live = short_recording();
+  const Recording intact = open_bytes(live.file);
+  ASSERT_EQ(intact.keyframes().size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(intact.keyframes()[k].number, k);
+  EXPECT_TRUE(intact.missing_keyframes().empty());
+  const ChunkLocation middle = intact.chunks()[intact.keyframes()[1].chunk];
+  const std::vector<std::uint8_t> damaged = with_payload_damaged(live.file, middle);
+  ASSERT_EQ(intact.chunks().back().type, static_cast<std::uint16_t>(ChunkType::kIndex));
+  const std::vector<std::uint8_t> no_index(damaged.begin(), damaged.begin() + static_cast<std::ptrdiff_t>(intact.chunks().back().offset));
+  RecoverReport report;
+  const std::vector<std::uint8_t> recovered = recovered_bytes(open_bytes(damaged), report);
+  for (const auto& [bytes, name] :
+       {std::pair{&damaged, "damaged.rsrec"}, std::pair{&no_index, "no_index.rsrec"}, std::pair{&recovered, "recovered.rsrec"}}) {
+    Result<Recording> r = Recording::from_bytes(*bytes, name);
+    ASSERT_TRUE(r) << r.error();
+    ASSERT_EQ(r->keyframes().size(), 2u) << name;
+    EXPECT_EQ(r->keyframes()[1].number, 2u) << name;
+    EXPECT_EQ(r->keyframes()[1].tick, intact.keyframes()[2].tick) << name;
+    const Result<std::size_t> two = r->find_keyframe(2);
+    ASSERT_TRUE(two) << two.error();
+    EXPECT_EQ(*two, 1u) << name;
+    const Result<std::size_t> one = r->find_keyframe(1);
+    ASSERT_FALSE(one) << name;
+    EXPECT_EQ(one.error().rfind("keyframe 1 (at 0.100 s) ", 0), 0u) << one.error();
+    EXPECT_EQ(r->missing_keyframes(), (std::vector<std::pair<std::uint64_t, std::uint64_t>>{{1, 1}})) << name;
+    const Result<SurfaceFrame> frame = r->decode_keyframe(*two);
+    ASSERT_TRUE(frame) << frame.error();
+    EXPECT_EQ(frame->positions.size(), intact.keyframes()[2].vertex_count);
+  }
+  const std::string range = "keyframe chunk " + std::to_string(middle.sequence) + " at byte " + std::to_string(middle.offset) + " (" +
+                            std::to_string(middle.end() - middle.offset) + " bytes): payload CRC mismatch";
+  EXPECT_EQ(Recording::from_bytes(damaged, "damaged.rsrec")->find_keyframe(1).error(),
+            "keyframe 1 (at 0.100 s) is in a damaged range of damaged.rsrec: " + range);
+  EXPECT_EQ(Recording::from_bytes(no_index, "no_index.rsrec")->find_keyframe(1).error(),
+            "keyframe 1 (at 0.100 s) is in a damaged range of no_index.rsrec: " + range);
+  const std::string left_out = Recording::from_bytes(recovered, "recovered.rsrec")->find_keyframe(1).error();
+  EXPECT_NE(left_out.find("is not in recovered.rsrec: `rec recover` made it from a damaged recording and left out its 1 damaged ranges"),
+            std::string::npos)
+      << left_out;
+  const std::string past = intact.find_keyframe(3).error();
+  EXPECT_NE(past.find("keyframe 3 does not exist (the recorder wrote 3"), std::string::npos) << past;
+}
+
+/// Replays `r` to its end; what it could not vouch for.
+std::string unverified_after_replay(const Recording& r) {
+  auto replayer = Replayer::create(r);
+  EXPECT_TRUE(replayer);
+  if (!replayer) return "no replay";
+  (*replayer)->run_to((*replayer)->end_tick());
+  EXPECT_EQ((*replayer)->mismatches(), 0u);
+  EXPECT_GT((*replayer)->verified_hashes(), 0u);
+  return unverified_hashes(r, **replayer);
+}
+
+// A recording cut short and recovered is sound (no damage left, an index, a summary), and every hash
+// it holds matches; but the cut took the recorder's summary, so nothing says how many hashes the cut
+// end held and the replay cannot vouch for the whole recording, nor can a second recovery's. A lost
+// ticks chunk leaves the hashes after it uncompared.
+TEST(RecordingFile, ARecoveredCutOrGappedRecordingDoesNotVerifyAsWhole) {
+  const testing::LiveRun& live = short_recording();
+  const Recording intact = open_bytes(live.file);
+  EXPECT_EQ(unverified_after_replay(intact), "");
+  const auto is = [](const ChunkLocation& c, ChunkType type) { return c.type == static_cast<std::uint16_t>(type); };
+
+  // Cut in the summary: every tick and hash is kept, so only the unknown is left to fail it. (Where
+  // a cut elsewhere falls, in ticks or steps, depends on the recorder thread's timing.)
+  const auto summary =
+      std::find_if(intact.chunks().begin(), intact.chunks().end(), [&](const ChunkLocation& c) { return is(c, ChunkType::kSummary); });
+  ASSERT_NE(summary, intact.chunks().end());
+  const std::vector<std::uint8_t> cut(live.file.begin(), live.file.begin() + static_cast<std::ptrdiff_t>(summary->offset + 30));
+  RecoverReport report;
+  const std::vector<std::uint8_t> recovered = recovered_bytes(open_bytes(cut), report);
+  ASSERT_EQ(report.damaged_ranges, 1u);
+  const Result<Recording> once = Recording::from_bytes(recovered, "recovered.rsrec");
+  ASSERT_TRUE(once);
+  EXPECT_TRUE(once->damaged().empty());
+  EXPECT_EQ(once->recovered_damaged_ranges(), 1u);
+  EXPECT_EQ(unverified_after_replay(*once),
+            "recovered.rsrec: `resecto rec recover` made it from a damaged recording that was never closed (1 "
+            "damaged ranges left out): how many hashes those held is unknown: only " +
+                std::to_string(intact.steps().size()) + " collision steps' hashes could be compared");
+  const Result<Recording> twice = Recording::from_bytes(recovered_bytes(*once, report), "twice.rsrec");
+  ASSERT_TRUE(twice);
+  EXPECT_EQ(twice->recovered_damaged_ranges(), 1u) << "a recovery of a recovery keeps the count";
+  EXPECT_NE(unverified_after_replay(*twice), "");
+
+  // A ticks chunk from the middle of the run lost: the replay stops there.
+  const auto ticks = std::find_if(intact.chunks().begin(), intact.chunks().end(), [&](const ChunkLocation& c) {
+    return is(c, ChunkType::kTicks) && first_tick_of(c.type, intact.payload(c)) >= live.inputs.size() / 2;
+  });
+  ASSERT_NE(ticks, intact.chunks().end());
+  const Result<Recording> gapped =
+      Recording::from_bytes(recovered_bytes(open_bytes(with_payload_damaged(live.file, *ticks)), report), "gapped.rsrec");
+  ASSERT_TRUE(gapped);
+  const std::string gap = unverified_after_replay(*gapped);
+  EXPECT_NE(gap.find("recorded hashes are of collision steps at or past tick " +
+                     std::to_string(first_tick_of(ticks->type, intact.payload(*ticks)))),
+            std::string::npos)
+      << gap;
 }
 
 }  // namespace
