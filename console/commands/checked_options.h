@@ -84,6 +84,12 @@ inline CLI::Validator unsigned_64() {
       "UINT64");
 }
 
+/// Accepts any path but the empty one: an output given as '' would otherwise read as not given at
+/// all, and the command would succeed having written nothing.
+inline CLI::Validator nonempty_path() {
+  return CLI::Validator([](std::string& text) -> std::string { return text.empty() ? "an empty path names no file" : std::string(); }, "FILE");
+}
+
 /// Accepts a path that exists; a missing input is a command line that cannot be run (exit 2). What
 /// it is (a folder, a device, a file of the wrong kind) the command that reads it says, in its words.
 inline CLI::Validator existing_path() {

@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "console/commands/checked_options.h"
 #include "console/commands/command_registry.h"
 #include "console/commands/pose_file.h"
 #include "rtcore/base/atomic_file.h"
@@ -180,7 +181,7 @@ void register_collide(CLI::App& app) {
   cmd->add_option("--tissue", options->tissue, "Tissue surface mesh (.off, .obj, .ply, .stl)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--tool", options->tool, "Tool surface mesh, in tool coordinates")->required()->check(CLI::ExistingFile);
   cmd->add_option("--poses", options->poses, "Tool poses: 12 numbers a line, row-major 3x4 [R|t]")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--pairs", options->pairs, "Write the pairs as CSV: pose,tissue_face,tool_face");
+  cmd->add_option("--pairs", options->pairs, "Write the pairs as CSV: pose,tissue_face,tool_face")->check(nonempty_path());
   cmd->add_option("--repeat", options->repeat, "Run every pose this many times for the timings")
       ->check(CLI::Range(1, 1'000'000))->capture_default_str();
   cmd->add_flag("--sequence", options->sequence,

@@ -17,7 +17,7 @@ void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_r
   if (!shared_with_run) {
     cmd.add_option("--procedure", o.procedure, "Built-in procedure (demo, turp) or a procedure file the emulated device follows")->check(procedure_name_or_file())->capture_default_str();
     cmd.add_option("--triangles", o.triangles, "Prostate surface triangles")->check(CLI::Range(200, 1000000))->capture_default_str();
-    cmd.add_option("--report", o.report, "Write the session's JSON report here when the console closes");
+    cmd.add_option("--report", o.report, "Write the session's JSON report here when the console closes")->check(nonempty_path());
     add_parameter_option(cmd, o.sets);
     cmd.add_option("--collision-hz", o.collision_hz, "Collision steps per second")->check(CLI::Range(10, 1000))->capture_default_str();
     cmd.add_option("--substeps", o.substeps, "Physics steps per collision step")->check(CLI::Range(1, 64))->capture_default_str();
@@ -34,12 +34,12 @@ void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_r
                  "hid: the LP3500 over USB")
       ->check(CLI::IsMember({"emulator", "keyboard", "hid"}))
       ->capture_default_str();
-  cmd.add_option("--preset", o.preset, "Tissue parameter preset (JSON) to start from");
+  cmd.add_option("--preset", o.preset, "Tissue parameter preset (JSON) to start from")->check(existing_path());
   cmd.add_option("--replay", o.replay, "Open this recording in the replay panel and show it in the views")->check(existing_path());
-  if (!shared_with_run) cmd.add_option("--record", o.record, "Record the session from its first tick to this file (replayable and verifiable)");
+  if (!shared_with_run) cmd.add_option("--record", o.record, "Record the session from its first tick to this file (replayable and verifiable)")->check(nonempty_path());
   cmd.add_option("--actions", o.actions, "Scripted UI actions, one 'frame N VERB ...' per line (docs/commands.md, \"Operator console\")")->check(existing_path());
   CLI::Option* frames = cmd.add_option("--frames", o.frames, "Quit after this many frames")->check(CLI::Range(1, 100000000));
-  cmd.add_option("--screenshot", o.screenshot, "Write a PNG of the whole window after the last of --frames")->needs(frames);
+  cmd.add_option("--screenshot", o.screenshot, "Write a PNG of the whole window after the last of --frames")->needs(frames)->check(nonempty_path());
   cmd.add_flag("--lockstep", o.lockstep,
                "Step the emulated board with the core's ticks (no link thread): the state depends only on the procedure and the commands");
   cmd.add_option("--insertion-mm", o.start_insertion_mm, "--device keyboard: where the sheath starts, mm past the pivot (the apex is at 150)")

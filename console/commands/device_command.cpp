@@ -295,7 +295,7 @@ void register_monitor(CLI::App& family) {
       ->check(finite_range(0.0, 1.0));
   cmd->add_option("--seed", o->seed, "Seed of the injected faults and the emulator's noise")->check(unsigned_64())->capture_default_str();
   cmd->add_option("--calibration", o->calibration, "Calibration file (JSON; default: the board's compiled-in one)");
-  cmd->add_option("--record", o->record, "Write every raw report to this file (text, timestamped)");
+  cmd->add_option("--record", o->record, "Write every raw report to this file (text, timestamped)")->check(nonempty_path());
   cmd->add_flag("--json", o->json, "Print only a JSON summary at the end");
   add_hid_options(*cmd, o->hid);
   cmd->callback([o] { run_monitor(*o); });

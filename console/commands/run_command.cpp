@@ -124,11 +124,12 @@ void register_run(CLI::App& app) {
   cmd->add_option("--procedure", o->procedure, "Built-in procedure (demo, turp) or a procedure file")->check(procedure_name_or_file())->capture_default_str();
   cmd->add_option("--seconds", o->seconds, "Simulated seconds (default: the procedure's length)")->check(positive_up_to(86400.0));
   cmd->add_flag("--realtime", o->realtime, "Real time: the device link on its own thread, ticks at their deadlines");
-  cmd->add_option("--report", o->report, "Write the JSON report here");
-  cmd->add_option("--trace", o->trace, "Write a Chrome trace-event JSON (opens in Perfetto)");
-  cmd->add_option("--record", o->record, "Record the session to FILE (replay with `resecto replay FILE --verify`)");
+  cmd->add_option("--report", o->report, "Write the JSON report here")->check(nonempty_path());
+  cmd->add_option("--trace", o->trace, "Write a Chrome trace-event JSON (opens in Perfetto)")->check(nonempty_path());
+  cmd->add_option("--record", o->record, "Record the session to FILE (replay with `resecto replay FILE --verify`)")->check(nonempty_path());
   cmd->add_option("--export-surface", o->export_surface,
-                  "At the end, write the remaining tissue's surface at rest, in millimetres (.off, .obj, .ply, .stl)");
+                  "At the end, write the remaining tissue's surface at rest, in millimetres (.off, .obj, .ply, .stl)")
+      ->check(nonempty_path());
   add_parameter_option(*cmd, o->sets);
   cmd->add_option("--triangles", o->triangles, "Prostate surface triangles")->check(CLI::Range(200, 1000000))->capture_default_str();
   cmd->add_option("--collision-hz", o->collision_hz, "Collision steps per second")->check(CLI::Range(10, 1000))->capture_default_str();

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "console/commands/checked_options.h"
 #include "console/commands/command_registry.h"
 #include "console/score/debrief_html.h"
 #include "console/score/rescore.h"
@@ -130,8 +131,8 @@ void register_score(CLI::App& app) {
   cmd->add_option("FILE", o->files, "Recordings (from `run --record`)");
   cmd->add_option("--compare", o->compare, "Two recordings side by side (trainee and expert); needs --html")->expected(2);
   cmd->add_flag("--json", o->json, "Print the metrics of every recording (and the skipped ones) as JSON");
-  cmd->add_option("--csv", o->csv, "Write one row per recording here (a cohort table)");
-  cmd->add_option("--html", o->html, "Write the debrief page here (a directory of pages when several FILEs are given)");
+  cmd->add_option("--csv", o->csv, "Write one row per recording here (a cohort table)")->check(nonempty_path());
+  cmd->add_option("--html", o->html, "Write the debrief page here (a directory of pages when several FILEs are given)")->check(nonempty_path());
   cmd->add_flag("--quiet", o->quiet, "No progress on standard error");
   cmd->callback([o] { score(*o); });
 }

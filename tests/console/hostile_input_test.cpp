@@ -109,6 +109,17 @@ TEST_F(HostileInput, MissingInputsAndUnknownNamesAreUsageErrors) {
   EXPECT_FALSE(std::filesystem::exists(path("out.rsrec")));
 }
 
+TEST_F(HostileInput, EmptyOutputPathsAreUsageErrors) {
+  // An output given as '' read as no output at all: the command succeeded having written nothing.
+  for (const std::string& args : {collide_args(arg("p.off")) + " --pairs ''", std::string("run --headless --seconds 0.1 --report ''"),
+                                  std::string("run --headless --seconds 0.1 --trace ''"), std::string("run --headless --seconds 0.1 --record ''"),
+                                  std::string("run --headless --seconds 0.1 --export-surface ''"), std::string("score --csv '' x.rsrec")}) {
+    const CommandOutput run = run_resecto(args);  // the shell gives resecto the empty word
+    EXPECT_EQ(run.exit_code, 2) << args << ": " << run.err;
+    expect_clean_failure(run, "an empty path names no file", args);
+  }
+}
+
 TEST_F(HostileInput, OffHeadersWithoutUsableCountsAreBoundedErrors) {
   const std::pair<const char*, std::string> cases[] = {
       {"empty_header.off", "OFF"},
