@@ -1,6 +1,8 @@
-// Range checks for numeric command-line options that NaN and infinity cannot pass. CLI11's
-// CLI::Range compares `value < min || value > max`, which is false for NaN, so `--seconds nan`
-// passed it; it also prints bounds rounded to six digits ("230.0001 is outside [0, 230]").
+// Checks of command-line options that CLI11's own validators get wrong or leave out, so that a command
+// line that cannot be run exits 2 before anything runs (docs/commands.md, "Bad input and output files").
+// Numbers: CLI11's CLI::Range compares `value < min || value > max`, which is false for NaN, so
+// `--seconds nan` passed it; it also prints bounds rounded to six digits ("230.0001 is outside
+// [0, 230]"). Paths: a missing input, an empty output path, an unknown procedure or parameter.
 #pragma once
 
 #include <algorithm>
@@ -11,10 +13,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include "rtcore/base/checked_number.h"
 #include "rtcore/scenes/procedure.h"
 #include "rtcore/tissue/tissue_parameters.h"
-
-#include "rtcore/base/checked_number.h"
 
 namespace resecto::cli {
 

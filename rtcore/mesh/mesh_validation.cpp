@@ -13,6 +13,9 @@
 #include <tuple>
 #include <vector>
 
+#include <glm/common.hpp>
+#include <glm/vector_relational.hpp>
+
 #include "rtcore/base/units.h"
 #include "rtcore/geometry/triangle_triangle.h"
 
@@ -245,13 +248,26 @@ double winding_number(const TriangleMesh& mesh, std::span<const std::uint32_t> f
 /// solids overlapping (its volume counted twice, and lost when tetrahedralized), and a cavity,
 /// wound inward, is refused with the orientation. So no shell may lie inside another.
 Status check_no_nested_shells(const TriangleMesh& mesh, DisjointSets& components, const std::vector<std::uint32_t>& component_first_face) {
-  std::map<std::uint32_t, std::vector<std::uint32_t>> shells;  // by component root, in order: the same report every run
-  for (std::uint32_t f = 0; f < mesh.triangle_count(); ++f) shells[components.find(mesh.triangles[f][0])].push_back(f);
-  for (const auto& [inner_root, inner_faces] : shells) {
-    // The shells do not intersect (checked before), so one vertex tells where the whole shell is.
-    const Vec3& probe = mesh.positions[mesh.triangles[inner_faces.front()][0]];
-    for (const auto& [outer_root, outer_faces] : shells) {
-      if (outer_root == inner_root || winding_number(mesh, outer_faces, probe) < 0.5) continue;
+  struct Shell {
+    std::vector<std::uint32_t> faces;
+    Vec3 low{1e300}, high{-1e300};
+  };
+  std::map<std::uint32_t, Shell> shells;  // by component root, in order: the same report every run
+  for (std::uint32_t f = 0; f < mesh.triangle_count(); ++f) {
+    Shell& shell = shells[components.find(mesh.triangles[f][0])];
+    shell.faces.push_back(f);
+    for (const std::uint32_t v : mesh.triangles[f]) {
+      shell.low = glm::min(shell.low, mesh.positions[v]);
+      shell.high = glm::max(shell.high, mesh.positions[v]);
+    }
+  }
+  for (const auto& [inner_root, inner] : shells) {
+    // The shells do not intersect (checked before), so one vertex tells where the whole shell is;
+    // only a shell whose box holds it can hold it (many small shells then cost little).
+    const Vec3& probe = mesh.positions[mesh.triangles[inner.faces.front()][0]];
+    for (const auto& [outer_root, outer] : shells) {
+      if (outer_root == inner_root || glm::any(glm::lessThan(probe, outer.low)) || glm::any(glm::greaterThan(probe, outer.high))) continue;
+      if (winding_number(mesh, outer.faces, probe) < 0.5) continue;
       return Error{"nested shells: the component containing " + face_name(component_first_face[inner_root]) + " lies inside the component containing " +
                    face_name(component_first_face[outer_root]) + "; a solid with a cavity is not read (each component must be a solid of its own, outside the others)"};
     }
