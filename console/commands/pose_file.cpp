@@ -3,15 +3,30 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
-#include <cstdlib>
+#include <optional>
 #include <sstream>
+#include <string>
+#include <string_view>
 
 #include <glm/matrix.hpp>
 
 #include "rtcore/base/checked_number.h"
 
 namespace resecto::cli {
+
+namespace {
+
+/// "nan", "inf", "-Infinity" and the like: a number, but not a finite one.
+bool names_a_non_finite_number(std::string_view word) {
+  if (!word.empty() && (word.front() == '+' || word.front() == '-')) word.remove_prefix(1);
+  std::string lower(word.substr(0, 3));
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return lower == "nan" || lower == "inf";
+}
+
+}  // namespace
 
 Result<std::vector<RigidPose>> parse_poses(const std::string& text, const std::string& source) {
   std::vector<RigidPose> poses;
@@ -27,14 +42,18 @@ Result<std::vector<RigidPose>> parse_poses(const std::string& text, const std::s
     for (;;) {
       while (*cursor == ' ' || *cursor == '\t' || *cursor == ',' || *cursor == '\r') ++cursor;
       if (*cursor == '\0') break;
-      char* end = nullptr;
-      const double v = std::strtod(cursor, &end);
-      if (end == cursor) return Error{where + "'" + std::string(cursor).substr(0, 20) + "' is not a number"};
-      if (!std::isfinite(v)) {
-        return Error{where + "number " + std::to_string(count + 1) + " of 12, '" + std::string(cursor, static_cast<std::size_t>(end - cursor)) + "', is not finite"};
+      // Decimal numbers only, as the mesh readers and the procedure files take them: strtod also took
+      // hexadecimal ("0x3") and read the number at the front of a word ("1.5abc").
+      const char* end = cursor;
+      while (*end != '\0' && *end != ' ' && *end != '\t' && *end != ',' && *end != '\r') ++end;
+      const std::string_view word(cursor, static_cast<std::size_t>(end - cursor));
+      const std::optional<double> v = parse_finite(word);
+      if (!v && names_a_non_finite_number(word)) {
+        return Error{where + "number " + std::to_string(count + 1) + " of 12, '" + std::string(word) + "', is not finite"};
       }
+      if (!v) return Error{where + "'" + std::string(word.substr(0, 20)) + "' is not a number"};
       if (count == 12) return Error{where + "more than 12 numbers (expected r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz)"};
-      values[count++] = v;
+      values[count++] = *v;
       cursor = end;
     }
     if (count != 12) {

@@ -151,11 +151,10 @@ Result<Procedure> parse_procedure(const std::string& text, const std::string& so
     std::string word;
     while (words >> word) {
       if (count == 8) return line_error(source_name, number, "more than 8 columns");
-      char* end = nullptr;
-      v[count] = std::strtod(word.c_str(), &end);
-      if (end == word.c_str() || *end != '\0' || !std::isfinite(v[count])) {
-        return line_error(source_name, number, std::string(kColumns[count]) + " is not a number: '" + word + "'");
-      }
+      // Decimal only, as the mesh readers take numbers: strtod also took hexadecimal ("0x3").
+      const std::optional<double> parsed = parse_finite(word);
+      if (!parsed) return line_error(source_name, number, std::string(kColumns[count]) + " is not a number: '" + word + "'");
+      v[count] = *parsed;
       ++count;
     }
     if (count != 8) {

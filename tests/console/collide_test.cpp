@@ -195,6 +195,16 @@ TEST(CollideCommand, MalformedPosesLineIsNamed) {
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.err.find("poses.txt:1: number 12 of 12, 'nan', is not finite"), std::string::npos) << result.err;
 
+  // Decimal numbers only, whole words: strtod took "0x3" as 3 and "1.5abc" as 1.5 then "abc".
+  for (const char* word : {"0x3", "1.5abc"}) {
+    std::ofstream(f.poses) << "1 0 0 0 0 1 0 0 0 0 1 " << word << "\n";
+    result = run_resecto(common_args(f));
+    EXPECT_NE(result.exit_code, 0);
+    EXPECT_NE(result.err.find(std::string("poses.txt:1: '") + word + "' is not a number"), std::string::npos) << result.err;
+  }
+  std::ofstream(f.poses) << "1,0,0,0, 0,1,0,0, 0,0,1,0.5\n";  // commas still separate
+  EXPECT_EQ(run_resecto(common_args(f)).exit_code, 0);
+
   std::ofstream(f.poses) << "2 0 0 0 0 1 0 0 0 0 1 0\n";
   result = run_resecto(common_args(f));
   EXPECT_NE(result.exit_code, 0);
