@@ -108,7 +108,7 @@ inline CLI::Validator existing_path() {
 inline CLI::Validator procedure_name_or_file() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
-        if (text.find('/') == std::string::npos && text.find('.') == std::string::npos) {
+        if (names_a_builtin_procedure(text)) {
           const Result<Procedure> builtin = builtin_procedure(text);
           return builtin ? std::string() : builtin.error();
         }

@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <optional>
 #include <sstream>
 
@@ -198,11 +197,12 @@ Result<Procedure> builtin_procedure(const std::string& name) {
   return Error{"no built-in procedure '" + name + "' (built-in: demo, turp)"};
 }
 
+bool names_a_builtin_procedure(const std::string& name_or_path) {
+  return name_or_path.find('/') == std::string::npos && name_or_path.find('.') == std::string::npos;
+}
+
 Result<Procedure> find_procedure(const std::string& name_or_path) {
-  if (name_or_path.find('/') == std::string::npos && name_or_path.find('.') == std::string::npos) {
-    return builtin_procedure(name_or_path);
-  }
-  return load_procedure(name_or_path);
+  return names_a_builtin_procedure(name_or_path) ? builtin_procedure(name_or_path) : load_procedure(name_or_path);
 }
 
 }  // namespace resecto

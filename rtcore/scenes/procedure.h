@@ -45,6 +45,8 @@ Result<Procedure> parse_procedure(const std::string& text, const std::string& so
 Result<Procedure> load_procedure(const std::filesystem::path& path);
 /// The built-in procedure called `name` ("demo" or "turp"), or an error listing the built-in names.
 Result<Procedure> builtin_procedure(const std::string& name);
+/// Whether find_procedure() takes `name_or_path` as a built-in name (no '/' and no '.') or a file path.
+bool names_a_builtin_procedure(const std::string& name_or_path);
 /// A built-in name or a file path.
 Result<Procedure> find_procedure(const std::string& name_or_path);
 

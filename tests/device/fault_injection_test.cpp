@@ -172,9 +172,20 @@ struct FaultyBoard {
   firmware::Emulator emulator;
   EmulatorTransport board{emulator, clock};
   FaultInjectingTransport faulty;
-};
+  std::array<std::uint8_t, kMaxRawReportBytes> buffer{};
 
-constexpr std::int64_t kReadTimeoutNs = 20 * kNanosecondsPerMillisecond;
+  static constexpr std::int64_t kReadTimeoutNs = 20 * kNanosecondsPerMillisecond;
+  /// Opens the wrapper (once) and reads one report with kReadTimeoutNs: the read must end within it.
+  Result<std::size_t> read_within_timeout() {
+    if (!faulty.is_open()) {
+      EXPECT_TRUE(faulty.open());
+    }
+    const std::int64_t start_ns = clock.now_ns();
+    Result<std::size_t> got = faulty.read_report(buffer, kReadTimeoutNs);
+    EXPECT_LE(clock.now_ns() - start_ns, kReadTimeoutNs + kNanosecondsPerMillisecond);
+    return got;
+  }
+};
 
 TEST(FaultInjection, EveryReportDroppedStillEndsEachReadAtItsTimeout) {
   // A read skipped dropped reports until one came through: with every one dropped it never returned,
@@ -182,18 +193,13 @@ TEST(FaultInjection, EveryReportDroppedStillEndsEachReadAtItsTimeout) {
   FaultConfig config;
   config.drop_probability = 1.0;
   FaultyBoard setup(config);
-  VirtualHostClock& clock = setup.clock;
-  FaultInjectingTransport& faulty = setup.faulty;
-  ASSERT_TRUE(faulty.open());
-  std::array<std::uint8_t, kMaxRawReportBytes> buffer{};
   for (int read = 0; read < 5; ++read) {
-    const std::int64_t start_ns = clock.now_ns();
-    const Result<std::size_t> got = faulty.read_report(buffer, kReadTimeoutNs);
+    SCOPED_TRACE(read);
+    const Result<std::size_t> got = setup.read_within_timeout();
     ASSERT_TRUE(got);
     EXPECT_EQ(*got, 0u) << "nothing gets through";
-    EXPECT_LE(clock.now_ns() - start_ns, kReadTimeoutNs + kNanosecondsPerMillisecond) << "read " << read;
   }
-  EXPECT_GT(faulty.injected().dropped, 50u);
+  EXPECT_GT(setup.faulty.injected().dropped, 50u);
 }
 
 TEST(FaultInjection, EveryReportDelayedStillFlowsInOrderWithABoundedBacklog) {
@@ -202,20 +208,15 @@ TEST(FaultInjection, EveryReportDelayedStillFlowsInOrderWithABoundedBacklog) {
   FaultConfig config;
   config.delay_probability = 1.0;
   FaultyBoard setup(config);
-  VirtualHostClock& clock = setup.clock;
-  FaultInjectingTransport& faulty = setup.faulty;
-  ASSERT_TRUE(faulty.open());
-  std::array<std::uint8_t, kMaxRawReportBytes> buffer{};
   int delivered = 0;
   for (int read = 0; read < 200; ++read) {
-    const std::int64_t start_ns = clock.now_ns();
-    const Result<std::size_t> got = faulty.read_report(buffer, kReadTimeoutNs);
+    SCOPED_TRACE(read);
+    const Result<std::size_t> got = setup.read_within_timeout();
     ASSERT_TRUE(got);
-    EXPECT_LE(clock.now_ns() - start_ns, kReadTimeoutNs + kNanosecondsPerMillisecond) << "read " << read;
     if (*got > 0) ++delivered;
   }
   EXPECT_GT(delivered, 150) << "most reads deliver a report, late";
-  EXPECT_LE(faulty.injected().delayed, static_cast<std::uint64_t>(delivered) + 17u) << "at most the held reports are still waiting";
+  EXPECT_LE(setup.faulty.injected().delayed, static_cast<std::uint64_t>(delivered) + 17u) << "at most the held reports are still waiting";
 }
 
 }  // namespace
