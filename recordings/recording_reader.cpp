@@ -29,9 +29,8 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
   r.scan_ = scan_chunks(r.bytes_);
   if (!r.scan_.signature_ok) {
     // An empty file, or one cut inside the signature, is a recording cut short, not some other file.
-    const std::size_t start = std::min(r.bytes_.size(), sizeof kFileSignature);
     if (r.bytes_.empty()) return Error{name + ": the file is empty (a recording cut off before its first byte)"};
-    if (r.bytes_.size() < sizeof kFileSignature && std::equal(r.bytes_.begin(), r.bytes_.begin() + static_cast<std::ptrdiff_t>(start), kFileSignature)) {
+    if (r.bytes_.size() < sizeof kFileSignature && std::equal(r.bytes_.begin(), r.bytes_.end(), kFileSignature)) {
       return Error{name + ": truncated: " + std::to_string(r.bytes_.size()) + " bytes, cut inside the recording's " +
                    std::to_string(sizeof kFileSignature) + "-byte signature"};
     }
