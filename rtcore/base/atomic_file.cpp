@@ -29,6 +29,18 @@ std::filesystem::path temporary_beside(const std::filesystem::path& target) {
   return target.parent_path() / leaf;
 }
 
+/// Creates a new temporary beside `target` (never another writer's) and names it in `created`: its
+/// descriptor, or -1 with errno set (EEXIST: no free name was found).
+int create_temporary_beside(const std::filesystem::path& target, std::filesystem::path& created) {
+  for (int attempt = 0; attempt < 16; ++attempt) {
+    created = temporary_beside(target);
+    const int fd = ::open(created.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0 || errno != EEXIST) return fd;
+  }
+  errno = EEXIST;
+  return -1;
+}
+
 /// The checks every output path gets: a file name, and only a regular file in the way (renaming over
 /// a device or a folder would destroy it). `stat_errno` is 0 when the target exists (`existing` is
 /// its stat), else stat's errno.
@@ -66,17 +78,13 @@ Status AtomicFile::open(const std::filesystem::path& target) {
   } else if (stat_errno != ENOENT) {
     return failure("cannot inspect the target", stat_errno);
   }
-  for (int attempt = 0; attempt < 16; ++attempt) {
-    temporary_ = temporary_beside(target);
-    fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd_ >= 0) break;
-    if (errno != EEXIST) {
-      const int error_number = errno;
-      temporary_.clear();
-      return failure("cannot create a file in its folder", error_number);
-    }
+  fd_ = create_temporary_beside(target, temporary_);
+  if (fd_ < 0) {
+    const int error_number = errno;
+    temporary_.clear();
+    if (error_number == EEXIST) return Error{target.string() + ": cannot pick a temporary name beside it"};
+    return failure("cannot create a file in its folder", error_number);
   }
-  if (fd_ < 0) return Error{target.string() + ": cannot pick a temporary name beside it"};
   return Ok{};
 }
 
@@ -143,6 +151,17 @@ Status check_writable_folder(const std::filesystem::path& folder, const std::fil
   if (::access(folder.c_str(), W_OK | X_OK) != 0) {
     return Error{output.string() + ": cannot write in its folder " + folder.string() + ": " + std::strerror(errno)};
   }
+  // access() answers from the permission bits, which root passes everywhere; a folder of /proc or
+  // /sys, a full inode table or a mount that takes no new files says so only when a file is made.
+  // So one is: the writer's own kind of temporary, removed at once.
+  std::filesystem::path probe;
+  const int fd = create_temporary_beside(folder / output.filename(), probe);
+  if (fd < 0) {
+    if (errno == EEXIST) return Ok{};  // the folder holds files enough to have no free name: it takes them
+    return Error{output.string() + ": cannot create a file in its folder " + folder.string() + ": " + std::strerror(errno)};
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
   return Ok{};
 }
 

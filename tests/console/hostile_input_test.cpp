@@ -157,6 +157,14 @@ TEST_F(HostileInput, CollideNeverWritesItsPairsOverAnInput) {
   expect_clean_failure(run_resecto_bounded(collide_args(arg("p.off")) + " --pairs " + arg("missing/pairs.csv")), "does not exist", "missing folder");
 }
 
+TEST_F(HostileInput, AnOutputFolderThatTakesNoFileIsRefusedBeforeTheRun) {
+  // /proc passes access(W_OK) for root but makes no file: the full turp procedure (minutes) used to
+  // run to its end and only then fail to write its surface or report.
+  for (const std::string option : {"--export-surface /proc/resecto.off", "--report /proc/resecto.json", "--trace /proc/resecto.trace.json"}) {
+    expect_clean_failure(run_resecto_bounded("run --headless --procedure turp " + option), "cannot create a file in its folder /proc", option);
+  }
+}
+
 TEST_F(HostileInput, CollideWithAToolFarBelowAMillimetreStaysBounded) {
   // A triangle 1e-110 mm across: its box's volume underflowed to zero, and so did the tool grids'
   // cells, which then numbered 65,537 a side (terabytes; the run grew past 12 GB before it was killed).

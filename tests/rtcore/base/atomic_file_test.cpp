@@ -84,6 +84,11 @@ TEST(OutputPath, IsCheckedBeforeTheWorkThatWouldWriteIt) {
   EXPECT_NE(check_output_path(dir / "sub").error().find("is a folder"), std::string::npos);
   EXPECT_NE(check_output_path(dir / "no" / "report.json").error().find("does not exist"), std::string::npos);
   EXPECT_NE(check_output_path(dir / "input.rsrec" / "report.json").error().find("is not a folder"), std::string::npos);
+  // A folder whose permission bits let root (and so access()) in, but that takes no new file.
+  const Status proc = check_output_path("/proc/report.json");
+  ASSERT_FALSE(proc.ok());
+  EXPECT_NE(proc.error().find("cannot create a file in its folder /proc"), std::string::npos) << proc.error();
+  EXPECT_EQ(entries(dir), 3u) << "the probe file was left behind";  // input.rsrec, linked.rsrec, sub
   // Two outputs of one command on one path, even one not yet written; outputs not asked for are empty.
   const std::vector<std::filesystem::path> outputs{dir / "a.json", "", dir / "sub" / ".." / "a.json"};
   const Status twice = check_output_paths(outputs);
