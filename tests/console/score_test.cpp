@@ -183,6 +183,32 @@ TEST(ScoreCommand, ARecoveredCutRecordingIsSkippedLikeTheCutOne) {
   EXPECT_EQ(both["scored"][0]["metrics"], both["scored"][1]["metrics"]);
 }
 
+// Cut between two chunks (a run killed between the recorder's writes), a file holds no damage and reads
+// as whole up to its end; only the summary the recorder writes when it closes the file says the
+// procedure ended there. Such a file, and a recovery of it, used to be scored as a whole procedure.
+TEST(ScoreCommand, ARecordingCutBetweenChunksIsSkippedAsNeverClosed) {
+  const auto dir = scratch_directory("score_cut_between_chunks");
+  const auto file = dir / "whole.resecto";
+  run_and_record("demo", file, " --seconds 1.2");
+  const std::string bytes = read_text(file);
+  const std::size_t summary = bytes.rfind(std::string("CHNK\x06\x00", 6));
+  const std::size_t last_keyframe = bytes.rfind(std::string("CHNK\x05\x00", 6));
+  ASSERT_NE(summary, std::string::npos);
+  ASSERT_NE(last_keyframe, std::string::npos);
+  const auto before_summary = dir / "before_summary.resecto", before_keyframe = dir / "before_keyframe.resecto";
+  const auto recovered = dir / "recovered.resecto";
+  std::ofstream(before_summary, std::ios::binary) << bytes.substr(0, summary);
+  std::ofstream(before_keyframe, std::ios::binary) << bytes.substr(0, last_keyframe);
+  ASSERT_EQ(run_resecto("rec recover " + before_keyframe.string() + " " + recovered.string()).exit_code, 0);
+  const CommandOutput scored = run_resecto("score --quiet " + before_summary.string() + " " + before_keyframe.string() + " " + recovered.string());
+  EXPECT_EQ(scored.exit_code, 1);
+  for (const auto& path : {before_summary, before_keyframe, recovered}) {
+    EXPECT_NE(scored.err.find("skipped: " + path.string() + ": the recorder never closed it"), std::string::npos) << scored.err;
+  }
+  EXPECT_NE(scored.err.find("3 of 3 recordings skipped"), std::string::npos) << scored.err;
+  EXPECT_EQ(score_json(file.string()).at("scored").size(), 1u);
+}
+
 TEST(ScoreCommand, RecordingsOfOneNameFromTwoFoldersGetAPageEach) {
   const auto dir = scratch_directory("score_same_name");
   std::filesystem::create_directories(dir / "trainee1");
