@@ -2,14 +2,17 @@
 #include "console/commands/console_command.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <stdexcept>
+#include <vector>
 
 #include "console/commands/checked_options.h"
 #include "console/commands/command_registry.h"
 #include "console/commands/parameter_options.h"
 #include "console/gui/console_app.h"
 #include "console/gui/tissue_presets.h"
+#include "rtcore/base/atomic_file.h"
 
 namespace resecto::cli {
 
@@ -64,7 +67,15 @@ void open_console(const ConsoleCliOptions& o) {
     throw std::runtime_error("no display (neither DISPLAY nor WAYLAND_DISPLAY is set): run the console under X or Wayland, "
                              "or use `resecto run --headless`");
   }
+  // Before the window opens: an output that is one of the session's inputs would destroy it, and a
+  // folder that is missing or takes no file would lose the session's output only at its end.
+  std::vector<std::filesystem::path> inputs{o.actions, o.preset, o.replay, o.calibration};
+  if (!names_a_builtin_procedure(o.procedure)) inputs.emplace_back(o.procedure);
+  std::erase_if(inputs, [](const std::filesystem::path& p) { return p.empty(); });
+  const std::vector<std::filesystem::path> outputs{o.record, o.report, o.screenshot};
+  if (Status writable = check_output_paths(outputs, inputs); !writable) throw std::runtime_error(writable.error());
   gui::ConsoleOptions options;
+  options.input_paths = inputs;
   Result<Procedure> procedure = find_procedure(o.procedure);
   if (!procedure) throw std::runtime_error(procedure.error());
   options.core.device.procedure = std::move(*procedure);

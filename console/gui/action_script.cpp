@@ -17,6 +17,10 @@ bool parse_number(const std::string& text, double& out) {
   return error == std::errc{} && ptr == end && std::isfinite(out);
 }
 
+/// The largest frame number a script may name (--frames' bound) and the largest drag, in pixels.
+constexpr double kMaxFrame = 1e8;
+constexpr double kMaxDragPixels = 1e5;
+
 struct VerbSpec {
   const char* name;
   ActionVerb verb;
@@ -48,8 +52,9 @@ Result<std::vector<Action>> parse_actions(const std::string& text, const std::st
     if (words.empty()) continue;
     const std::string where = source_name + ":" + std::to_string(number) + ": ";
     double frame = 0.0;
-    if (words.size() < 3 || words[0] != "frame" || !parse_number(words[1], frame) || frame < 0 || frame != std::floor(frame)) {
-      return Error{where + "expected 'frame N VERB ...' with N a whole number of frames, got '" + line + "'"};
+    // The bound is --frames' own: a larger number, past 2^64 above all, would not convert to a frame.
+    if (words.size() < 3 || words[0] != "frame" || !parse_number(words[1], frame) || frame < 0 || frame != std::floor(frame) || frame > kMaxFrame) {
+      return Error{where + "expected 'frame N VERB ...' with N a whole number of frames up to 100000000, got '" + line + "'"};
     }
     const VerbSpec* spec = nullptr;
     for (const VerbSpec& v : kVerbs)
@@ -80,7 +85,11 @@ Result<std::vector<Action>> parse_actions(const std::string& text, const std::st
         break;
       case ActionVerb::kDrag:
         if (a.words[0] != "endoscope" && a.words[0] != "outside") return Error{where + "drag: expected endoscope or outside, got '" + a.words[0] + "'"};
-        if (!parse_number(a.words[1], a.value) || !parse_number(a.words[2], a.value2)) return Error{where + "drag: DX and DY must be numbers"};
+        // Pixels, at most a few screens' worth: a larger drag overflowed the camera's floats and blanked the view.
+        if (!parse_number(a.words[1], a.value) || !parse_number(a.words[2], a.value2) || std::abs(a.value) > kMaxDragPixels ||
+            std::abs(a.value2) > kMaxDragPixels) {
+          return Error{where + "drag: DX and DY must be numbers of pixels within +-100000"};
+        }
         break;
       case ActionVerb::kStep:
         if (!parse_number(a.words[0], a.value) || a.value < 1 || a.value != std::floor(a.value) || a.value > 1e7) {

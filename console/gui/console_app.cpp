@@ -18,12 +18,12 @@
 #include <cstdlib>
 #include <thread>
 
-#include "console/gui/atomic_file.h"
 #include "console/gui/console_controller.h"
 #include "console/gui/console_panels.h"
 #include "console/gui/scene_renderer.h"
 #include "console/gui/screenshot.h"
 #include "console/headless/headless_run.h"
+#include "rtcore/base/atomic_file.h"
 #include "rtcore/base/units.h"
 #include "rtcore/core/thread_priority.h"
 
@@ -54,7 +54,9 @@ class ConsoleWindow {
       : window_(window), options_(options), session_(session), renderer_(renderer), settings_(options.settings),
         controller_(session, ui_, settings_), actions_(std::move(actions)) {
     ui_.manual = ManualMotion(options.core.device.manual_start);
-    if (!options.record_path.empty()) controller_.start_recording(options.record_path);
+    controller_.protect_inputs(options.input_paths);
+    // Checked with the other outputs before the window opened (open_console): it starts.
+    if (!options.record_path.empty()) (void)controller_.start_recording(options.record_path);
     for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
       ui_.slider_values[static_cast<std::size_t>(spec.id)] = settings_.parameters.get(spec.id);
     }
@@ -128,8 +130,8 @@ Status ConsoleWindow::apply_action(const Action& a) {
     case ActionVerb::kRecord:
       if (a.words[0] == "stop") {
         controller_.stop_recording();
-      } else {
-        controller_.start_recording(a.words[0]);
+      } else if (Status started = controller_.start_recording(a.words[0]); !started) {
+        return fail(started.error());
       }
       break;
     case ActionVerb::kReplay:
@@ -139,7 +141,10 @@ Status ConsoleWindow::apply_action(const Action& a) {
         return fail(done.error());
       }
       break;
-    case ActionVerb::kScreenshot: screenshots_due_.push_back(a.words[0]); break;
+    case ActionVerb::kScreenshot:
+      if (Status writable = controller_.check_output(a.words[0]); !writable) return fail(writable.error());
+      screenshots_due_.push_back(a.words[0]);
+      break;
     case ActionVerb::kPreset:
       if (Status done = a.words[0] == "save" ? controller_.save_preset(a.words[1]) : controller_.load_preset(a.words[1]); !done) {
         return fail(done.error());
@@ -528,6 +533,11 @@ Result<ordered_json> run_console(const ConsoleOptions& options) {
     session.start();
     ran = console.open_initial_replay();
     if (ran) ran = console.run();
+    const std::vector<std::string>& taken = console.ui().screenshots;
+    if (ran && !options.screenshot_path.empty() && std::find(taken.begin(), taken.end(), options.screenshot_path) == taken.end()) {
+      ran = Error{options.screenshot_path + ": not written: the session ended after " + std::to_string(console.ui().frame) +
+                  " frames, before the last of --frames " + std::to_string(options.frames) + " (a quit action or the window closed)"};
+    }
     session.stop();
     session.frames().update();  // the core's last frame: the recording's final figures
     console.ui().replay.wait_for_verification();
@@ -543,7 +553,7 @@ Result<ordered_json> run_console(const ConsoleOptions& options) {
   glfwDestroyWindow(window);
   if (!ran) return Error{ran.error()};
   if (!options.report_path.empty()) {
-    if (Status written = write_text_atomically(options.report_path, report.dump(2) + "\n", "report"); !written) return Error{written.error()};
+    if (Status written = write_file_atomically(options.report_path, report.dump(2) + "\n"); !written) return Error{written.error()};
   }
   return report;
 }

@@ -5,7 +5,9 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -24,6 +26,9 @@ struct ConsoleOptions {
   std::string report_path;      ///< --report: the session's JSON report
   std::string record_path;      ///< --record: record the session from its first tick
   std::string replay_path;      ///< --replay: open this recording in the replay panel
+  /// Every file the session reads (--actions, --preset, --replay, --calibration, a procedure file):
+  /// no recording, screenshot, preset or report of the session may be written over one.
+  std::vector<std::filesystem::path> input_paths;
   double slow_frame_ms = 0.0;   ///< every frame takes this much longer (tests of frame pacing)
   std::uint64_t slow_frame_every = 1;  ///< only every Nth frame is slowed (the others are the comparison)
   bool vsync = true;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "console/gui/tissue_presets.h"
+#include "rtcore/base/atomic_file.h"
 #include "rtcore/base/units.h"
 
 namespace resecto::gui {
@@ -69,11 +70,23 @@ Status ConsoleController::set_by_key(const std::string& key, double value) {
   return Ok{};
 }
 
-void ConsoleController::start_recording(const std::string& path) {
+Status ConsoleController::check_output(const std::string& path) const {
+  std::vector<std::filesystem::path> inputs = inputs_;
+  if (!ui_.replay_path.empty()) inputs.emplace_back(ui_.replay_path);
+  return check_output_path(path, inputs);
+}
+
+Status ConsoleController::start_recording(const std::string& path) {
+  if (Status writable = check_output(path); !writable) {
+    ui_.message = writable.error();
+    return writable;
+  }
   CoreControl control;
   control.kind = CoreControlKind::kRecordStart;
   control.path = path;
-  if (send(control)) ui_.recording_started_ns = FrameProfiler::now_ns();
+  if (!send(control)) return Error{ui_.message};
+  ui_.recording_started_ns = FrameProfiler::now_ns();
+  return Ok{};
 }
 
 void ConsoleController::stop_recording() { send({CoreControlKind::kRecordStop, {}, 0, 0, 1.0, {}}); }
@@ -111,7 +124,8 @@ void ConsoleController::step(std::uint32_t ticks) { send({CoreControlKind::kStep
 void ConsoleController::set_speed(double speed) { send({CoreControlKind::kSpeed, {}, 0, 0, speed, {}}); }
 
 Status ConsoleController::save_preset(const std::string& path) {
-  Status saved = gui::save_preset(path, frame().status.parameters);
+  Status saved = check_output(path);
+  if (saved) saved = gui::save_preset(path, frame().status.parameters);
   ui_.preset_message = saved ? "saved " + path : saved.error();
   return saved;
 }

@@ -3,7 +3,9 @@
 // simulation become CoreControls for the core's next tick; nothing here writes into the core.
 #pragma once
 
+#include <filesystem>
 #include <string>
+#include <vector>
 
 #include "console/gui/console_state.h"
 
@@ -35,8 +37,15 @@ class ConsoleController {
   /// Moves the hand-driven device's yaw and pitch as a mouse drag across the endoscope image would.
   void drag_endoscope(float dx_pixels, float dy_pixels);
   bool manual_device() const;
-  /// Starts recording the live session to `path` (the core creates the file at its next tick).
-  void start_recording(const std::string& path);
+  /// Starts recording the live session to `path` (the core creates the file at its next tick), once
+  /// check_output() passes it.
+  Status start_recording(const std::string& path);
+  /// Whether `path` may be written: check_output_path(), with the session's files it reads (the
+  /// recording open for replay, and those of protect_inputs()) as inputs it would destroy.
+  Status check_output(const std::string& path) const;
+  /// Files the session reads (--actions, --preset, --replay): never written over by a recording,
+  /// screenshot or preset this session makes.
+  void protect_inputs(std::vector<std::filesystem::path> inputs) { inputs_ = std::move(inputs); }
   void stop_recording();
   /// Opens a recording in the replay panel and shows it in the views.
   Status open_replay(const std::string& path);
@@ -56,6 +65,7 @@ class ConsoleController {
   CoreSession& session_;
   ConsoleUi& ui_;
   ConsoleSettings& settings_;
+  std::vector<std::filesystem::path> inputs_;  // protect_inputs()
 };
 
 }  // namespace resecto::gui

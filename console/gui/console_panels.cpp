@@ -258,7 +258,9 @@ void draw_recording_panel(ConsoleController& console) {
     ImGui::SetNextItemWidth(260);
     if (ImGui::InputText("file##record", path, sizeof path)) ui.record_path = path;
     ImGui::SameLine();
-    if (ImGui::Button("Record")) console.start_recording(ui.record_path);
+    // A path that cannot be written is named below rather than left for the core to fail on.
+    if (ImGui::Button("Record")) ui.record_message = console.start_recording(ui.record_path) ? std::string() : ui.message;
+    if (!ui.record_message.empty()) ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.3f, 1.0f), "%s", ui.record_message.c_str());
     if (s.recordings_finished > 0) {
       ImGui::TextDisabled("last: %s, %.2f MB, %" PRIu64 " ticks, %" PRIu64 " keyframes, %" PRIu64 " lost", s.recording_path.data(),
                           static_cast<double>(s.recorded_bytes) / 1e6, s.recorded_ticks, s.recorded_keyframes, s.recording_lost);

@@ -4,10 +4,11 @@
 #include <stb_image_write.h>
 
 #include <cstdint>
-#include <system_error>
+#include <string>
 #include <vector>
 
 #include "console/gui/gl_api.h"
+#include "rtcore/base/atomic_file.h"
 
 namespace resecto::gui {
 
@@ -18,14 +19,13 @@ Status save_framebuffer_png(const std::filesystem::path& path, int width, int he
   glReadBuffer(GL_BACK);
   glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
   for (std::size_t i = 3; i < pixels.size(); i += 4) pixels[i] = 255;  // the window is opaque
-  const std::filesystem::path temporary = path.string() + ".tmp";
+  // Encoded in memory, then written by the one writer every output uses (rtcore/base/atomic_file.h):
+  // only a regular file is ever replaced, and every write, the fsync and the close are checked.
+  std::string png;
   stbi_flip_vertically_on_write(1);  // OpenGL's rows run bottom-up, PNG's top-down
-  const int written = stbi_write_png(temporary.string().c_str(), width, height, 4, pixels.data(), width * 4);
-  if (!written) return Error{path.string() + ": cannot write the screenshot"};
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) return Error{path.string() + ": cannot move the screenshot into place: " + error.message()};
-  return Ok{};
+  const auto append = [](void* context, void* data, int size) { static_cast<std::string*>(context)->append(static_cast<const char*>(data), static_cast<std::size_t>(size)); };
+  if (!stbi_write_png_to_func(append, &png, width, height, 4, pixels.data(), width * 4)) return Error{path.string() + ": cannot encode the screenshot"};
+  return write_file_atomically(path, png);
 }
 
 }  // namespace resecto::gui

@@ -1,6 +1,6 @@
 // Saving the console's window as a PNG: the framebuffer read with glReadPixels after a frame is
-// drawn, written with stb_image_write (Debian's libstb, already linked by Dear ImGui) to a
-// temporary file that is then renamed, so a reader never sees half a PNG.
+// drawn, encoded with stb_image_write (Debian's libstb, already linked by Dear ImGui) and written
+// through rtcore/base/atomic_file.h, so a reader never sees half a PNG and no device is replaced.
 #pragma once
 
 #include <filesystem>

@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "console/gui/atomic_file.h"
+#include "rtcore/base/atomic_file.h"
 #include "rtcore/base/json_text.h"
 #include "rtcore/base/text_file.h"
 
@@ -17,7 +17,7 @@ Status save_preset(const std::filesystem::path& path, const TissueParameters& pa
   for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
     preset["parameters"][std::string(spec.key)] = parameters.get(spec.id);
   }
-  return write_text_atomically(path, preset.dump(2) + "\n", "preset");
+  return write_file_atomically(path, preset.dump(2) + "\n");
 }
 
 Result<TissueParameters> load_preset(const std::filesystem::path& path, const TissueParameters& base) {

@@ -9,6 +9,7 @@
 // shows it and, scrubbed back, the uncut lining. Each test
 // skips, saying why, where no X server can be started.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <stb_image.h>
 
 #include <cmath>
@@ -414,6 +415,50 @@ TEST(ConsoleWindow, BadActionsAreClearErrors) {
   EXPECT_NE(range.exit_code, 0);
   EXPECT_NE(range.err.find("range.actions:1"), std::string::npos) << range.err;
   EXPECT_NE(range.err.find("out of range"), std::string::npos) << range.err;
+}
+
+// Audit 24's cases: the console's outputs went through writers of their own, which renamed over
+// /dev/null (it became a regular file) and over a FIFO, wrote over the recording being replayed, and
+// let a recording that could not be created, or a screenshot never taken, pass with exit 0.
+TEST(ConsoleWindow, OutputsNeverReplaceDevicesInputsOrFailSilently) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_outputs");
+  ASSERT_EQ(::mkfifo((dir / "fifo").c_str(), 0600), 0);
+  const std::string base = "console --triangles 1296 --width 800 --height 600 --frames 30 ";
+  const auto expect_refused = [&](const std::string& actions, const std::string& extra, const std::string& expected) {
+    SCOPED_TRACE(actions + extra);
+    std::ofstream(dir / "a.actions") << actions;
+    const CommandOutput run = run_in_xvfb(base + "--actions " + (dir / "a.actions").string() + extra, dir);
+    EXPECT_EQ(run.exit_code, 1) << run.err;
+    EXPECT_NE(run.err.find(expected), std::string::npos) << run.err;
+  };
+  expect_refused("frame 1 screenshot " + (dir / "fifo").string() + "\n", "", "a.actions:1: " + (dir / "fifo").string() + ": is not a regular file");
+  expect_refused("frame 1 preset save " + (dir / "fifo").string() + "\n", "", "is not a regular file");
+  expect_refused("frame 1 record " + (dir / "no" / "x.rsrec").string() + "\n", "", "does not exist");
+  expect_refused("frame 1 screenshot " + (dir / "a.actions").string() + "\n", "", "is the input");
+  expect_refused("frame 2 quit\n", " --screenshot " + (dir / "never.png").string(), "never.png: not written");
+  EXPECT_FALSE(std::filesystem::exists(dir / "never.png"));
+  struct stat fifo {};
+  ASSERT_EQ(::stat((dir / "fifo").c_str(), &fifo), 0);
+  EXPECT_TRUE(S_ISFIFO(fifo.st_mode)) << "the FIFO was replaced";
+
+  // Before the window opens: --record over the recording replayed, --report over the actions file.
+  const auto recorded = dir / "in.rsrec";
+  ASSERT_EQ(run_resecto("run --headless --triangles 1296 --seconds 0.5 --record " + recorded.string()).exit_code, 0);
+  const std::string original = read_text(recorded);
+  std::ofstream(dir / "q.actions") << "frame 3 quit\n";
+  const CommandOutput over_replay =
+      run_in_xvfb(base + "--replay " + recorded.string() + " --record " + recorded.string() + " --actions " + (dir / "q.actions").string(), dir);
+  EXPECT_EQ(over_replay.exit_code, 1);
+  EXPECT_NE(over_replay.err.find("is the input"), std::string::npos) << over_replay.err;
+  EXPECT_EQ(read_text(recorded), original);
+  const CommandOutput over_actions = run_in_xvfb(base + "--actions " + (dir / "q.actions").string() + " --report " + (dir / "q.actions").string(), dir);
+  EXPECT_EQ(over_actions.exit_code, 1);
+  EXPECT_EQ(read_text(dir / "q.actions"), "frame 3 quit\n");
+
+  // Numbers past what a frame or a drag can hold are refused with the line, not run at frame 0.
+  expect_refused("frame 1e300 quit\n", "", "a.actions:1: expected 'frame N VERB");
+  expect_refused("frame 1 drag outside 1e300 -1e300\n", "", "a.actions:1: drag: DX and DY");
 }
 
 }  // namespace
