@@ -95,12 +95,14 @@ void open_console(const ConsoleCliOptions& o) {
   options.core.simulation.collision_hz = o.collision_hz;
   options.core.simulation.physics_per_collision = o.substeps;
   options.core.simulation.physics_threads = o.physics_threads;
-  TissueParameters parameters = parameters_from_assignments(o.sets);
+  // The preset first, then --set over it: a value given on the command line is the one asked for.
+  TissueParameters parameters;
   if (!o.preset.empty()) {
     Result<TissueParameters> preset = gui::load_preset(o.preset, parameters);
     if (!preset) throw std::runtime_error(preset.error());
     parameters = *preset;
   }
+  parameters = parameters_from_assignments(o.sets, parameters);
   options.settings.parameters = parameters;
   options.settings.window_width = o.width;
   options.settings.window_height = o.height;

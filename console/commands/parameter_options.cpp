@@ -14,8 +14,8 @@ void add_parameter_option(CLI::App& command, std::vector<std::string>& assignmen
       ->allow_extra_args(false);
 }
 
-TissueParameters parameters_from_assignments(const std::vector<std::string>& assignments) {
-  TissueParameters parameters;
+TissueParameters parameters_from_assignments(const std::vector<std::string>& assignments, const TissueParameters& base) {
+  TissueParameters parameters = base;
   for (const std::string& assignment : assignments) {
     if (Status status = parameters.set_from_assignment(assignment); !status) throw std::runtime_error(status.error());
   }

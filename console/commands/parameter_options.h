@@ -15,8 +15,8 @@ namespace resecto::cli {
 /// Adds `--set KEY=VALUE` to `command`; the assignments land in `assignments`.
 void add_parameter_option(CLI::App& command, std::vector<std::string>& assignments);
 
-/// The defaults with every assignment applied in order; throws std::runtime_error with the first
+/// `base` (the defaults) with every assignment applied in order; throws std::runtime_error with the first
 /// bad assignment's one-line reason (the command's callback turns it into exit 1).
-TissueParameters parameters_from_assignments(const std::vector<std::string>& assignments);
+TissueParameters parameters_from_assignments(const std::vector<std::string>& assignments, const TissueParameters& base = {});
 
 }  // namespace resecto::cli

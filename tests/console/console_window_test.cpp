@@ -417,6 +417,22 @@ TEST(ConsoleWindow, BadActionsAreClearErrors) {
   EXPECT_NE(range.err.find("out of range"), std::string::npos) << range.err;
 }
 
+// A value given with --set is the one asked for, whatever the preset the session starts from says
+// (the preset used to be applied over it without a word).
+TEST(ConsoleWindow, SetWinsOverThePresetItStartsFrom) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_preset_and_set");
+  std::ofstream(dir / "p.json") << R"({"resecto_preset": 1, "parameters": {"stiffness": 45, "density": 1.2}})";
+  std::ofstream(dir / "save.actions") << "frame 3 preset save " << (dir / "out.json").string() << "\nframe 4 quit\n";
+  const CommandOutput run = run_in_xvfb("console --triangles 1296 --width 800 --height 600 --preset " + (dir / "p.json").string() +
+                                            " --set stiffness=50 --actions " + (dir / "save.actions").string(),
+                                        dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json saved = nlohmann::json::parse(read_text(dir / "out.json"));
+  EXPECT_EQ(saved["parameters"]["stiffness"], 50.0);
+  EXPECT_EQ(saved["parameters"]["density"], 1.2);
+}
+
 // Audit 24's cases: the console's outputs went through writers of their own, which renamed over
 // /dev/null (it became a regular file) and over a FIFO, wrote over the recording being replayed, and
 // let a recording that could not be created, or a screenshot never taken, pass with exit 0.
