@@ -182,7 +182,7 @@ void draw_metrics_panel(ConsoleController& console) {
   row("contact now", "%d points, %.2f N", f.snapshot.penetrating_points, length(f.snapshot.reaction.force_n));
   row("contact time", "%.2f s", m.contact_time_s);
   row("force", "peak %.2f N, mean %.2f N", m.peak_reaction_force_n, m.mean_contact_force_n);
-  row("cut pedal", "%.2f s (%.2f s in contact)", m.cut_pedal_time_s, m.cut_in_contact_time_s);
+  row("cut pedal", "%.2f s (%.2f s with the tool pressing tissue)", m.cut_pedal_time_s, m.cut_in_contact_time_s);
   row("tissue moved", "up to %.2f mm", m.max_tissue_displacement_mm);
   row("deepest insertion", "%.1f mm", m.max_insertion_mm);
   if (!m.distal_margin_mm) {

@@ -62,7 +62,11 @@ struct SimulationConfig {
 struct ProcedureMetrics {
   double contact_time_s = 0.0;             ///< time any tool part pressed into tissue
   double cut_pedal_time_s = 0.0;
-  double cut_in_contact_time_s = 0.0;      ///< pedal down while the loop pressed tissue
+  /// Pedal down while any tool part pressed tissue: the energised loop cuts and takes no part in
+  /// contact, so this is the sheath (or the loop retracted against the beak) pressing while the pedal
+  /// is down, not time spent cutting tissue (loop_on_idle_s in the resection metrics is the pedal down
+  /// with nothing cut).
+  double cut_in_contact_time_s = 0.0;
   double peak_reaction_force_n = 0.0;      ///< largest force of the tissue on the tool
   double mean_contact_force_n = 0.0;       ///< over the ticks in contact
   double max_tissue_displacement_mm = 0.0;
