@@ -121,6 +121,23 @@ Result<SheathFit> fit_sheath(const std::vector<SheathSample>& samples, const std
   }
   if (fit.max_mm <= fit.min_mm) return Error{source + ": every sheath measurement is at the same position"};
   summarise(fit);
+  // A gain fitted over a short stretch of the travel multiplies its errors out to the ends (two rows 1
+  // mm apart gave a table of 10-11 mm); a caliper reads to a tenth of a millimetre and the
+  // potentiometer is linear to well under one, so a row more than 2 mm off the line through the
+  // others is a misread or mistyped measurement (one such row gave an rms residual of 64 mm).
+  if (fit.max_mm - fit.min_mm < kMinSheathSpanMm) {
+    return Error{source + ": the measurements cover only " + mm(fit.min_mm) + " to " + mm(fit.max_mm) + " mm; measure across at least " +
+                 mm(kMinSheathSpanMm) + " mm of the sheath's travel"};
+  }
+  // Which row is wrong cannot be told from three (one bad row pulls the line toward itself and away
+  // from the good ones): the message names where the line misses most and leaves the rows to the user.
+  const auto worst = std::max_element(fit.residuals.begin(), fit.residuals.end(),
+                                      [](const Residual& a, const Residual& b) { return std::abs(a.residual_mm) < std::abs(b.residual_mm); });
+  if (std::abs(worst->residual_mm) > kMaxSheathResidualMm) {
+    return Error{source + ":" + std::to_string(worst->line) + ": the line fitted through the rows misses this one (" + mm(worst->position_mm) +
+                 " mm) by " + mm(std::abs(worst->residual_mm)) + " mm, more than " + mm(kMaxSheathResidualMm) +
+                 ": a row is misread or mistyped; check them and measure again"};
+  }
   return fit;
 }
 

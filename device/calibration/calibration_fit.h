@@ -59,7 +59,13 @@ Result<std::vector<SheathSample>> sheath_samples(const NumericCsv& csv, const st
 /// Hall CSV: `position_mm,hall_sum_counts` or `position_mm,hall_a_counts,hall_b_counts`.
 Result<std::vector<HallSample>> hall_samples(const NumericCsv& csv, const std::string& source);
 
-/// Least-squares line position = gain * counts + offset; needs two distinct readings.
+/// The least stretch of the sheath's 230 mm travel the sheath measurements must cover, and the most
+/// any of them may be off the fitted line.
+inline constexpr double kMinSheathSpanMm = 50.0;
+inline constexpr double kMaxSheathResidualMm = 2.0;
+
+/// Least-squares line position = gain * counts + offset; needs two distinct readings, covering at
+/// least kMinSheathSpanMm, none off the line by more than kMaxSheathResidualMm.
 Result<SheathFit> fit_sheath(const std::vector<SheathSample>& samples, const std::string& source);
 
 /// How far the table may be extrapolated past the measured range at either end.

@@ -306,6 +306,9 @@ TEST_F(HostileInput, CalibrationInputsOutsideTheDeviceAreRefused) {
       {"position_mm,potentiometer_counts\n0,100\n10,5000\n", "potentiometer_counts 5000 is outside [0, 4095]"},
       {"position_mm,potentiometer_counts\n0,100\n-10,200\n", "position_mm -10 is outside [0, 230]"},
       {"position_mm,potentiometer_counts\nnan,100\nnan,200\n", "column position_mm: not a finite number: 'nan'"},
+      // Audit 24: a mistyped row (rms residual 64 mm) and two rows 1 mm apart were fitted and written.
+      {"position_mm,potentiometer_counts\n0,3686\n230,2646\n115,4000\n", "by 86.187 mm, more than 2.000: a row is misread or mistyped"},
+      {"position_mm,potentiometer_counts\n10,3640\n11,3636\n", "the measurements cover only 10.000 to 11.000 mm"},
   };
   for (const auto& [csv, expected] : sheaths) {
     write_bytes(path("bad_sheath.csv"), csv);
