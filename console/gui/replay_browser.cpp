@@ -20,7 +20,7 @@ void ReplayBrowser::close() {
 
 Status ReplayBrowser::open(const std::filesystem::path& path) {
   Result<rec::Recording> opened = rec::Recording::open(path);
-  if (!opened) return Error{path.string() + ": " + opened.error()};
+  if (!opened) return Error{opened.error()};  // it names the file
   if (opened->keyframes().empty()) return Error{path.string() + ": the recording holds no keyframe to show"};
   close();
   recording_ = std::make_unique<rec::Recording>(std::move(*opened));

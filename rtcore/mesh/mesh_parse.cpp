@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "rtcore/base/checked_number.h"
+#include "rtcore/base/quoted_word.h"
 
 namespace resecto {
 namespace {
@@ -97,25 +98,6 @@ std::vector<std::string_view> split_words(std::string_view line, bool hash_comme
   return words;
 }
 
-std::string quoted(std::string_view word) {
-  // Appended, not `"'" + std::string(...)`: GCC 12 at -O3 warns falsely (-Wrestrict) on that form.
-  // A control byte is written as \xNN: a NUL in the word cut the printed message short at it.
-  std::string text = "'";
-  for (const char c : word.substr(0, 24)) {
-    const auto byte = static_cast<unsigned char>(c);
-    if (byte >= 0x20 && byte != 0x7f) {
-      text.push_back(c);
-      continue;
-    }
-    constexpr char kHex[] = "0123456789abcdef";
-    text += "\\x";
-    text.push_back(kHex[byte >> 4]);
-    text.push_back(kHex[byte & 15]);
-  }
-  text += word.size() > 24 ? "...'" : "'";
-  return text;
-}
-
 /// A whole word as an integer; nullopt when it is not one (or does not fit 64 bits).
 std::optional<std::int64_t> parse_integer(std::string_view word) {
   std::int64_t value = 0;
@@ -127,7 +109,7 @@ std::optional<std::int64_t> parse_integer(std::string_view word) {
 
 Result<double> coordinate(const TextLines& lines, std::string_view word) {
   const std::optional<double> value = parse_finite(word);
-  if (!value) return lines.error_at(word, quoted(word) + " is not a finite number");
+  if (!value) return lines.error_at(word, quoted_word(word) + " is not a finite number");
   return *value;
 }
 
@@ -211,10 +193,10 @@ Result<RawMesh> parse_off(std::string_view text, const std::string& name) {
         if (word.size() > 3 && word.substr(word.size() - 3) == "OFF") {
           return lines.error_at(word, "'" + std::string(word) + "' files are not read; only plain 'OFF' (no colours, normals or 4D)");
         }
-        return lines.error_at(word, "expected 'OFF' at the start of the file, found " + quoted(word));
+        return lines.error_at(word, "expected 'OFF' at the start of the file, found " + quoted_word(word));
       }
       if (word == "BINARY") return lines.error_at(word, "binary OFF is not read; write it as ASCII OFF");
-      if (header.size() == 4) return lines.error_at(word, "unexpected " + quoted(word) + " after the vertex, face and edge counts");
+      if (header.size() == 4) return lines.error_at(word, "unexpected " + quoted_word(word) + " after the vertex, face and edge counts");
       header.push_back(word);
     }
   }
@@ -223,7 +205,7 @@ Result<RawMesh> parse_off(std::string_view text, const std::string& name) {
   std::int64_t counts[3];
   for (int i = 0; i < 3; ++i) {
     const std::optional<std::int64_t> count = parse_integer(header[static_cast<std::size_t>(i) + 1]);
-    if (!count) return lines.error_at(header[static_cast<std::size_t>(i) + 1], quoted(header[static_cast<std::size_t>(i) + 1]) + " is not a count");
+    if (!count) return lines.error_at(header[static_cast<std::size_t>(i) + 1], quoted_word(header[static_cast<std::size_t>(i) + 1]) + " is not a count");
     counts[i] = *count;
   }
   // The shortest vertex line is "0 0 0\n" (6 bytes), the shortest face line "3 0 1 2\n" (8).
@@ -255,7 +237,7 @@ Result<RawMesh> parse_off(std::string_view text, const std::string& name) {
       continue;
     }
     const std::optional<std::int64_t> corners = parse_integer(words[0]);
-    if (!corners) return lines.error_at(words[0], "face " + std::to_string(raw.face_count()) + ": " + quoted(words[0]) + " is not a corner count");
+    if (!corners) return lines.error_at(words[0], "face " + std::to_string(raw.face_count()) + ": " + quoted_word(words[0]) + " is not a corner count");
     if (*corners < 3 || *corners > static_cast<std::int64_t>(kMaxPolygonCorners)) {
       return lines.error_at(words[0], "face " + std::to_string(raw.face_count()) + " has " + std::to_string(*corners) +
                                           " corners (3 to " + std::to_string(kMaxPolygonCorners) + " are read)");
@@ -269,15 +251,15 @@ Result<RawMesh> parse_off(std::string_view text, const std::string& name) {
     }
     for (std::size_t c = 1; c <= n; ++c) {
       const std::optional<std::int64_t> index = parse_integer(words[c]);
-      if (!index) return lines.error_at(words[c], "face " + std::to_string(raw.face_count()) + ": vertex index " + quoted(words[c]) + " is not a whole number");
+      if (!index) return lines.error_at(words[c], "face " + std::to_string(raw.face_count()) + ": vertex index " + quoted_word(words[c]) + " is not a whole number");
       if (*index < 0 || static_cast<std::uint64_t>(*index) >= vertex_count) {
-        return lines.error_at(words[c], "face " + std::to_string(raw.face_count()) + ": vertex index " + quoted(words[c]) +
+        return lines.error_at(words[c], "face " + std::to_string(raw.face_count()) + ": vertex index " + quoted_word(words[c]) +
                                             " is not in [0, " + std::to_string(vertex_count) + ")");
       }
       raw.corners.push_back(static_cast<std::uint32_t>(*index));
     }
     for (std::size_t c = n + 1; c < words.size(); ++c) {
-      if (!is_number(words[c])) return lines.error_at(words[c], "face colour " + quoted(words[c]) + " is not a number");
+      if (!is_number(words[c])) return lines.error_at(words[c], "face colour " + quoted_word(words[c]) + " is not a number");
     }
     raw.end_face();
   }
@@ -336,12 +318,12 @@ Result<RawMesh> parse_obj(std::string_view text, const std::string& name) {
         const std::string_view corner = words[c].substr(0, words[c].find('/'));  // "v", "v/vt", "v//vn", "v/vt/vn"
         const std::optional<std::int64_t> index = parse_integer(corner);
         if (!index || !texture_and_normal_indices_well_formed(words[c].substr(corner.size()))) {
-          return lines.error_at(words[c], "corner " + quoted(words[c]) + " is not a vertex index (v, v/vt, v//vn or v/vt/vn)");
+          return lines.error_at(words[c], "corner " + quoted_word(words[c]) + " is not a vertex index (v, v/vt, v//vn or v/vt/vn)");
         }
         // OBJ counts from 1; a negative index counts back from the latest vertex.
         const std::int64_t resolved = *index > 0 ? *index - 1 : static_cast<std::int64_t>(raw.points.size()) + *index;
         if (*index == 0 || resolved < 0 || resolved >= static_cast<std::int64_t>(kMaxMeshVertices)) {
-          return lines.error_at(words[c], "vertex index " + quoted(corner) + " is not in [1, " + std::to_string(kMaxMeshVertices) +
+          return lines.error_at(words[c], "vertex index " + quoted_word(corner) + " is not in [1, " + std::to_string(kMaxMeshVertices) +
                                               "] or a valid negative index (" + std::to_string(raw.points.size()) + " vertices so far)");
         }
         raw.corners.push_back(static_cast<std::uint32_t>(resolved));
@@ -351,7 +333,7 @@ Result<RawMesh> parse_obj(std::string_view text, const std::string& name) {
     } else {
       bool ignored = false;
       for (std::string_view known : kIgnored) ignored = ignored || keyword == known;
-      if (!ignored) return lines.error_at(keyword, "unknown statement " + quoted(keyword));
+      if (!ignored) return lines.error_at(keyword, "unknown statement " + quoted_word(keyword));
     }
   }
   for (std::size_t f = 0; f < raw.face_count(); ++f) {
@@ -418,7 +400,7 @@ class PlyBody {
       if (start == offset_) return Error{name_ + ": the file ends inside " + what + " (truncated?)"};
       const std::string_view word = body_.substr(start, offset_ - start);
       const std::optional<double> value = ply_integral(type) ? to_double(parse_integer(word)) : parse_finite(word);
-      if (!value) return Error{name_ + ": byte " + std::to_string(body_offset_ + start) + ": " + what + " " + quoted(word) + " is not a " + (ply_integral(type) ? "whole number" : "finite number")};
+      if (!value) return Error{name_ + ": byte " + std::to_string(body_offset_ + start) + ": " + what + " " + quoted_word(word) + " is not a " + (ply_integral(type) ? "whole number" : "finite number")};
       return *value;
     }
     const std::size_t size = ply_size(type);
@@ -453,7 +435,7 @@ class PlyBody {
     std::size_t end = offset_;
     while (end < body_.size() && !is_space(body_[end])) ++end;
     return Error{name_ + ": byte " + std::to_string(body_offset_ + offset_) + ": " + row + " has a value past its " + std::to_string(properties) +
-                 (properties == 1 ? " property: " : " properties: ") + quoted(body_.substr(offset_, end - offset_)) + " (an ASCII row is one line)"};
+                 (properties == 1 ? " property: " : " properties: ") + quoted_word(body_.substr(offset_, end - offset_)) + " (an ASCII row is one line)"};
   }
 
   /// Nothing but whitespace (ASCII) or nothing at all (binary) may follow the last element.
@@ -502,11 +484,11 @@ Result<RawMesh> parse_ply(std::string_view text, const std::string& name) {
       if (words[1] == "ascii") format = 0;
       else if (words[1] == "binary_little_endian") format = 1;
       else if (words[1] == "binary_big_endian") format = 2;
-      else return lines.error_at(words[1], "unknown PLY format " + quoted(words[1]));
+      else return lines.error_at(words[1], "unknown PLY format " + quoted_word(words[1]));
     } else if (keyword == "element") {
       if (words.size() != 3) return lines.error("expected 'element <name> <count>'");
       const std::optional<std::int64_t> count = parse_integer(words[2]);
-      if (!count || *count < 0) return lines.error_at(words[2], "element count " + quoted(words[2]) + " is not a count");
+      if (!count || *count < 0) return lines.error_at(words[2], "element count " + quoted_word(words[2]) + " is not a count");
       if (elements.size() == 64) return lines.error("more than 64 elements");
       elements.push_back({words[1], *count, {}});
     } else if (keyword == "property") {
@@ -516,19 +498,19 @@ Result<RawMesh> parse_ply(std::string_view text, const std::string& name) {
       if (words.size() == 5 && words[1] == "list") {
         const std::optional<PlyType> count_type = ply_type(words[2]);
         const std::optional<PlyType> item_type = ply_type(words[3]);
-        if (!count_type || !ply_integral(*count_type)) return lines.error_at(words[2], "a list's count type must be an integer type, not " + quoted(words[2]));
-        if (!item_type) return lines.error_at(words[3], "unknown PLY type " + quoted(words[3]));
+        if (!count_type || !ply_integral(*count_type)) return lines.error_at(words[2], "a list's count type must be an integer type, not " + quoted_word(words[2]));
+        if (!item_type) return lines.error_at(words[3], "unknown PLY type " + quoted_word(words[3]));
         property = {words[4], *item_type, true, *count_type};
       } else if (words.size() == 3) {
         const std::optional<PlyType> type = ply_type(words[1]);
-        if (!type) return lines.error_at(words[1], "unknown PLY type " + quoted(words[1]));
+        if (!type) return lines.error_at(words[1], "unknown PLY type " + quoted_word(words[1]));
         property = {words[2], *type, false, PlyType::uint8};
       } else {
         return lines.error("expected 'property <type> <name>' or 'property list <count type> <item type> <name>'");
       }
       elements.back().properties.push_back(property);
     } else {
-      return lines.error_at(keyword, "unknown header line " + quoted(keyword));
+      return lines.error_at(keyword, "unknown header line " + quoted_word(keyword));
     }
   }
   if (!ended) return Error{name + ": the header has no 'end_header' line"};
@@ -687,7 +669,7 @@ Result<RawMesh> parse_ascii_stl(std::string_view text, const std::string& name) 
     const std::vector<std::string_view> words = split_words(line, false);
     if (words.empty()) continue;
     const std::string_view keyword = words[0];
-    auto expected = [&](const char* what) { return lines.error_at(keyword, std::string("expected ") + what + ", found " + quoted(keyword)); };
+    auto expected = [&](const char* what) { return lines.error_at(keyword, std::string("expected ") + what + ", found " + quoted_word(keyword)); };
     switch (expect) {
       case Expect::solid:
       case Expect::nothing:
@@ -703,7 +685,7 @@ Result<RawMesh> parse_ascii_stl(std::string_view text, const std::string& name) 
         if (words.size() != 5 || words[1] != "normal") return lines.error("expected 'facet normal nx ny nz'");
         for (std::size_t i = 2; i < 5; ++i) {
           if (!is_number(words[i])) {
-            return lines.error_at(words[i], "normal " + quoted(words[i]) + " is not a number");
+            return lines.error_at(words[i], "normal " + quoted_word(words[i]) + " is not a number");
           }
         }
         if (raw.face_count() == kMaxMeshFaces) return lines.error("more than " + std::to_string(kMaxMeshFaces) + " facets");

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "rtcore/base/checked_number.h"
+#include "rtcore/base/quoted_word.h"
 #include "rtcore/base/text_file.h"
 
 namespace resecto {
@@ -152,7 +153,7 @@ Result<Procedure> parse_procedure(const std::string& text, const std::string& so
       if (count == 8) return line_error(source_name, number, "more than 8 columns");
       // Decimal only, as the mesh readers take numbers: strtod also took hexadecimal ("0x3").
       const std::optional<double> parsed = parse_finite(word);
-      if (!parsed) return line_error(source_name, number, std::string(kColumns[count]) + " is not a number: '" + word + "'");
+      if (!parsed) return line_error(source_name, number, std::string(kColumns[count]) + " is not a number: " + quoted_word(word));
       v[count] = *parsed;
       ++count;
     }

@@ -4,8 +4,9 @@
 
 #include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <string>
+
+#include "rtcore/base/checked_number.h"
 
 namespace resecto {
 namespace {
@@ -42,11 +43,9 @@ constexpr TissueParameterSpec kSpecs[] = {
 };
 static_assert(std::size(kSpecs) == kTissueParameterCount);
 
-std::string format_value(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%g", v);
-  return buffer;
-}
+/// The value exactly (the shortest text that reads back as it): "%g" printed 3.0000000000000004 as 3,
+/// so "3 is out of range [0.2, 3]".
+std::string format_value(double v) { return exact_number(v); }
 
 }  // namespace
 

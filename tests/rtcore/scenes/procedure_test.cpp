@@ -71,6 +71,9 @@ TEST(Procedure, ErrorsNameTheLine) {
   EXPECT_NE(error_of("0 0 0 0 100 0 2 0\n").find("cut must be 0 or 1"), std::string::npos);
   EXPECT_NE(error_of("0 0 zero 0 100 0 0 0\n").find("pitch_deg is not a number: 'zero'"), std::string::npos);
   EXPECT_NE(error_of("0 0 0 0 0x10 0 0 0\n").find("insertion_mm is not a number: '0x10'"), std::string::npos);  // decimal only, as the meshes
+  // A NUL in a word used to cut the message short at it (audit 24).
+  EXPECT_NE(error_of(std::string("0 0 0 0 100 0 0 0\x00x\n", 20)).find("coagulate is not a number: '0\\x00x'"), std::string::npos)
+      << error_of(std::string("0 0 0 0 100 0 0 0\x00x\n", 20));
   EXPECT_NE(error_of("0 5 0 0 100 0 0 0\n").find("mine.txt:1: the first keyframe must have yaw, pitch and roll 0"), std::string::npos);
   EXPECT_NE(error_of("# nothing\n").find("no keyframes"), std::string::npos);
   EXPECT_EQ(error_of("0 0 0 0 100 0 0 0   # start\n1 0 0 0 120 0 0 0# in\n"), "");  // a comment may end a line
