@@ -19,6 +19,11 @@
 
 namespace resecto::cli {
 
+/// Ends a command whose options, each valid alone, cannot be run together (an option of another
+/// mode, a run shorter than one collision step, a reuse shift past the margin): exit 2, as for any
+/// other command line that cannot be run, rather than 1, which means a failure in the inputs.
+[[noreturn]] inline void refuse_command_line(const std::string& why) { throw CLI::ValidationError(why); }
+
 /// Accepts a finite number in [lo, hi]; names the value exactly when it is not.
 inline CLI::Validator finite_range(double lo, double hi) {
   return CLI::Validator(

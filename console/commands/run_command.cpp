@@ -1,6 +1,7 @@
 // `resecto run`: the simulator. `--headless` drives the core through the emulated device with a
 // scripted procedure and writes the JSON report of DESIGN.md's contract.
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -77,7 +78,7 @@ void run(const RunOptions& o) {
     std::string extension = std::filesystem::path(o.export_surface).extension().string();
     for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (extension != ".off" && extension != ".obj" && extension != ".ply" && extension != ".stl") {
-      throw std::runtime_error("--export-surface " + o.export_surface + ": unknown format '" + extension + "' (use .off, .obj, .ply or .stl)");
+      refuse_command_line("--export-surface " + o.export_surface + ": unknown format '" + extension + "' (use .off, .obj, .ply or .stl)");
     }
   }
   options.export_surface_path = o.export_surface;
@@ -97,6 +98,13 @@ void run(const RunOptions& o) {
   if (o.contact_margin_mm) options.simulation.tissue.contact_margin_m = units::mm_to_m(*o.contact_margin_mm);
   options.spin_us = o.spin_us;
   options.simulation.parameters = parameters_from_assignments(o.sets);
+  // Options valid alone that do not go together (--contact-reuse-mm past --contact-margin-mm, a
+  // --seconds shorter than one collision step at --collision-hz) are refused before the model is built.
+  if (Status valid = options.simulation.validate(); !valid) refuse_command_line(valid.error());
+  if (o.seconds > 0.0 && std::llround(o.seconds / options.simulation.tick_s()) < options.simulation.physics_per_collision) {
+    refuse_command_line("--seconds " + exact_number(o.seconds) + ": the run must last at least one collision step, " +
+                        exact_number(options.simulation.tick_s() * options.simulation.physics_per_collision) + " s");
+  }
   if (!o.calibration.empty()) {
     Result<device::Calibration> calibration = device::read_calibration(o.calibration);
     if (!calibration) throw std::runtime_error(calibration.error());
@@ -163,7 +171,7 @@ void register_run(CLI::App& app) {
       for (const char* console_only : {"--device", "--preset", "--replay", "--actions", "--frames", "--screenshot", "--lockstep", "--insertion-mm",
                                        "--width", "--height", "--slow-frame-ms", "--slow-frame-every", "--view-scale", "--no-vsync"}) {
         if (cmd->count(console_only) > 0) {
-          throw std::runtime_error(std::string(console_only) + " is an option of the operator console; a --headless run follows its procedure through the emulated device");
+          refuse_command_line(std::string(console_only) + " is an option of the operator console; a --headless run follows its procedure through the emulated device");
         }
       }
     }

@@ -37,9 +37,9 @@ void write_or_throw(const std::filesystem::path& path, const std::string& text) 
 
 void score(const ScoreOptions& o) {
   const bool comparing = !o.compare.empty();
-  if (comparing && o.compare.size() != 2) throw std::runtime_error("score --compare takes two recordings (trainee and expert)");
-  if (comparing && !o.files.empty()) throw std::runtime_error("score --compare A B takes no other FILE");
-  if (comparing && o.html.empty()) throw std::runtime_error("score --compare A B needs --html OUT (the side-by-side page)");
+  if (comparing && o.compare.size() != 2) refuse_command_line("score --compare takes two recordings (trainee and expert)");
+  if (comparing && !o.files.empty()) refuse_command_line("score --compare A B takes no other FILE");
+  if (comparing && o.html.empty()) refuse_command_line("score --compare A B needs --html OUT (the side-by-side page)");
   const std::vector<std::string>& files = comparing ? o.compare : o.files;
   if (files.empty()) throw std::runtime_error("score: no recording given (resecto score FILE... or --compare A B)");
 

@@ -325,7 +325,7 @@ TEST(RunCommand, OutputsAndLengthAreCheckedBeforeTheRun) {
   EXPECT_EQ(std::filesystem::file_size(kept), size);
   // The console's options and a seed that would wrap are refused, not silently taken.
   const testing::CommandOutput hid = run_resecto("run --headless --triangles 1296 --seconds 0.5 --device hid");
-  EXPECT_NE(hid.exit_code, 0);
+  EXPECT_EQ(hid.exit_code, 2);
   EXPECT_NE(hid.err.find("--device is an option of the operator console"), std::string::npos) << hid.err;
   for (const char* seed : {"-1", "99999999999999999999"}) {
     const testing::CommandOutput wrapped = run_resecto(std::string("run --headless --triangles 1296 --seconds 0.5 --seed ") + seed);
@@ -333,7 +333,7 @@ TEST(RunCommand, OutputsAndLengthAreCheckedBeforeTheRun) {
   }
   // Shorter than one collision step: nothing a replay or a score could use.
   const testing::CommandOutput short_run = run_resecto("run --headless --triangles 1296 --seconds 0.001");
-  EXPECT_NE(short_run.exit_code, 0);
+  EXPECT_EQ(short_run.exit_code, 2);
   EXPECT_NE(short_run.err.find("at least one collision step"), std::string::npos) << short_run.err;
 }
 

@@ -44,7 +44,7 @@ TEST(Resection, DemoReportsTheCutAndExportsAValidRemainingSurface) {
 
 TEST(Resection, AnUnknownSurfaceFormatIsRefusedBeforeTheRun) {
   const CommandOutput run = run_resecto("run --headless --triangles 1296 --seconds 0.1 --export-surface remaining.xyz");
-  EXPECT_NE(run.exit_code, 0);
+  EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.err.find("--export-surface remaining.xyz: unknown format"), std::string::npos) << run.err;
 }
 

@@ -104,7 +104,7 @@ TEST(RunCommand, ReportsTheCollisionStepsThatKeptTheirContactCandidates) {
     }
   }
   const CommandOutput refused = run_resecto(std::string(kShortRun) + " --contact-reuse-mm 1.5");
-  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_EQ(refused.exit_code, 2);
   EXPECT_NE(refused.err.find("contact reuse shift 1.5 mm is outside [0, the contact margin 1.5 mm)"), std::string::npos) << refused.err;
 }
 
@@ -121,7 +121,7 @@ TEST(RunCommand, TheContactMarginIsTheUsersToChooseWithinItsRange) {
   EXPECT_EQ(hashes[0], hashes[1]);
   // Below the reuse shift it is refused, naming both; outside its range, named by the option.
   const CommandOutput below_reuse = run_resecto(std::string(kShortRun) + " --contact-margin-mm 0.2");
-  EXPECT_NE(below_reuse.exit_code, 0);
+  EXPECT_EQ(below_reuse.exit_code, 2);
   EXPECT_NE(below_reuse.err.find("contact reuse shift 0.3 mm is outside [0, the contact margin 0.2 mm)"), std::string::npos) << below_reuse.err;
   const CommandOutput out_of_range = run_resecto(std::string(kShortRun) + " --contact-margin-mm 0");
   EXPECT_NE(out_of_range.exit_code, 0);

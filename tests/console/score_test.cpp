@@ -230,7 +230,7 @@ TEST(ScoreCommand, BadArgumentsAreNamed) {
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.err.find("skipped: /nonexistent/x.resecto"), std::string::npos) << missing.err;
   const CommandOutput compare = run_resecto("score --compare a b");
-  EXPECT_NE(compare.exit_code, 0);
+  EXPECT_EQ(compare.exit_code, 2);
   EXPECT_NE(compare.err.find("needs --html"), std::string::npos) << compare.err;
   // With several recordings --html is a folder: a file in its place is refused before any scoring
   // (the recordings need not even exist for that).
