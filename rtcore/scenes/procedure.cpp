@@ -195,7 +195,10 @@ Result<Procedure> load_procedure(const std::filesystem::path& path) {
 Result<Procedure> builtin_procedure(const std::string& name) {
   if (name == "demo") return parse_procedure(kDemoProcedure, "demo");
   if (name == "turp") return Procedure{"turp", turp_keyframes()};
-  return Error{"no built-in procedure '" + name + "' (built-in: demo, turp)"};
+  // A name without '/' or '.' is taken for a built-in one; a file of that name is read as ./NAME.
+  std::error_code error;
+  const std::string file_hint = std::filesystem::is_regular_file(name, error) ? "; to read the file " + name + ", write ./" + name : "";
+  return Error{"no built-in procedure '" + name + "' (built-in: demo, turp)" + file_hint};
 }
 
 bool names_a_builtin_procedure(const std::string& name_or_path) {

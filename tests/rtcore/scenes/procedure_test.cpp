@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <vector>
 
 #include "rtcore/scenes/procedure.h"
@@ -81,6 +83,22 @@ TEST(Procedure, ErrorsNameTheLine) {
   ASSERT_FALSE(unknown);
   EXPECT_NE(unknown.error().find("built-in: demo"), std::string::npos);
   EXPECT_FALSE(find_procedure("/nonexistent/file.txt"));
+}
+
+// A name without '/' or '.' is a built-in procedure's; a file of that name in the working folder is
+// pointed to (audit 24: "no built-in procedure 'proc'" left the user wondering why the file was ignored).
+TEST(Procedure, AnUnknownNameThatIsAFileHereSaysHowToReadIt) {
+  const std::filesystem::path here = "procedure_name_hint";
+  std::ofstream(here) << "0 0 0 0 100 0 0 0\n1 0 0 0 110 0 0 0\n";
+  const Result<Procedure> named = find_procedure(here.string());
+  std::filesystem::remove(here);
+  ASSERT_FALSE(named);
+  EXPECT_NE(named.error().find("no built-in procedure 'procedure_name_hint' (built-in: demo, turp); to read the file procedure_name_hint, write ./procedure_name_hint"),
+            std::string::npos)
+      << named.error();
+  const Result<Procedure> absent = find_procedure("procedure_name_hint");
+  ASSERT_FALSE(absent);
+  EXPECT_EQ(absent.error().find("to read the file"), std::string::npos) << absent.error();
 }
 
 }  // namespace
