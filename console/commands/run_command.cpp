@@ -101,7 +101,7 @@ void run(const RunOptions& o) {
   // Options valid alone that do not go together (--contact-reuse-mm past --contact-margin-mm, a
   // --seconds shorter than one collision step at --collision-hz) are refused before the model is built.
   if (Status valid = options.simulation.validate(); !valid) refuse_command_line(valid.error());
-  if (o.seconds > 0.0 && std::llround(o.seconds / options.simulation.tick_s()) < options.simulation.physics_per_collision) {
+  if (o.seconds > 0.0 && !options.simulation.holds_a_collision_step(o.seconds)) {
     refuse_command_line("--seconds " + exact_number(o.seconds) + ": the run must last at least one collision step, " +
                         exact_number(options.simulation.tick_s() * options.simulation.physics_per_collision) + " s");
   }

@@ -78,10 +78,7 @@ Status ConsoleController::check_output(const std::string& path) const {
 }
 
 Status ConsoleController::start_recording(const std::string& path) {
-  if (Status writable = check_output(path); !writable) {
-    ui_.message = writable.error();
-    return writable;
-  }
+  if (Status writable = check_output(path); !writable) return writable;
   CoreControl control;
   control.kind = CoreControlKind::kRecordStart;
   control.path = path;

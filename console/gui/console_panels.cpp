@@ -259,7 +259,10 @@ void draw_recording_panel(ConsoleController& console) {
     if (ImGui::InputText("file##record", path, sizeof path)) ui.record_path = path;
     ImGui::SameLine();
     // A path that cannot be written is named below rather than left for the core to fail on.
-    if (ImGui::Button("Record")) ui.record_message = console.start_recording(ui.record_path) ? std::string() : ui.message;
+    if (ImGui::Button("Record")) {
+      const Status started = console.start_recording(ui.record_path);
+      ui.record_message = started ? std::string() : started.error();
+    }
     if (!ui.record_message.empty()) ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.3f, 1.0f), "%s", ui.record_message.c_str());
     if (s.recordings_finished > 0) {
       ImGui::TextDisabled("last: %s, %.2f MB, %" PRIu64 " ticks, %" PRIu64 " keyframes, %" PRIu64 " lost", s.recording_path.data(),

@@ -115,7 +115,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   const double seconds = options.seconds > 0.0 ? options.seconds : options.procedure.duration_s();
   const double tick_s = simulation.tick_s();
   const auto ticks = static_cast<std::uint64_t>(std::max<long long>(0, std::llround(seconds / tick_s)));
-  if (!(ticks >= static_cast<std::uint64_t>(simulation.physics_per_collision))) {
+  if (!simulation.holds_a_collision_step(seconds)) {
     char text[256];
     std::snprintf(text, sizeof text, "the run is %.3g s long (%s); it must last at least one collision step, %.4g s", seconds,
                   options.seconds > 0.0 ? "--seconds" : "the procedure's length", tick_s * simulation.physics_per_collision);

@@ -64,11 +64,11 @@ std::string lost_part_of_procedure(const rec::Recording& recording) {
   const std::optional<std::uint64_t> ticks = recording.summary_count("ticks"), commands = recording.summary_count("commands");
   // Cut between two chunks, a file looks whole up to its end; only the recorder's summary, written
   // when it closes the file, says the procedure ended there.
-  if (dropped == 0 && !ticks) {
+  if (dropped == 0) {
+    if (ticks) return {};
     return "the recorder never closed it (the run was killed or the file cut after " + std::to_string(recording.ticks().size()) +
            " ticks), so how much of the procedure it lacks is unknown";
   }
-  if (dropped == 0) return {};
   if (ticks && commands && *ticks == recording.ticks().size() && *commands == recording.commands().size()) return {};
   return "recovered (`rec recover`) from a damaged recording, " + std::to_string(dropped) + " damaged ranges left out" +
          (ticks && commands

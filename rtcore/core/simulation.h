@@ -9,6 +9,7 @@
 
 #include <array>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -54,6 +55,9 @@ struct SimulationConfig {
   ResectionConfig resection;
 
   double tick_s() const { return 1.0 / (static_cast<double>(collision_hz) * physics_per_collision); }
+  /// Whether a run of `seconds` (rounded to whole ticks) holds at least one collision step: a shorter
+  /// one would report and record nothing a replay or a score can use.
+  bool holds_a_collision_step(double seconds) const { return std::llround(seconds / tick_s()) >= physics_per_collision; }
   /// The tick rates as a user would write them, or an error naming the bad value.
   Status validate() const;
 };

@@ -43,9 +43,6 @@ constexpr TissueParameterSpec kSpecs[] = {
 };
 static_assert(std::size(kSpecs) == kTissueParameterCount);
 
-/// The value exactly (the shortest text that reads back as it): "%g" printed 3.0000000000000004 as 3,
-/// so "3 is out of range [0.2, 3]".
-std::string format_value(double v) { return exact_number(v); }
 
 }  // namespace
 
@@ -69,8 +66,9 @@ double TissueParameters::si(TissueParameter id) const { return get(id) * tissue_
 Status TissueParameters::set(TissueParameter id, double value) {
   const TissueParameterSpec& spec = tissue_parameter_spec(id);
   if (!std::isfinite(value) || value < spec.min_value || value > spec.max_value) {
-    return Error{"parameter " + std::string(spec.key) + " = " + format_value(value) + " is out of range [" +
-                 format_value(spec.min_value) + ", " + format_value(spec.max_value) + "] " + std::string(spec.unit)};
+    // Exact values: "%g" printed 3.0000000000000004 as 3, so "3 is out of range [0.2, 3]".
+    return Error{"parameter " + std::string(spec.key) + " = " + exact_number(value) + " is out of range [" +
+                 exact_number(spec.min_value) + ", " + exact_number(spec.max_value) + "] " + std::string(spec.unit)};
   }
   values[static_cast<std::size_t>(id)] = value;
   return Ok{};
