@@ -114,6 +114,10 @@ void run_collide(const CollideOptions& options) {
                             : collider.collide(tissue_tree, tissue, tool_tree, tool, pose);
   };
   const auto pairs = [&] { return shared ? shared->pairs() : collider.pairs(); };
+  // The work behind the timings, summed over the first repeat (one thread: the shared query's
+  // counters are split between its two Colliders).
+  CollisionStats work;
+  std::size_t near_leaves = 0;
   for (int r = 0; r < options.repeat; ++r) {
     collider.reset_sequence();  // every repeat runs the sequence from its first frame
     if (shared) shared->reset_sequence();
@@ -127,7 +131,16 @@ void run_collide(const CollideOptions& options) {
         start = Clock::now();
       }
       times_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
-      if (r == 0) found[p].assign(pairs().begin(), pairs().end());
+      if (r == 0) {
+        found[p].assign(pairs().begin(), pairs().end());
+        const CollisionStats& s = collider.stats();
+        work.sphere_tests += s.sphere_tests;
+        work.front_kept += s.front_kept;
+        work.front_renewed += s.front_renewed;
+        work.leaf_pairs += s.leaf_pairs;
+        work.triangle_tests += s.triangle_tests;
+        near_leaves += collider.tissue_leaves().size();
+      }
     }
   }
   std::size_t total_pairs = 0;
@@ -160,6 +173,15 @@ void run_collide(const CollideOptions& options) {
         {"tool_field_ms", field_ms},
         {"query_us", {{"median", median}, {"p95", p95}, {"max", times_us.back()}}},
     };
+    if (!shared) {
+      const double n = static_cast<double>(poses.size());
+      report["work_per_query"] = {{"bound_tests", static_cast<double>(work.sphere_tests) / n},
+                                  {"near_leaves", static_cast<double>(near_leaves) / n},
+                                  {"leaf_candidates", static_cast<double>(work.leaf_pairs) / n},
+                                  {"triangle_tests", static_cast<double>(work.triangle_tests) / n},
+                                  {"front_kept", static_cast<double>(work.front_kept) / n},
+                                  {"front_renewed", static_cast<double>(work.front_renewed) / n}};
+    }
     std::printf("%s\n", report.dump().c_str());
     return;
   }
@@ -172,6 +194,17 @@ void run_collide(const CollideOptions& options) {
   std::printf("tree build        %.3f ms\n", build_ms);
   if (!dual) std::printf("tool field build  %.3f ms (once per tool)\n", field_ms);
   std::printf("query             median %.1f us, p95 %.1f us\n", median, p95);
+  if (!shared) {
+    const double n = static_cast<double>(poses.size());
+    std::printf("work per query    %.0f bound tests, %.0f near tissue leaves, %.0f leaf candidates, %.0f triangle tests",
+                static_cast<double>(work.sphere_tests) / n, static_cast<double>(near_leaves) / n,
+                static_cast<double>(work.leaf_pairs) / n, static_cast<double>(work.triangle_tests) / n);
+    if (options.sequence) {
+      std::printf(", front %.0f kept / %.0f renewed", static_cast<double>(work.front_kept) / n,
+                  static_cast<double>(work.front_renewed) / n);
+    }
+    std::printf("\n");
+  }
 }
 
 void register_collide(CLI::App& app) {
