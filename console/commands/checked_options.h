@@ -77,6 +77,29 @@ inline CLI::Validator index_up_to(std::uint64_t hi) {
       "INDEX in [0, " + std::to_string(hi) + "]");
 }
 
+/// Accepts a whole number in [lo, hi] written in decimal digits, with a '-' where lo allows one, and
+/// hands it on without leading zeros. The conversion underneath took "0x510" as 1296, "0300" as octal
+/// (192), and refused "1296.0" as "not in range 200 to 5000000". A transform (Option::transform), not a
+/// check: it rewrites the text the option converts.
+inline CLI::Validator whole_in_range(std::int64_t lo, std::int64_t hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& text) -> std::string {
+        const bool negative = !text.empty() && text[0] == '-';
+        const std::string digits = text.substr(negative ? 1 : 0);
+        if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos) {
+          return "'" + text + "' is not a whole number of decimal digits";
+        }
+        const std::string significant = digits.substr(std::min(digits.find_first_not_of('0'), digits.size() - 1));
+        const std::string range = " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+        if (significant.size() > 18) return text + range;  // past any bound an int64 holds
+        const std::int64_t value = (negative ? -1 : 1) * std::stoll(significant);
+        if (value < lo || value > hi) return text + range;
+        text = std::to_string(value);
+        return std::string();
+      },
+      "INT in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+}
+
 /// Accepts a whole number in [0, 2^64 - 1] written in decimal digits: the conversion underneath
 /// would take "-1" as 2^64 - 1 and saturate a longer number, both without a word.
 inline CLI::Validator unsigned_64() {

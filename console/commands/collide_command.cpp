@@ -216,14 +216,14 @@ void register_collide(CLI::App& app) {
   cmd->add_option("--poses", options->poses, "Tool poses: 12 numbers a line, row-major 3x4 [R|t]")->required()->check(CLI::ExistingFile);
   cmd->add_option("--pairs", options->pairs, "Write the pairs as CSV: pose,tissue_face,tool_face")->check(nonempty_path());
   cmd->add_option("--repeat", options->repeat, "Run every pose this many times for the timings")
-      ->check(CLI::Range(1, 1'000'000))->capture_default_str();
+      ->transform(whole_in_range(1, 1'000'000))->capture_default_str();
   cmd->add_flag("--sequence", options->sequence,
                 "Treat the poses as consecutive frames of one motion and reuse each query's work in the next "
                 "(same pairs; without it every pose is independent)");
   cmd->add_option("--threads", options->threads,
                   "1: every query on one thread (the default); 2: each query shared with a helper thread (same pairs; "
                   "with --sequence each thread keeps the front of its own half of the tissue tree)")
-      ->check(CLI::Range(1, 2))
+      ->transform(whole_in_range(1, 2))
       ->capture_default_str();
   cmd->add_option("--method", options->method,
                   "field: the tissue's sphere tree against the tool's precomputed field (the default); "

@@ -19,15 +19,15 @@ namespace resecto::cli {
 void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_run) {
   if (!shared_with_run) {
     cmd.add_option("--procedure", o.procedure, "Built-in procedure (demo, turp) or a procedure file the emulated device follows")->check(procedure_name_or_file())->capture_default_str();
-    cmd.add_option("--triangles", o.triangles, "Prostate surface triangles")->check(CLI::Range(200, 1000000))->capture_default_str();
+    cmd.add_option("--triangles", o.triangles, "Prostate surface triangles")->transform(whole_in_range(200, 1000000))->capture_default_str();
     cmd.add_option("--report", o.report, "Write the session's JSON report here when the console closes")->check(nonempty_path());
     add_parameter_option(cmd, o.sets);
-    cmd.add_option("--collision-hz", o.collision_hz, "Collision steps per second")->check(CLI::Range(10, 1000))->capture_default_str();
-    cmd.add_option("--substeps", o.substeps, "Physics steps per collision step")->check(CLI::Range(1, 64))->capture_default_str();
-    cmd.add_option("--spin-us", o.spin_us, "Spin this long before each tick instead of sleeping")->check(CLI::Range(0, 100000))->capture_default_str();
+    cmd.add_option("--collision-hz", o.collision_hz, "Collision steps per second")->transform(whole_in_range(10, 1000))->capture_default_str();
+    cmd.add_option("--substeps", o.substeps, "Physics steps per collision step")->transform(whole_in_range(1, 64))->capture_default_str();
+    cmd.add_option("--spin-us", o.spin_us, "Spin this long before each tick instead of sleeping")->transform(whole_in_range(0, 100000))->capture_default_str();
     cmd.add_option("--physics-threads", o.physics_threads,
                    "Threads sharing each physics step's spring and node loops: 1, or 2 (the core and a helper); same state hashes")
-        ->check(CLI::Range(1, 2))
+        ->transform(whole_in_range(1, 2))
         ->capture_default_str();
     cmd.add_option("--seed", o.seed, "Seed of the emulated sensors' noise")->check(unsigned_64())->capture_default_str();
     cmd.add_option("--calibration", o.calibration, "Device calibration file (default: the reference device's)")->check(existing_path());
@@ -41,20 +41,20 @@ void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_r
   cmd.add_option("--replay", o.replay, "Open this recording in the replay panel and show it in the views")->check(existing_path());
   if (!shared_with_run) cmd.add_option("--record", o.record, "Record the session from its first tick to this file (replayable and verifiable)")->check(nonempty_path());
   cmd.add_option("--actions", o.actions, "Scripted UI actions, one 'frame N VERB ...' per line (docs/commands.md, \"Operator console\")")->check(existing_path());
-  CLI::Option* frames = cmd.add_option("--frames", o.frames, "Quit after this many frames")->check(CLI::Range(1, 100000000));
+  CLI::Option* frames = cmd.add_option("--frames", o.frames, "Quit after this many frames")->transform(whole_in_range(1, 100000000));
   cmd.add_option("--screenshot", o.screenshot, "Write a PNG of the whole window after the last of --frames")->needs(frames)->check(nonempty_path());
   cmd.add_flag("--lockstep", o.lockstep,
                "Step the emulated board with the core's ticks (no link thread): the state depends only on the procedure and the commands");
   cmd.add_option("--insertion-mm", o.start_insertion_mm, "--device keyboard: where the sheath starts, mm past the pivot (the apex is at 150)")
       ->check(finite_range(0.0, 230.0))
       ->capture_default_str();
-  cmd.add_option("--width", o.width, "Window width, pixels")->check(CLI::Range(640, 8192))->capture_default_str();
-  cmd.add_option("--height", o.height, "Window height, pixels")->check(CLI::Range(480, 8192))->capture_default_str();
+  cmd.add_option("--width", o.width, "Window width, pixels")->transform(whole_in_range(640, 8192))->capture_default_str();
+  cmd.add_option("--height", o.height, "Window height, pixels")->transform(whole_in_range(480, 8192))->capture_default_str();
   cmd.add_option("--slow-frame-ms", o.slow_frame_ms, "Make every frame this much slower (to show the core is never held back)")
       ->check(finite_range(0.0, 10000.0));
   cmd.add_option("--slow-frame-every", o.slow_frame_every,
                  "Slow only every Nth frame, so the report can set the core's misses during slow frames beside those during the others")
-      ->check(CLI::Range(1, 1000))
+      ->transform(whole_in_range(1, 1000))
       ->capture_default_str();
   cmd.add_option("--view-scale", o.view_scale,
                  "Resolution of the 3-D views relative to their panels (default: 1 on a GPU, 0.5 on a software rasteriser)")

@@ -76,7 +76,7 @@ void register_prostate(CLI::App& mesh) {
   auto options = std::make_shared<Options>();
   CLI::App* cmd = mesh.add_subcommand("prostate", "Write the procedural hyperplastic prostate (and its landmarks JSON beside it)");
   cmd->add_option("--triangles", options->triangles, "Target surface triangle count (result within 1%)")
-      ->check(CLI::Range(200, 5'000'000))->capture_default_str();
+      ->transform(whole_in_range(200, 5'000'000))->capture_default_str();
   cmd->add_option("-o,--output", options->output, "Mesh file (.off, .obj, .ply, .stl), millimetres")->required();
   cmd->callback([options] {
     const ProstateModel model = generate_prostate(options->triangles);

@@ -6,13 +6,13 @@
 #include <cctype>
 #include <cmath>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <string_view>
 
 #include <glm/matrix.hpp>
 
 #include "rtcore/base/checked_number.h"
+#include "rtcore/base/text_file.h"
 
 namespace resecto::cli {
 
@@ -30,9 +30,11 @@ bool names_a_non_finite_number(std::string_view word) {
 
 Result<std::vector<RigidPose>> parse_poses(const std::string& text, const std::string& source) {
   std::vector<RigidPose> poses;
-  std::istringstream in(text);
-  std::string line;
-  for (int number = 1; std::getline(in, line); ++number) {
+  int number = 0;
+  // Lines end in LF, CR LF or a lone CR (text_lines).
+  for (const std::string_view text_line : text_lines(text)) {
+    ++number;
+    const std::string line(text_line);
     const std::size_t start = line.find_first_not_of(" \t\r");
     if (start == std::string::npos || line[start] == '#') continue;
     const std::string where = source + ":" + std::to_string(number) + ": ";

@@ -139,14 +139,14 @@ void register_run(CLI::App& app) {
                   "At the end, write the remaining tissue's surface at rest, in millimetres (.off, .obj, .ply, .stl)")
       ->check(nonempty_path());
   add_parameter_option(*cmd, o->sets);
-  cmd->add_option("--triangles", o->triangles, "Prostate surface triangles")->check(CLI::Range(200, 1000000))->capture_default_str();
-  cmd->add_option("--collision-hz", o->collision_hz, "Collision steps per second")->check(CLI::Range(10, 1000))->capture_default_str();
-  cmd->add_option("--substeps", o->substeps, "Physics steps per collision step")->check(CLI::Range(1, 64))->capture_default_str();
+  cmd->add_option("--triangles", o->triangles, "Prostate surface triangles")->transform(whole_in_range(200, 1000000))->capture_default_str();
+  cmd->add_option("--collision-hz", o->collision_hz, "Collision steps per second")->transform(whole_in_range(10, 1000))->capture_default_str();
+  cmd->add_option("--substeps", o->substeps, "Physics steps per collision step")->transform(whole_in_range(1, 64))->capture_default_str();
   cmd->add_flag("--inline-collision", o->inline_collision,
                 "Refit and query on the core's own thread instead of the collision thread (same state hashes)");
   cmd->add_option("--physics-threads", o->physics_threads,
                   "Threads sharing each physics step's spring and node loops: 1, or 2 (the core and a helper); same state hashes")
-      ->check(CLI::Range(1, 2))
+      ->transform(whole_in_range(1, 2))
       ->capture_default_str();
   cmd->add_flag("--raw-input", o->raw_input, "Place the tool by the device's raw readings, without the One Euro smoothing");
   cmd->add_option("--contact-reuse-mm", o->contact_reuse_mm,
@@ -158,7 +158,7 @@ void register_run(CLI::App& app) {
                   "tissue move between collision steps (default 1.5)")
       ->check(finite_range(0.1, 10.0));
   cmd->add_option("--spin-us", o->spin_us, "Real time: spin this long before each tick instead of sleeping")
-      ->check(CLI::Range(0, 100000))
+      ->transform(whole_in_range(0, 100000))
       ->capture_default_str();
   cmd->add_option("--calibration", o->calibration, "Device calibration file (default: the reference device's)")->check(existing_path());
   cmd->add_option("--seed", o->seed, "Seed of the emulated sensors' noise")->check(unsigned_64())->capture_default_str();

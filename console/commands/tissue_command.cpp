@@ -69,7 +69,7 @@ void register_tissue(CLI::App& app) {
   tissue.require_subcommand(1);
   auto options = std::make_shared<IndentOptions>();
   CLI::App* cmd = tissue.add_subcommand("indent", "Virtual indentation: the loop presses into a lateral lobe for 1 s, holds 1 s, withdraws, relaxes 3 s");
-  cmd->add_option("--triangles", options->triangles, "Prostate surface triangles")->check(CLI::Range(200, 1'000'000))->capture_default_str();
+  cmd->add_option("--triangles", options->triangles, "Prostate surface triangles")->transform(whole_in_range(200, 1'000'000))->capture_default_str();
   cmd->add_option("--depth-mm", options->depth_mm, "Indentation depth past first touch, mm")->check(finite_range(0.0, 10.0))->capture_default_str();
   add_parameter_option(*cmd, options->assignments);
   cmd->add_flag("--json", options->json, "One JSON object: peak_force_n, max_displacement_mm, residual_mm, finite, ...");

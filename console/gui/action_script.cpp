@@ -2,11 +2,13 @@
 #include "console/gui/action_script.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
-#include <sstream>
 
+#include "rtcore/base/checked_number.h"
 #include "rtcore/base/text_file.h"
+#include "rtcore/tissue/tissue_parameters.h"
 
 namespace resecto::gui {
 namespace {
@@ -36,59 +38,117 @@ constexpr VerbSpec kVerbs[] = {
     {"replay", ActionVerb::kReplay, 1, 2}, {"quit", ActionVerb::kQuit, 0, 0},
 };
 
+const char* verb_name(ActionVerb verb) {
+  for (const VerbSpec& v : kVerbs)
+    if (v.verb == verb) return v.name;
+  return "action";
+}
+
 }  // namespace
+
+bool script_key_known(const std::string& name) {
+  const bool letter_or_digit = name.size() == 1 && std::isalnum(static_cast<unsigned char>(name[0]));
+  return letter_or_digit || name == "SPACE" || name == "space";
+}
+
+bool action_needs_manual_device(const Action& action) {
+  switch (action.verb) {
+    case ActionVerb::kPedal:
+    case ActionVerb::kKey: return true;
+    case ActionVerb::kDrag: return action.words[0] == "endoscope";
+    case ActionVerb::kSet: return is_joint_key(action.words[0]);
+    default: return false;
+  }
+}
+
+bool is_joint_key(const std::string& key) {
+  return key == "yaw" || key == "pitch" || key == "roll" || key == "insertion" || key == "loop";
+}
+
+Status check_set_action(const std::string& key, double value) {
+  if (const std::optional<TissueParameter> id = find_tissue_parameter(key)) {
+    TissueParameters check;
+    return check.set(*id, value);
+  }
+  if (key == "speed") {
+    if (!(value > 0.0 && value <= 1.0)) return Error{"speed " + exact_number(value) + " is outside (0, 1]"};
+    return Ok{};
+  }
+  if (!is_joint_key(key)) return Error{"unknown key '" + key + "': a tissue parameter (resecto params), yaw, pitch, roll, insertion, loop or speed"};
+  return Ok{};
+}
+
+Status check_actions_for_device(const std::vector<Action>& actions, bool manual_device, const std::string& source_name) {
+  if (manual_device) return Ok{};
+  for (const Action& a : actions) {
+    if (!action_needs_manual_device(a)) continue;
+    return Error{source_name + ":" + std::to_string(a.line) + ":" + std::to_string(a.column) + ": " + (a.verb == ActionVerb::kSet ? "set " + a.words[0] : std::string(verb_name(a.verb))) +
+                 " drives the hand-driven device, and this session's joints and pedals follow the device; start with --device keyboard"};
+  }
+  return Ok{};
+}
 
 Result<std::vector<Action>> parse_actions(const std::string& text, const std::string& source_name) {
   std::vector<Action> actions;
-  std::istringstream lines(text);
-  std::string line;
   int number = 0;
-  while (std::getline(lines, line)) {
+  for (const std::string_view line : text_lines(text)) {
     ++number;
-    if (const std::size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
-    std::istringstream fields(line);
+    // A comment starts at a word beginning with '#', so a path may hold one (shots/#2.png).
+    std::vector<TextWord> all = text_words(line);
+    const auto comment = std::find_if(all.begin(), all.end(), [](const TextWord& w) { return w.text.front() == '#'; });
+    all.erase(comment, all.end());
+    if (all.empty()) continue;
     std::vector<std::string> words;
-    for (std::string w; fields >> w;) words.push_back(w);
-    if (words.empty()) continue;
-    const std::string where = source_name + ":" + std::to_string(number) + ": ";
+    for (const TextWord& w : all) words.emplace_back(w.text);
+    const std::string written(line.substr(all.front().column - 1, all.back().column - 1 + all.back().text.size() - (all.front().column - 1)));
+    // "file:line:column: ", the column of the word at fault (from 1), as compilers write it.
+    const auto at = [&](std::size_t word) {
+      const std::size_t column = word < all.size() ? all[word].column : line.size() + 1;
+      return source_name + ":" + std::to_string(number) + ":" + std::to_string(column) + ": ";
+    };
     double frame = 0.0;
     // The bound is --frames' own: a larger number, past 2^64 above all, would not convert to a frame.
     if (words.size() < 3 || words[0] != "frame" || !parse_number(words[1], frame) || frame < 0 || frame != std::floor(frame) || frame > kMaxFrame) {
-      return Error{where + "expected 'frame N VERB ...' with N a whole number of frames up to 100000000, got '" + line + "'"};
+      return Error{at(words[0] != "frame" ? 0 : 1) + "expected 'frame N VERB ...' with N a whole number of frames up to 100000000, got '" + written + "'"};
     }
     const VerbSpec* spec = nullptr;
     for (const VerbSpec& v : kVerbs)
       if (words[2] == v.name) spec = &v;
-    if (!spec) return Error{where + "unknown action '" + words[2] + "' (set, pedal, key, drag, pause, resume, step, record, screenshot, preset, replay, quit)"};
+    if (!spec) return Error{at(2) + "unknown action '" + words[2] + "' (set, pedal, key, drag, pause, resume, step, record, screenshot, preset, replay, quit)"};
     Action a;
     a.frame = static_cast<std::uint64_t>(frame);
     a.verb = spec->verb;
     a.line = number;
+    a.column = all[all.size() > 3 ? 3 : 2].column;
     a.words.assign(words.begin() + 3, words.end());
+    const std::string where = at(3);  // the first argument
     if (a.words.size() < spec->min_words || a.words.size() > spec->max_words) {
       // Appended piece by piece: `"-" + std::to_string(n)` trips GCC 12's -Wrestrict false positive at -O3.
-      std::string message = where + "'" + words[2] + "' takes " + std::to_string(spec->min_words);
+      std::string message = at(2) + "'" + words[2] + "' takes " + std::to_string(spec->min_words);
       if (spec->max_words != spec->min_words) message.append("-").append(std::to_string(spec->max_words));
       message.append(" argument(s), got ").append(std::to_string(a.words.size()));
       return Error{message};
     }
     switch (a.verb) {
       case ActionVerb::kSet:
-        if (!parse_number(a.words[1], a.value)) return Error{where + "set " + a.words[0] + ": '" + a.words[1] + "' is not a number"};
+        if (!parse_number(a.words[1], a.value)) return Error{at(4) + "set " + a.words[0] + ": '" + a.words[1] + "' is not a number"};
+        // Known keys and their ranges are checked here, before the window opens, not at frame N.
+        if (Status valid = check_set_action(a.words[0], a.value); !valid) return Error{where + valid.error()};
         break;
       case ActionVerb::kPedal:
         if (a.words[0] != "cut" && a.words[0] != "coagulate") return Error{where + "pedal: expected cut or coagulate, got '" + a.words[0] + "'"};
-        if (a.words[1] != "on" && a.words[1] != "off") return Error{where + "pedal: expected on or off, got '" + a.words[1] + "'"};
+        if (a.words[1] != "on" && a.words[1] != "off") return Error{at(4) + "pedal: expected on or off, got '" + a.words[1] + "'"};
         break;
       case ActionVerb::kKey:
-        if (a.words[1] != "down" && a.words[1] != "up") return Error{where + "key: expected down or up, got '" + a.words[1] + "'"};
+        if (!script_key_known(a.words[0])) return Error{where + "key: '" + a.words[0] + "' is not a key (a letter, a digit or SPACE)"};
+        if (a.words[1] != "down" && a.words[1] != "up") return Error{at(4) + "key: expected down or up, got '" + a.words[1] + "'"};
         break;
       case ActionVerb::kDrag:
         if (a.words[0] != "endoscope" && a.words[0] != "outside") return Error{where + "drag: expected endoscope or outside, got '" + a.words[0] + "'"};
         // Pixels, at most a few screens' worth: a larger drag overflowed the camera's floats and blanked the view.
         if (!parse_number(a.words[1], a.value) || !parse_number(a.words[2], a.value2) || std::abs(a.value) > kMaxDragPixels ||
             std::abs(a.value2) > kMaxDragPixels) {
-          return Error{where + "drag: DX and DY must be numbers of pixels within +-100000"};
+          return Error{at(4) + "drag: DX and DY must be numbers of pixels within +-100000"};
         }
         break;
       case ActionVerb::kStep:
@@ -105,7 +165,7 @@ Result<std::vector<Action>> parse_actions(const std::string& text, const std::st
         const bool plain = op == "play" || op == "pause" || op == "step" || op == "verify";
         if (!takes_argument && !plain) return Error{where + "replay: unknown operation '" + op + "' (open, play, pause, step, seek, speed, verify)"};
         if (takes_argument != (a.words.size() == 2)) return Error{where + "replay " + op + (takes_argument ? " needs one argument" : " takes no argument")};
-        if ((op == "seek" || op == "speed") && !parse_number(a.words[1], a.value)) return Error{where + "replay " + op + ": '" + a.words[1] + "' is not a number"};
+        if ((op == "seek" || op == "speed") && !parse_number(a.words[1], a.value)) return Error{at(4) + "replay " + op + ": '" + a.words[1] + "' is not a number"};
         break;
       }
       default: break;

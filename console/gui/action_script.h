@@ -34,12 +34,26 @@ struct Action {
   std::vector<std::string> words;  ///< the arguments after the verb, as written
   double value = 0.0;              ///< the numeric argument where the verb has one
   double value2 = 0.0;
-  int line = 0;                    ///< where it was written, for messages
+  int line = 0;                    ///< where it was written, for messages: the line (from 1)
+  std::size_t column = 1;          ///< and the column of its first argument, or of its verb if it has none
 };
 
 /// Parses a script; errors name the source, the line and what is wrong there. Actions come out
 /// ordered by frame, and in written order within a frame.
 Result<std::vector<Action>> parse_actions(const std::string& text, const std::string& source_name);
 Result<std::vector<Action>> load_actions(const std::filesystem::path& path);
+
+/// Whether a `key` action names a key the console can hold: a letter, a digit or SPACE.
+bool script_key_known(const std::string& name);
+/// Whether `key` (of `set KEY VALUE`) is a joint of the hand-driven device.
+bool is_joint_key(const std::string& key);
+/// `set KEY VALUE` checked without a session: KEY known, VALUE in its range (a joint's travel is
+/// clamped by the device's limits, as the keys' is).
+Status check_set_action(const std::string& key, double value);
+/// Whether the action drives the hand-driven device (pedals, keys, the endoscope drag, a joint).
+bool action_needs_manual_device(const Action& action);
+/// An error naming the first action that needs the hand-driven device when the session has none,
+/// so the script is refused before the window opens rather than at that action's frame.
+Status check_actions_for_device(const std::vector<Action>& actions, bool manual_device, const std::string& source_name);
 
 }  // namespace resecto::gui

@@ -37,7 +37,7 @@ void on_glfw_error(int code, const char* description) { g_glfw_error = "GLFW err
 
 std::int64_t now_ns() { return FrameProfiler::now_ns(); }
 
-/// The GLFW key a script names: a letter, a digit, or SPACE.
+/// The GLFW key a script names: a letter, a digit, or SPACE (script_key_known()).
 int key_code(const std::string& name) {
   if (name.size() == 1 && name[0] >= 'A' && name[0] <= 'Z') return GLFW_KEY_A + (name[0] - 'A');
   if (name.size() == 1 && name[0] >= 'a' && name[0] <= 'z') return GLFW_KEY_A + (name[0] - 'a');
@@ -100,7 +100,7 @@ class ConsoleWindow {
 };
 
 Status ConsoleWindow::apply_action(const Action& a) {
-  const std::string where = options_.actions_path + ":" + std::to_string(a.line) + ": ";
+  const std::string where = options_.actions_path + ":" + std::to_string(a.line) + ":" + std::to_string(a.column) + ": ";
   auto fail = [&](const std::string& message) -> Status { return Error{where + message}; };
   switch (a.verb) {
     case ActionVerb::kSet:
@@ -476,6 +476,8 @@ Result<ordered_json> run_console(const ConsoleOptions& options) {
     Result<std::vector<Action>> loaded = load_actions(options.actions_path);
     if (!loaded) return Error{loaded.error()};
     actions = std::move(*loaded);
+    const bool manual = options.core.device.source == DeviceSource::kEmulatorManual;
+    if (Status fits = check_actions_for_device(actions, manual, options.actions_path); !fits) return Error{fits.error()};
   }
   glfwSetErrorCallback(on_glfw_error);
   if (!glfwInit()) {

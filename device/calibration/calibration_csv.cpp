@@ -38,12 +38,11 @@ int NumericCsv::column(const std::string& name) const {
 
 Result<NumericCsv> parse_numeric_csv(const std::string& text, const std::string& source) {
   NumericCsv table;
-  std::stringstream in(text);
-  std::string line;
   int number = 0;
-  while (std::getline(in, line)) {
+  // Lines end in LF, CR LF or a lone CR: a spreadsheet's "CSV (Macintosh)" export ends them in CR.
+  for (const std::string_view line : text_lines(text)) {
     ++number;
-    const std::string content = trim(line);
+    const std::string content = trim(std::string(line));
     if (content.empty() || content[0] == '#') continue;
     const auto cells = split(content);
     const std::string where = source + ":" + std::to_string(number);

@@ -10,6 +10,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <vector>
 
 #include "rtcore/base/result.h"
 
@@ -68,6 +69,45 @@ inline std::string text_position(std::string_view text, std::size_t offset) {
     if (text[i] == '\n') ++line, line_start = i + 1;
   }
   return "line " + std::to_string(line) + ", column " + std::to_string(offset - line_start + 1);
+}
+
+/// The lines of `text`, ended by "\n", "\r\n" or a lone "\r" (classic Mac OS files, and some
+/// spreadsheets' exports, end lines with CR alone: read by "\n" they were one long line), without
+/// their endings. A last line without an ending counts; an ending at the very end adds no empty line.
+inline std::vector<std::string_view> text_lines(std::string_view text) {
+  std::vector<std::string_view> lines;
+  std::size_t start = 0;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] != '\n' && text[i] != '\r') continue;
+    lines.push_back(text.substr(start, i - start));
+    if (text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n') ++i;
+    start = i + 1;
+  }
+  if (start < text.size()) lines.push_back(text.substr(start));
+  return lines;
+}
+
+/// A word of a line and where it starts: its column, counting bytes from 1.
+struct TextWord {
+  std::string_view text;
+  std::size_t column = 1;
+};
+
+/// The words of `line`, split on spaces, tabs, vertical tabs and form feeds.
+inline std::vector<TextWord> text_words(std::string_view line) {
+  const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f' || c == '\r' || c == '\n'; };
+  std::vector<TextWord> words;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    if (blank(line[i])) {
+      ++i;
+      continue;
+    }
+    const std::size_t start = i;
+    while (i < line.size() && !blank(line[i])) ++i;
+    words.push_back({line.substr(start, i - start), start + 1});
+  }
+  return words;
 }
 
 /// Drops a leading UTF-8 byte-order mark, which spreadsheets and Windows editors put before text

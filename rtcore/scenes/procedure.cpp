@@ -105,8 +105,9 @@ std::vector<ProcedureKeyframe> turp_keyframes() {
   return keys;
 }
 
-Error line_error(const std::string& source, int line, const std::string& what) {
-  return Error{source + ":" + std::to_string(line) + ": " + what};
+/// "source:line:column: what", the column counting bytes from 1, as compilers write it.
+Error position_error(const std::string& source, int line, std::size_t column, const std::string& what) {
+  return Error{source + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + what};
 }
 
 }  // namespace
@@ -135,49 +136,46 @@ ProcedureKeyframe Procedure::sample(double time_s) const {
 Result<Procedure> parse_procedure(const std::string& text, const std::string& source_name) {
   Procedure procedure;
   procedure.name = source_name;
-  std::istringstream lines(text);
-  std::string line;
   int number = 0;
   static const char* kColumns[] = {"time_s", "yaw_deg", "pitch_deg", "roll_deg", "insertion_mm", "loop_mm", "cut", "coagulate"};
-  while (std::getline(lines, line)) {
+  for (std::string_view line : text_lines(text)) {
     ++number;
-    const auto first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
     // A comment may also end a line ("2.0  0 0 0  80 0  1 0   # first stroke").
-    if (const std::size_t comment = line.find('#'); comment != std::string::npos) line.erase(comment);
-    std::istringstream words(line);
-    double v[8];
-    int count = 0;
-    std::string word;
-    while (words >> word) {
-      if (count == 8) return line_error(source_name, number, "more than 8 columns");
-      // Decimal only, as the mesh readers take numbers: strtod also took hexadecimal ("0x3").
-      const std::optional<double> parsed = parse_finite(word);
-      if (!parsed) return line_error(source_name, number, std::string(kColumns[count]) + " is not a number: " + quoted_word(word));
-      v[count] = *parsed;
-      ++count;
-    }
-    if (count != 8) {
-      return line_error(source_name, number, "expected 8 columns (time_s yaw_deg pitch_deg roll_deg insertion_mm loop_mm cut coagulate), found " +
-                                                 std::to_string(count));
-    }
-    auto out_of = [&](int column, double lo, double hi) -> std::optional<Error> {
-      if (auto problem = range_problem(kColumns[column], v[column], lo, hi)) return line_error(source_name, number, *problem);
-      return std::nullopt;
+    if (const std::size_t comment = line.find('#'); comment != std::string_view::npos) line = line.substr(0, comment);
+    const std::vector<TextWord> words = text_words(line);
+    if (words.empty()) continue;
+    const auto error_at = [&](std::size_t word, const std::string& what) {
+      return position_error(source_name, number, words[word].column, what);
     };
-    for (auto check : {out_of(0, 0.0, 86400.0), out_of(1, -kMaxGimbalDeg, kMaxGimbalDeg), out_of(2, -kMaxGimbalDeg, kMaxGimbalDeg),
-                       out_of(3, -kMaxRollDeg, kMaxRollDeg), out_of(4, 0.0, kMaxInsertionMm), out_of(5, 0.0, kMaxLoopMm)}) {
-      if (check) return *check;
+    if (words.size() > 8) return error_at(8, "more than 8 columns");
+    if (words.size() < 8) {
+      return position_error(source_name, number, line.size() + 1,
+                            "expected 8 columns (time_s yaw_deg pitch_deg roll_deg insertion_mm loop_mm cut coagulate), found " +
+                                std::to_string(words.size()));
     }
-    for (int pedal = 6; pedal < 8; ++pedal) {
-      if (v[pedal] != 0.0 && v[pedal] != 1.0) return line_error(source_name, number, std::string(kColumns[pedal]) + " must be 0 or 1");
+    double v[8];
+    for (std::size_t c = 0; c < 8; ++c) {
+      // Decimal only, as the mesh readers take numbers: strtod also took hexadecimal ("0x3").
+      const std::optional<double> parsed = parse_finite(std::string(words[c].text));
+      if (!parsed) return error_at(c, std::string(kColumns[c]) + " is not a number: " + quoted_word(std::string(words[c].text)));
+      v[c] = *parsed;
+    }
+    constexpr double kLimits[6][2] = {{0.0, 86400.0},           {-kMaxGimbalDeg, kMaxGimbalDeg}, {-kMaxGimbalDeg, kMaxGimbalDeg},
+                                      {-kMaxRollDeg, kMaxRollDeg}, {0.0, kMaxInsertionMm},        {0.0, kMaxLoopMm}};
+    for (std::size_t c = 0; c < 6; ++c) {
+      if (auto problem = range_problem(kColumns[c], v[c], kLimits[c][0], kLimits[c][1])) return error_at(c, *problem);
+    }
+    for (std::size_t pedal = 6; pedal < 8; ++pedal) {
+      if (v[pedal] != 0.0 && v[pedal] != 1.0) return error_at(pedal, std::string(kColumns[pedal]) + " must be 0 or 1");
     }
     if (!procedure.keyframes.empty() && !(v[0] > procedure.keyframes.back().time_s)) {
-      return line_error(source_name, number, "time_s must increase from one keyframe to the next");
+      return error_at(0, "time_s must increase from one keyframe to the next");
     }
     // Encoders count from where the device powers up, so every procedure starts at the home pose.
-    if (procedure.keyframes.empty() && (v[1] != 0.0 || v[2] != 0.0 || v[3] != 0.0)) {
-      return line_error(source_name, number, "the first keyframe must have yaw, pitch and roll 0 (the device powers up at its home pose)");
+    if (procedure.keyframes.empty()) {
+      for (std::size_t c = 1; c <= 3; ++c) {
+        if (v[c] != 0.0) return error_at(c, "the first keyframe must have yaw, pitch and roll 0 (the device powers up at its home pose)");
+      }
     }
     procedure.keyframes.push_back({v[0], v[1], v[2], v[3], v[4], v[5], v[6] != 0.0, v[7] != 0.0});
   }

@@ -47,10 +47,29 @@ TEST(ActionScript, ParsesEveryVerbInFrameOrder) {
   EXPECT_EQ(actions->back().line, 2);
 }
 
+// Lines may end in LF, CR LF or a lone CR; a comment starts at a word that begins with '#', so a
+// path may hold one (audit 24, F11: "screenshot shots/#2.png" lost its file name to the comment).
+TEST(ActionScript, LineEndingsAndHashesInPaths) {
+  for (const char* ending : {"\n", "\r\n", "\r"}) {
+    const std::string text = std::string("# tutorial") + ending + "frame 2 screenshot shots/#2.png  # the second" + ending + ending + "frame 3 quit";
+    Result<std::vector<Action>> parsed = parse_actions(text, "t");
+    ASSERT_TRUE(parsed) << parsed.error();
+    ASSERT_EQ(parsed->size(), 2u);
+    EXPECT_EQ((*parsed)[0].words[0], "shots/#2.png");
+    EXPECT_EQ((*parsed)[0].line, 2);
+    EXPECT_EQ((*parsed)[1].line, 4);
+  }
+}
+
 TEST(ActionScript, ErrorsNameTheLineAndTheProblem) {
   const std::pair<const char*, const char*> cases[] = {
-      {"frame 1 pause\nframe x quit\n", "t:2: expected 'frame N VERB"},
-      {"frame 1 jump\n", "t:1: unknown action 'jump'"},
+      {"frame 1 pause\nframe x quit\n", "t:2:7: expected 'frame N VERB"},
+      {"frame 1 jump\n", "t:1:9: unknown action 'jump'"},
+      {"frame 1 set stifness 50\n", "t:1:13: unknown key 'stifness'"},
+      {"frame 1 set stiffness 1e9\n", "t:1:13: parameter stiffness = 1e+09 is out of range"},
+      {"frame 1 set speed 2\n", "t:1:13: speed 2 is outside (0, 1]"},
+      {"frame 1 key F1 down\n", "t:1:13: key: 'F1' is not a key"},
+      {"\tframe 1 pedal cut sometimes\n", "t:1:20: pedal: expected on or off"},
       {"frame 1 set stiffness soft\n", "'soft' is not a number"},
       {"frame 1 pedal cut maybe\n", "expected on or off"},
       {"frame 1 step 0\n", "whole number of ticks"},
@@ -64,6 +83,13 @@ TEST(ActionScript, ErrorsNameTheLineAndTheProblem) {
     EXPECT_NE(parsed.error().find(expected), std::string::npos) << parsed.error();
   }
   EXPECT_FALSE(load_actions("/nonexistent/x.actions"));
+  // The hand-driven device's actions, refused up front for a session whose device follows a procedure.
+  Result<std::vector<Action>> manual = parse_actions("frame 1 set stiffness 50\nframe 9 drag endoscope 5 5\n", "t");
+  ASSERT_TRUE(manual) << manual.error();
+  EXPECT_TRUE(check_actions_for_device(*manual, true, "t"));
+  const Status refused = check_actions_for_device(*manual, false, "t");
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().find("t:2:14: drag drives the hand-driven device"), std::string::npos) << refused.error();
   // A device is refused by name, not read until the memory runs out.
   Result<std::vector<Action>> device = load_actions("/dev/zero");
   ASSERT_FALSE(device);

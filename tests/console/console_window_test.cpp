@@ -418,15 +418,19 @@ TEST(ConsoleWindow, RecordedSessionReplaysAtAScrubbedTimeWithTheRecordedToolPose
 TEST(ConsoleWindow, BadActionsAreClearErrors) {
   REQUIRE_X_SERVER();
   const auto dir = scratch_directory("console_errors");
-  std::ofstream(dir / "bad.actions") << "frame 1 pause\nframe 2 fly away\n";
-  const CommandOutput bad = run_in_xvfb("console --triangles 1296 --actions " + (dir / "bad.actions").string(), dir);
-  EXPECT_NE(bad.exit_code, 0);
-  EXPECT_NE(bad.err.find("bad.actions:2"), std::string::npos) << bad.err;
-  std::ofstream(dir / "range.actions") << "frame 1 set stiffness 100000\n";
-  const CommandOutput range = run_in_xvfb("console --triangles 1296 --actions " + (dir / "range.actions").string(), dir);
-  EXPECT_NE(range.exit_code, 0);
-  EXPECT_NE(range.err.find("range.actions:1"), std::string::npos) << range.err;
-  EXPECT_NE(range.err.find("out of range"), std::string::npos) << range.err;
+  const auto expect_refused = [&](const std::string& name, const std::string& actions, const std::vector<std::string>& expected) {
+    SCOPED_TRACE(name);
+    std::ofstream(dir / name) << actions;
+    const CommandOutput run = run_in_xvfb("console --triangles 1296 --device emulator --actions " + (dir / name).string(), dir);
+    EXPECT_EQ(run.exit_code, 1) << run.err;
+    for (const std::string& part : expected) EXPECT_NE(run.err.find(part), std::string::npos) << run.err;
+  };
+  expect_refused("bad.actions", "frame 1 pause\nframe 2 fly away\n", {"bad.actions:2:9: unknown action 'fly'"});
+  expect_refused("range.actions", "frame 1 set stiffness 100000\n", {"range.actions:1:13: ", "out of range"});
+  // Found before the window opens, not when frame 100000 comes (audit 24, F11): an unknown key, and
+  // an action for the hand-driven device in a session whose device follows the procedure.
+  expect_refused("late.actions", "frame 1 pause\nframe 100000 set stifness 50\n", {"late.actions:2:18: unknown key 'stifness'"});
+  expect_refused("device.actions", "frame 1 pause\nframe 100000 pedal cut on\n", {"device.actions:2:20: pedal drives the hand-driven device"});
 }
 
 // A value given with --set is the one asked for, whatever the preset the session starts from says
@@ -460,7 +464,7 @@ TEST(ConsoleWindow, OutputsNeverReplaceDevicesInputsOrFailSilently) {
     EXPECT_EQ(run.exit_code, 1) << run.err;
     EXPECT_NE(run.err.find(expected), std::string::npos) << run.err;
   };
-  expect_refused("frame 1 screenshot " + (dir / "fifo").string() + "\n", "", "a.actions:1: " + (dir / "fifo").string() + ": is not a regular file");
+  expect_refused("frame 1 screenshot " + (dir / "fifo").string() + "\n", "", "a.actions:1:20: " + (dir / "fifo").string() + ": is not a regular file");
   expect_refused("frame 1 preset save " + (dir / "fifo").string() + "\n", "", "is not a regular file");
   expect_refused("frame 1 record " + (dir / "no" / "x.rsrec").string() + "\n", "", "does not exist");
   expect_refused("frame 1 screenshot " + (dir / "a.actions").string() + "\n", "", "is the input");
@@ -485,8 +489,8 @@ TEST(ConsoleWindow, OutputsNeverReplaceDevicesInputsOrFailSilently) {
   EXPECT_EQ(read_text(dir / "q.actions"), "frame 3 quit\n");
 
   // Numbers past what a frame or a drag can hold are refused with the line, not run at frame 0.
-  expect_refused("frame 1e300 quit\n", "", "a.actions:1: expected 'frame N VERB");
-  expect_refused("frame 1 drag outside 1e300 -1e300\n", "", "a.actions:1: drag: DX and DY");
+  expect_refused("frame 1e300 quit\n", "", "a.actions:1:7: expected 'frame N VERB");
+  expect_refused("frame 1 drag outside 1e300 -1e300\n", "", "a.actions:1:22: drag: DX and DY");
 }
 
 }  // namespace

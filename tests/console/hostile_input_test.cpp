@@ -277,6 +277,13 @@ TEST_F(HostileInput, NumericOptionsRejectNanAndZeroDurations) {
       {"console --view-scale nan --frames 1", "--view-scale: 'nan' is not a finite number"},
       {"console --slow-frame-ms nan --frames 1", "--slow-frame-ms: 'nan' is not a finite number"},
       {"console --device keyboard --insertion-mm nan --frames 1", "--insertion-mm: 'nan' is not a finite number"},
+      // Whole numbers in decimal digits only (audit 24, F11): 0x510 ran as 1296 triangles, and 1296.0
+      // was refused as "not in range 200 to 5000000".
+      {"mesh prostate --triangles 0x510 -o " + arg("x.off"), "--triangles: '0x510' is not a whole number of decimal digits"},
+      {"mesh prostate --triangles 1296.0 -o " + arg("x.off"), "--triangles: '1296.0' is not a whole number of decimal digits"},
+      {"run --headless --substeps 1e1", "--substeps: '1e1' is not a whole number of decimal digits"},
+      {"run --headless --triangles 199", "--triangles: 199 is outside [200, 1000000]"},
+      {"console --frames 99999999999999999999", "--frames: 99999999999999999999 is outside [1, 100000000]"},
   };
   for (const auto& [arguments, expected] : cases) expect_clean_failure(run_resecto_bounded(arguments), expected, arguments);
 }
@@ -288,6 +295,11 @@ TEST_F(HostileInput, PosesMustBeRigidAndWithinReach) {
   write_bytes(path("far.txt"), "1 0 0 1e200  0 1 0 0  0 0 1 0\n");
   expect_clean_failure(run_resecto_bounded(collide_args(arg("p.off"), "far.txt")),
                        "far.txt:1: translation 1e+200 is outside", "1e200");
+  // Lines ended by a lone CR (classic Mac OS) are lines, not one long line of 24 numbers (audit 24, F11).
+  write_bytes(path("cr.txt"), "# two poses\r1 0 0 0  0 1 0 0  0 0 1 0\r1 0 0 0  0 1 0 0  0 0 1 1\r");
+  const CommandOutput cr = run_resecto_bounded(collide_args(arg("p.off"), "cr.txt") + " --json");
+  ASSERT_EQ(cr.exit_code, 0) << cr.err;
+  EXPECT_NE(cr.out.find("\"poses\":2"), std::string::npos) << cr.out;
 }
 
 TEST_F(HostileInput, CalibrationInputsOutsideTheDeviceAreRefused) {

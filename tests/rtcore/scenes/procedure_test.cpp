@@ -62,23 +62,42 @@ TEST(Procedure, JointsInterpolateAndPedalsHold) {
   EXPECT_DOUBLE_EQ(p->sample(99.0).insertion_mm, 140.0);  // and after the last
 }
 
-TEST(Procedure, ErrorsNameTheLine) {
+TEST(Procedure, ErrorsNameTheLineAndColumn) {
   auto error_of = [](const std::string& text) {
     Result<Procedure> p = parse_procedure(text, "mine.txt");
     return p ? std::string() : p.error();
   };
-  EXPECT_EQ(error_of("# header\n0 0 0 0 100 0 0 0\n1 0 0 0 100 0\n").rfind("mine.txt:3: expected 8 columns", 0), 0u);
-  EXPECT_NE(error_of("0 0 0 0 100 0 0 0\n0 0 0 0 100 0 0 0\n").find("mine.txt:2: time_s must increase"), std::string::npos);
-  EXPECT_NE(error_of("0 0 0 0 300 0 0 0\n").find("mine.txt:1: insertion_mm 300 is outside [0, 230]"), std::string::npos);
-  EXPECT_NE(error_of("0 0 0 0 100 0 2 0\n").find("cut must be 0 or 1"), std::string::npos);
-  EXPECT_NE(error_of("0 0 zero 0 100 0 0 0\n").find("pitch_deg is not a number: 'zero'"), std::string::npos);
+  EXPECT_EQ(error_of("# header\n0 0 0 0 100 0 0 0\n1 0 0 0 100 0\n").rfind("mine.txt:3:14: expected 8 columns", 0), 0u);
+  EXPECT_NE(error_of("0 0 0 0 100 0 0 0\n0 0 0 0 100 0 0 0\n").find("mine.txt:2:1: time_s must increase"), std::string::npos);
+  EXPECT_NE(error_of("0 0 0 0 300 0 0 0\n").find("mine.txt:1:9: insertion_mm 300 is outside [0, 230]"), std::string::npos);
+  EXPECT_NE(error_of("0 0 0 0 100 0 2 0\n").find("mine.txt:1:15: cut must be 0 or 1"), std::string::npos);
+  EXPECT_NE(error_of("0 0 zero 0 100 0 0 0\n").find("mine.txt:1:5: pitch_deg is not a number: 'zero'"), std::string::npos);
   EXPECT_NE(error_of("0 0 0 0 0x10 0 0 0\n").find("insertion_mm is not a number: '0x10'"), std::string::npos);  // decimal only, as the meshes
   // A NUL in a word used to cut the message short at it (audit 24).
   EXPECT_NE(error_of(std::string("0 0 0 0 100 0 0 0\x00x\n", 20)).find("coagulate is not a number: '0\\x00x'"), std::string::npos)
       << error_of(std::string("0 0 0 0 100 0 0 0\x00x\n", 20));
-  EXPECT_NE(error_of("0 5 0 0 100 0 0 0\n").find("mine.txt:1: the first keyframe must have yaw, pitch and roll 0"), std::string::npos);
+  EXPECT_NE(error_of("0 5 0 0 100 0 0 0\n").find("mine.txt:1:3: the first keyframe must have yaw, pitch and roll 0"), std::string::npos);
   EXPECT_NE(error_of("# nothing\n").find("no keyframes"), std::string::npos);
   EXPECT_EQ(error_of("0 0 0 0 100 0 0 0   # start\n1 0 0 0 120 0 0 0# in\n"), "");  // a comment may end a line
+  // Columns count bytes from 1, tabs as one: the word at fault, or the line's end for a missing one.
+  EXPECT_NE(error_of("0 0 0 0 100 0 0 0\n1\t0 0 0 100 0 0 0 7\n").find("mine.txt:2:19: more than 8 columns"), std::string::npos)
+      << error_of("0 0 0 0 100 0 0 0\n1\t0 0 0 100 0 0 0 7\n");
+}
+
+// Lines may end in LF, CR LF or a lone CR (classic Mac OS, some spreadsheets' exports): a CR-only file
+// used to read as one line of 8 x N words, "more than 8 columns" (audit 24, F11).
+TEST(Procedure, LinesEndInLfCrLfOrCr) {
+  for (const char* ending : {"\n", "\r\n", "\r"}) {
+    const std::string text = std::string("# t yaw pitch roll insertion loop cut coag") + ending + "0 0 0 0 100 0 0 0" + ending +
+                             "1 0 0 0 120 5 1 0" + ending + ending + "2 0 0 0 140 0 0 0";
+    const Result<Procedure> p = parse_procedure(text, "mine.txt");
+    ASSERT_TRUE(p) << p.error();
+    ASSERT_EQ(p->keyframes.size(), 3u);
+    EXPECT_DOUBLE_EQ(p->keyframes[2].insertion_mm, 140.0);
+    const Result<Procedure> bad = parse_procedure(text + ending + "3 0 0 0 300 0 0 0" + ending, "mine.txt");
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().find("mine.txt:6:9: insertion_mm 300"), std::string::npos) << bad.error();
+  }
   Result<Procedure> unknown = find_procedure("tour");
   ASSERT_FALSE(unknown);
   EXPECT_NE(unknown.error().find("built-in: demo"), std::string::npos);
