@@ -494,7 +494,11 @@ double MassSpringTissue::kinetic_energy_j() const {
 
 double MassSpringTissue::max_displacement_m() const {
   double largest2 = 0.0;
-  for (std::size_t i = 0; i < x_.size(); ++i) largest2 = std::max(largest2, glm::dot(x_[i] - rest_[i], x_[i] - rest_[i]));
+  for (std::size_t i = 0; i < x_.size(); ++i) {
+    // A node whose tetrahedra have all gone (cut, torn) is no tissue, wherever it was left.
+    if (topology().valence(mesh_node_[i]) == 0) continue;
+    largest2 = std::max(largest2, glm::dot(x_[i] - rest_[i], x_[i] - rest_[i]));
+  }
   return std::sqrt(largest2);
 }
 

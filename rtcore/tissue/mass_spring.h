@@ -249,7 +249,7 @@ class MassSpringTissue {
   const SpringNetwork& network() const { return network_; }
   double total_mass_kg() const;
   double kinetic_energy_j() const;
-  /// Largest distance of a node from its rest position.
+  /// Largest distance of a tissue node (one some tetrahedron still holds) from its rest position.
   double max_displacement_m() const;
   const TissueFaults& faults() const { return faults_; }
   /// A bound on how far any node has moved since construction: the sum over steps of the step's

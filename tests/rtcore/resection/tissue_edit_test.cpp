@@ -259,5 +259,32 @@ TEST(TissueEdits, RefinementAlonePreservesMassAndUniformStrainStiffness) {
   expect_matches_fresh_build(tissue);
 }
 
+// A node whose tetrahedra have all gone is no tissue: wherever it was left, the largest tissue
+// displacement (the report's max_tissue_displacement_mm) does not count it. Dead nodes stay in the
+// arrays until a compaction, frozen where their last tetrahedron left them.
+TEST(TissueEdits, MaxDisplacementCountsOnlyNodesSomeTetrahedronHolds) {
+  const ProstateTissueModel& model = tissue_model(1296);
+  MassSpringTissue tissue(model.mesh);
+  const TetTopology& topo = tissue.topology();
+  const std::uint32_t orphan = topo.tetrahedron(0)[0];  // a mesh node
+  std::vector<std::uint32_t> around;
+  topo.for_each_tetrahedron_of(orphan, [&](std::uint32_t t) { around.push_back(t); });
+  std::sort(around.begin(), around.end());
+  ASSERT_FALSE(tissue.edit_tetrahedra(around, {}, {}).refused);
+  ASSERT_EQ(topo.valence(orphan), 0u);
+  std::vector<Vec3> moved(tissue.positions().begin(), tissue.positions().end());
+  std::size_t orphan_at = moved.size();
+  for (std::size_t i = 0; i < moved.size(); ++i) {
+    if (tissue.mesh_node(i) == orphan) orphan_at = i;
+  }
+  ASSERT_LT(orphan_at, moved.size());
+  moved[orphan_at] += Vec3(0.05, 0.0, 0.0);  // 50 mm away
+  std::size_t neighbour = (orphan_at + 1) % moved.size();
+  while (topo.valence(tissue.mesh_node(neighbour)) == 0) neighbour = (neighbour + 1) % moved.size();
+  moved[neighbour] += Vec3(0.0, 0.002, 0.0);  // 2 mm: tissue
+  tissue.set_positions(moved);
+  EXPECT_NEAR(tissue.max_displacement_m(), 0.002, 1e-12);
+}
+
 }  // namespace
 }  // namespace resecto
