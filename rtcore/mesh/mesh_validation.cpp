@@ -308,13 +308,15 @@ Result<SurfaceReport> validate_closed_surface(const TriangleMesh& mesh, const Va
   report.volume_m3 = signed_volume(mesh);
 
   // Orientation is checked per component: each must enclose positive volume.
+  // Each from a corner of the component's first face, not the world origin (signed_volume's reason).
   std::vector<double> component_volume(mesh.vertex_count(), 0.0);
   std::vector<std::uint32_t> component_first_face(mesh.vertex_count(), UINT32_MAX);
   for (std::size_t f = 0; f < mesh.triangle_count(); ++f) {
     const Triangle& t = mesh.triangles[f];
     const std::uint32_t root = components.find(t[0]);
-    component_volume[root] += dot(mesh.positions[t[0]], cross(mesh.positions[t[1]], mesh.positions[t[2]])) / 6.0;
     component_first_face[root] = std::min(component_first_face[root], static_cast<std::uint32_t>(f));
+    const Vec3& from = mesh.positions[mesh.triangles[component_first_face[root]][0]];
+    component_volume[root] += dot(mesh.positions[t[0]] - from, cross(mesh.positions[t[1]] - from, mesh.positions[t[2]] - from)) / 6.0;
   }
   for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
     if (component_first_face[v] != UINT32_MAX && component_volume[v] <= 0.0) {

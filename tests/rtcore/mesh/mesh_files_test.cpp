@@ -128,6 +128,35 @@ TEST(MeshFiles, InwardSurfaceIsRejected) {
   EXPECT_NE(error.find("face 0"), std::string::npos) << error;
 }
 
+// A small solid far from the origin (a part in scanner coordinates): the volume used to be summed
+// about the world origin, where its terms cancel; a correct 1 mm cube at 999000 mm read as inward,
+// and a 10 mm one as 1.05 ml (audit 25, F1).
+TEST(MeshFiles, VolumeAndOrientationHoldFarFromTheOrigin) {
+  const auto cube_at = [](double side, double offset, bool inward) {
+    std::string text = "OFF\n8 12 0\n";
+    for (int v = 0; v < 8; ++v) {
+      const int x = (v == 1 || v == 2 || v == 5 || v == 6), y = (v == 2 || v == 3 || v == 6 || v == 7), z = v >= 4;
+      text += std::to_string(offset + side * x) + " " + std::to_string(offset + side * y) + " " + std::to_string(offset + side * z) + "\n";
+    }
+    for (const auto& t : kCubeFaces) {
+      text += "3 " + std::to_string(t[0]) + " " + std::to_string(inward ? t[2] : t[1]) + " " + std::to_string(inward ? t[1] : t[2]) + "\n";
+    }
+    return text;
+  };
+  for (const double offset : {0.0, 300000.0, 999000.0}) {
+    SCOPED_TRACE(offset);
+    for (const double side : {1.0, 10.0}) {
+      Result<TriangleMesh> mesh = read_surface_mesh(write_file("far.off", cube_at(side, offset, false)));
+      ASSERT_TRUE(mesh) << mesh.error();
+      Result<SurfaceReport> report = validate_closed_surface(*mesh);
+      ASSERT_TRUE(report) << report.error();
+      const double volume_m3 = side * side * side * 1e-9;
+      EXPECT_NEAR(report->volume_m3, volume_m3, 1e-9 * volume_m3);
+      EXPECT_NE(validation_error(write_file("far_inward.off", cube_at(side, offset, true))).find("inward orientation"), std::string::npos);
+    }
+  }
+}
+
 TEST(MeshFiles, NonManifoldEdgeNamesTheFaces) {
   // A cube plus a fin: an extra triangle on the cube's edge (0, 1) makes that edge three-way.
   std::string text = "OFF\n9 13 0\n" + std::string(kCubeVertices) + "0.5 -1 -1\n";
