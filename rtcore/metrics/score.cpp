@@ -103,6 +103,19 @@ void ScoreTracker::reserve(std::size_t steps) {
   lobe_history_.reserve(steps);
 }
 
+int ScoreTracker::nearest_lobe(const Vec3& wire) const {
+  const double theta = std::atan2(wire.y, wire.x);
+  int nearest = -1;
+  double best = 0.0;
+  for (int lobe = 0; lobe < kLobeCount; ++lobe) {
+    if (!lobe_present_[lobe]) continue;
+    const Vec3& crest = lobes_[static_cast<std::size_t>(lobe)];
+    const double d = std::abs(std::remainder(theta - std::atan2(crest.y, crest.x), 2.0 * 3.141592653589793));
+    if (nearest < 0 || d < best) nearest = lobe, best = d;
+  }
+  return nearest;
+}
+
 void ScoreTracker::observe(const Simulation& sim) {
   const ProcedureMetrics& m = sim.metrics();
   const double time_s = static_cast<double>(sim.tick()) * tick_s_;
@@ -119,16 +132,7 @@ void ScoreTracker::observe(const Simulation& sim) {
   const double removed_g = m.resected_adenoma_g - last_adenoma_g_;
   last_adenoma_g_ = m.resected_adenoma_g;
   if (removed_g > 0.0) {
-    const double theta = std::atan2(tip.y, tip.x);
-    int nearest = -1;
-    double best = 0.0;
-    for (int lobe = 0; lobe < kLobeCount; ++lobe) {
-      if (!lobe_present_[lobe]) continue;
-      const Vec3& crest = lobes_[static_cast<std::size_t>(lobe)];
-      const double d = std::abs(std::remainder(theta - std::atan2(crest.y, crest.x), 2.0 * 3.141592653589793));
-      if (nearest < 0 || d < best) nearest = lobe, best = d;
-    }
-    if (nearest >= 0) lobe_g_[static_cast<std::size_t>(nearest)] += removed_g;
+    if (const int nearest = nearest_lobe(tip); nearest >= 0) lobe_g_[static_cast<std::size_t>(nearest)] += removed_g;
   }
   lobe_history_.push_back(lobe_g_);
 
@@ -167,15 +171,24 @@ ProcedureScore ScoreTracker::finish(const Simulation& sim) const {
   out.peak_force_n = m.peak_reaction_force_n;
   out.mean_contact_force_n = m.mean_contact_force_n;
   out.cut_pedal_time_s = m.cut_pedal_time_s;
-  out.lobe_adenoma_g = lobe_g_;
+  // What the last steps removed after the last observation (the collision job a run's end collects,
+  // Simulation::settle) goes to a lobe by the same rule, from where the wire is now: the lobes always
+  // add up to the adenoma resected (audit 25, F2: a procedure ending in a stroke left 27% to none).
+  std::array<double, kLobeCount> lobe_g = lobe_g_;
+  if (const double tail_g = m.resected_adenoma_g - last_adenoma_g_; tail_g > 0.0) {
+    if (const int nearest = nearest_lobe(sim.tool_poses().loop.apply_point(wire_middle_tool_)); nearest >= 0) {
+      lobe_g[static_cast<std::size_t>(nearest)] += tail_g;
+    }
+  }
+  out.lobe_adenoma_g = lobe_g;
   // The order lobes were reached in: the first step each had lost a quarter of its final total.
   std::array<std::size_t, kLobeCount> reached{};
   for (int lobe = 0; lobe < kLobeCount; ++lobe) {
     const auto l = static_cast<std::size_t>(lobe);
     reached[l] = lobe_history_.size();
-    if (lobe_g_[l] <= 0.0) continue;
+    if (lobe_g[l] <= 0.0) continue;
     for (std::size_t step = 0; step < lobe_history_.size(); ++step) {
-      if (lobe_history_[step][l] >= kLobeReachedFraction * lobe_g_[l]) {
+      if (lobe_history_[step][l] >= kLobeReachedFraction * lobe_g[l]) {
         reached[l] = step;
         break;
       }

@@ -95,6 +95,8 @@ class ScoreTracker {
   const std::vector<ScoreSample>& series() const { return series_; }
 
  private:
+  /// The lobe whose crest lies nearest the wire in angle around the channel axis (-1: no landmarks).
+  int nearest_lobe(const Vec3& wire) const;
   Vec3 wire_middle_tool_{0.0};           // the cutting wire's middle point in the loop's frame
   std::array<Vec3, kLobeCount> lobes_{};  // landmark positions
   bool lobe_present_[kLobeCount] = {false, false, false};

@@ -70,6 +70,35 @@ TEST(Score, ReadsTheCoresTotalsAndDerivesTheRates) {
   EXPECT_NEAR(m.lobe_adenoma_g[0] + m.lobe_adenoma_g[1] + m.lobe_adenoma_g[2], m.resected_adenoma_g, 1e-9);
 }
 
+// A procedure that ends in a stroke: what the run's last collision job removes (collected at the
+// end, Simulation::settle) comes after the last observation, and went to no lobe (audit 25, F2).
+TEST(Score, LobesAddUpToTheAdenomaWhenTheRunEndsInAStroke) {
+  Result<Procedure> demo = builtin_procedure("demo");
+  ASSERT_TRUE(demo);
+  int exercised = 0;
+  for (const double end_s : {5.3, 5.6, 5.9, 6.2, 8.0, 8.4}) {  // the strokes cut 5.0-6.3 s and 7.6-8.9 s
+    SCOPED_TRACE(end_s);
+    SimulationConfig config;
+    config.prostate_triangles = 1296;
+    auto sim = Simulation::create(config);
+    ASSERT_TRUE(sim) << sim.error();
+    Simulation& s = **sim;
+    ScoreTracker tracker(s);
+    const double tick_s = s.config().tick_s();
+    const auto ticks = static_cast<std::uint64_t>(std::llround(end_s / tick_s));
+    for (std::uint64_t t = 0; t < ticks; ++t) {
+      s.step(procedure_input(*demo, t, tick_s), {});
+      if (s.is_collision_tick(t)) tracker.observe(s);
+    }
+    const double observed_g = s.metrics().resected_adenoma_g;
+    s.settle();
+    const ScoreMetrics m = tracker.finish(s).metrics;
+    exercised += m.resected_adenoma_g > observed_g ? 1 : 0;
+    EXPECT_NEAR(m.lobe_adenoma_g[0] + m.lobe_adenoma_g[1] + m.lobe_adenoma_g[2], m.resected_adenoma_g, 1e-9);
+  }
+  EXPECT_GT(exercised, 0) << "no run's last collision job removed anything: the case is not exercised";
+}
+
 TEST(Score, ToolPathIsAtLeastTheStraightLinesTheScriptDrawsAndSpeedIsPathOverTime) {
   const ScoreMetrics& m = demo_run().score.metrics;
   // The demo goes in 47 mm and back out: the wire travels that twice at least.
