@@ -657,6 +657,13 @@ Result<RawMesh> parse_binary_stl(std::string_view bytes, const std::string& name
   return raw;
 }
 
+// ASCII STL's keywords in any case: older CAD exporters write them in capitals ("SOLID", "FACET
+// NORMAL", "VERTEX"), which read as a binary file claiming 774910240 triangles (audit 25, F4).
+bool stl_keyword(std::string_view word, std::string_view lower) {
+  return word.size() == lower.size() &&
+         std::equal(word.begin(), word.end(), lower.begin(), [](char a, char b) { return std::tolower(static_cast<unsigned char>(a)) == b; });
+}
+
 Result<RawMesh> parse_ascii_stl(std::string_view text, const std::string& name) {
   TextLines lines(text, name);
   RawMesh raw;
@@ -673,16 +680,16 @@ Result<RawMesh> parse_ascii_stl(std::string_view text, const std::string& name) 
     switch (expect) {
       case Expect::solid:
       case Expect::nothing:
-        if (keyword != "solid") return expected(expect == Expect::solid ? "'solid'" : "'solid' or the end of the file");
+        if (!stl_keyword(keyword, "solid")) return expected(expect == Expect::solid ? "'solid'" : "'solid' or the end of the file");
         expect = Expect::facet_or_end;
         break;
       case Expect::facet_or_end:
-        if (keyword == "endsolid") {
+        if (stl_keyword(keyword, "endsolid")) {
           expect = Expect::nothing;
           break;
         }
-        if (keyword != "facet") return expected("'facet' or 'endsolid'");
-        if (words.size() != 5 || words[1] != "normal") return lines.error("expected 'facet normal nx ny nz'");
+        if (!stl_keyword(keyword, "facet")) return expected("'facet' or 'endsolid'");
+        if (words.size() != 5 || !stl_keyword(words[1], "normal")) return lines.error("expected 'facet normal nx ny nz'");
         for (std::size_t i = 2; i < 5; ++i) {
           if (!is_number(words[i])) {
             return lines.error_at(words[i], "normal " + quoted_word(words[i]) + " is not a number");
@@ -692,12 +699,12 @@ Result<RawMesh> parse_ascii_stl(std::string_view text, const std::string& name) 
         expect = Expect::outer_loop;
         break;
       case Expect::outer_loop:
-        if (words.size() != 2 || keyword != "outer" || words[1] != "loop") return expected("'outer loop'");
+        if (words.size() != 2 || !stl_keyword(keyword, "outer") || !stl_keyword(words[1], "loop")) return expected("'outer loop'");
         expect = Expect::vertex;
         corner = 0;
         break;
       case Expect::vertex: {
-        if (keyword != "vertex") return expected("'vertex'");
+        if (!stl_keyword(keyword, "vertex")) return expected("'vertex'");
         if (words.size() != 4) return lines.error("expected 'vertex x y z'");
         double xyz[3];
         for (int a = 0; a < 3; ++a) {
@@ -710,11 +717,11 @@ Result<RawMesh> parse_ascii_stl(std::string_view text, const std::string& name) 
         break;
       }
       case Expect::endloop:
-        if (keyword != "endloop") return expected("'endloop' (a facet has 3 vertices)");
+        if (!stl_keyword(keyword, "endloop")) return expected("'endloop' (a facet has 3 vertices)");
         expect = Expect::endfacet;
         break;
       case Expect::endfacet:
-        if (keyword != "endfacet") return expected("'endfacet'");
+        if (!stl_keyword(keyword, "endfacet")) return expected("'endfacet'");
         raw.end_face();
         expect = Expect::facet_or_end;
         break;
@@ -735,7 +742,7 @@ Result<RawMesh> parse_stl(std::string_view bytes, const std::string& name) {
   // earlier; a binary STL's header may begin with those bytes, so here only ahead of the text).
   const std::string_view text = bytes.starts_with("\xEF\xBB\xBF") ? bytes.substr(3) : bytes;
   const std::size_t first = text.find_first_not_of(" \t\r\n");
-  if (first != std::string_view::npos && text.substr(first, 5) == "solid") return parse_ascii_stl(text, name);
+  if (first != std::string_view::npos && stl_keyword(text.substr(first, 5), "solid")) return parse_ascii_stl(text, name);
   if (bytes.size() >= 84) return parse_binary_stl(bytes, name);
   return Error{name + ": neither ASCII STL (no 'solid') nor binary STL (" + std::to_string(bytes.size()) + " bytes, under the 84-byte header)"};
 }

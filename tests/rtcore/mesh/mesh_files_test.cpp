@@ -76,6 +76,26 @@ TEST(MeshFiles, ReadsAValidCubeInEveryFormat) {
   }
 }
 
+// ASCII STL's keywords in capitals, as older CAD exporters write them, read as the lowercase ones: they
+// were taken for a binary STL declaring 774910240 triangles (audit 25, F4).
+TEST(MeshFiles, AsciiStlKeywordsInAnyCase) {
+  std::string stl = "SOLID CUBE\n";
+  const double corners[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  for (const auto& t : kCubeFaces) {
+    stl += " Facet Normal 0 0 0\n  OUTER LOOP\n";
+    for (int c = 0; c < 3; ++c) {
+      const double* p = corners[t[c]];
+      stl += "   VERTEX " + std::to_string(p[0]) + " " + std::to_string(p[1]) + " " + std::to_string(p[2]) + "\n";
+    }
+    stl += "  ENDLOOP\n ENDFACET\n";
+  }
+  stl += "ENDSOLID CUBE\n";
+  Result<TriangleMesh> mesh = read_surface_mesh(write_file("upper.stl", stl));
+  ASSERT_TRUE(mesh) << mesh.error();
+  EXPECT_EQ(mesh->triangle_count(), 12u);
+  EXPECT_TRUE(validate_closed_surface(*mesh));
+}
+
 TEST(MeshFiles, PolygonsAreFanTriangulatedInFileOrder) {
   const auto path = write_file("quads.off",
                                "OFF\n8 6 0\n" + std::string(kCubeVertices) +
