@@ -56,9 +56,11 @@ void replay(const ReplayOptions& o) {
     std::printf("replayed %llu ticks (%.2f s) of %s, final state hash %s\n", static_cast<unsigned long long>(ticks),
                 out["simulated_s"].get<double>(), o.file.c_str(), out["state_hash"].get<std::string>().c_str());
     if (out.contains("recorded_state_hash")) std::printf("  the run ended with state hash %s\n", out["recorded_state_hash"].get<std::string>().c_str());
-    if (!complete) {
+    if (ticks < recording->ticks().size()) {
       std::printf("  the recording's inputs end or break at tick %llu (%llu ticks recorded, %zu damaged ranges)\n",
                   static_cast<unsigned long long>(ticks), static_cast<unsigned long long>(recording->ticks().size()), recording->damaged().size());
+    } else if (!recording->damaged().empty()) {
+      std::printf("  every recorded tick replayed; the file has %zu damaged ranges (`resecto rec verify` names them)\n", recording->damaged().size());
     }
     if (o.verify) {
       std::printf("  %llu of %llu recorded hashes verified, %llu mismatches\n", static_cast<unsigned long long>(r.verified_hashes()),

@@ -162,6 +162,23 @@ TEST(RecordingCommands, VerifyNamesADamagedChunkAndRecoverRepairsIt) {
 // A recording cut short and recovered: every hash left in it matches, but the cut took the rest of
 // the procedure and the recorder's summary, so --verify says how many matched and exits 1 (it printed
 // "45 of 90 recorded hashes verified, 0 mismatches" and exited 0).
+// Bytes after the trailer damage the file but touch no input or hash: replay --verify still fails
+// it (a damaged file cannot vouch for itself) and says so, not that hashes could not be compared or
+// that the inputs break (audit 25, F5).
+TEST(RecordingCommands, DamageThatTouchesNoHashIsReportedAsSuch) {
+  const auto [dir, file, r] = record_and_open("recording_appended", "--seconds 1");
+  ASSERT_TRUE(r);
+  const auto appended = dir / "appended.rsrec";
+  std::ofstream(appended, std::ios::binary) << testing::read_text(file) << std::string(100, 'x');
+  const testing::CommandOutput replay = run_resecto("replay " + appended.string() + " --verify");
+  EXPECT_EQ(replay.exit_code, 1) << replay.out;
+  EXPECT_NE(replay.err.find("all " + std::to_string(r->steps().size()) + " collision steps' hashes in the file matched"), std::string::npos)
+      << replay.err;
+  EXPECT_NE(replay.err.find("`resecto rec recover` keeps what is intact"), std::string::npos) << replay.err;
+  EXPECT_EQ(replay.out.find("end or break"), std::string::npos) << replay.out;
+  EXPECT_NE(replay.out.find("every recorded tick replayed"), std::string::npos) << replay.out;
+}
+
 TEST(RecordingCommands, ACutRecordingRecoveredDoesNotVerifyAsWhole) {
   const auto [dir, file, r] = record_and_open("recording_cut_recovered", "--seconds 2");
   ASSERT_TRUE(r);
@@ -176,7 +193,7 @@ TEST(RecordingCommands, ACutRecordingRecoveredDoesNotVerifyAsWhole) {
   // Which reason it gives depends on where the cut fell (in a ticks chunk whose hashes are already in
   // the file, or after both): the recorder thread's timing decides the chunks' order.
   EXPECT_EQ(replay.err.rfind("resecto: " + recovered.string() + ": ", 0), 0u) << replay.err;
-  EXPECT_NE(replay.err.find(" collision steps' hashes could be compared"), std::string::npos) << replay.err;
+  EXPECT_NE(replay.err.find(" collision steps' hashes in the file "), std::string::npos) << replay.err;
   const nlohmann::json out = json_of(run_resecto("replay " + recovered.string() + " --verify --json"));
   EXPECT_EQ(out["mismatches"], 0);
   EXPECT_GT(out["verified_hashes"].get<int>(), 0);

@@ -289,8 +289,8 @@ TEST(RecordingFile, ARecoveredCutOrGappedRecordingDoesNotVerifyAsWhole) {
   EXPECT_EQ(once->recovered_damaged_ranges(), 1u);
   EXPECT_EQ(unverified_after_replay(*once),
             "recovered.rsrec: `resecto rec recover` made it from a damaged recording that was never closed (1 "
-            "damaged ranges left out): how many hashes those held is unknown: only " +
-                std::to_string(intact.steps().size()) + " collision steps' hashes could be compared");
+            "damaged ranges left out): how many hashes those held is unknown: all " +
+                std::to_string(intact.steps().size()) + " collision steps' hashes in the file matched, which vouches for those alone");
   const Result<Recording> twice = Recording::from_bytes(recovered_bytes(*once, report), "twice.rsrec");
   ASSERT_TRUE(twice);
   EXPECT_EQ(twice->recovered_damaged_ranges(), 1u) << "a recovery of a recovery keeps the count";
