@@ -70,6 +70,7 @@ void score(const ScoreOptions& o) {
       skipped.push_back({{"file", file}, {"reason", result.error()}});
       continue;
     }
+    if (!result->note.empty()) std::fprintf(stderr, "note: %s\n", result->note.c_str());
     scored.push_back(std::move(*result));
   }
   if (comparing && scored.size() != 2) throw std::runtime_error("score --compare: both recordings must score (see above)");

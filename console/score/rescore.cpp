@@ -128,10 +128,19 @@ Result<RecordingScore> score_recording(const std::filesystem::path& path, const 
   const std::string name = path.string();
   Result<rec::Recording> recording = rec::Recording::open(path);
   if (!recording) return Error{recording.error()};  // it names the file
+  std::string note;
   if (!recording->damaged().empty()) {
+    // Damage that took only keyframes, hashes or bytes past the end leaves every tick and command the
+    // recorder counted when it closed the file: the procedure is whole, and scores (the `rec recover`
+    // copy of such a file scored while the file itself was skipped; audit 25, F7).
     const rec::DamagedRange& d = recording->damaged().front();
-    return Error{name + ": damaged (" + std::to_string(recording->damaged().size()) + " damaged byte ranges, the first at byte " +
-                 std::to_string(d.offset) + "); a score from part of a procedure would mislead"};
+    const std::string damaged = "damaged (" + std::to_string(recording->damaged().size()) + " damaged byte ranges, the first at byte " +
+                                std::to_string(d.offset) + ")";
+    const std::optional<std::uint64_t> ticks = recording->summary_count("ticks"), commands = recording->summary_count("commands");
+    const bool whole = ticks && commands && *ticks == recording->ticks().size() && *commands == recording->commands().size() &&
+                       recording->content_errors().empty() && recording->replayable_ticks() == recording->ticks().size();
+    if (!whole) return Error{name + ": " + damaged + "; a score from part of a procedure would mislead"};
+    note = name + ": " + damaged + ", but every tick and command the recorder wrote is intact: scored";
   }
   if (!recording->content_errors().empty()) return Error{name + ": " + recording->content_errors().front()};
   if (std::string lost = lost_part_of_procedure(*recording); !lost.empty())
@@ -170,6 +179,7 @@ Result<RecordingScore> score_recording(const std::filesystem::path& path, const 
   out.procedure = recording->header().procedure;
   out.ticks = sim.tick();
   out.verified_hashes = replayer.verified_hashes();
+  out.note = note;
   out.score = tracker.finish(sim);
   return out;
 }

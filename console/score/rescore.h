@@ -21,6 +21,8 @@ struct RecordingScore {
   std::string procedure;       ///< as the recording's header names it
   std::uint64_t ticks = 0;
   std::uint64_t verified_hashes = 0;
+  /// Why a damaged file was scored anyway (its damage lost no tick or command), or empty.
+  std::string note;
   ProcedureScore score;
 };
 

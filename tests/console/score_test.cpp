@@ -181,6 +181,13 @@ TEST(ScoreCommand, ARecoveredCutRecordingIsSkippedLikeTheCutOne) {
   const json both = score_json(file.string() + " " + kept.string());
   ASSERT_EQ(both.at("scored").size(), 2u);
   EXPECT_EQ(both["scored"][0]["metrics"], both["scored"][1]["metrics"]);
+  // The damaged file itself holds the same ticks and commands: it scores too, with a note (it was
+  // skipped as "part of a procedure" while its recovery scored; audit 25, F7).
+  const CommandOutput as_is = run_resecto("score --quiet --json " + damaged.string());
+  EXPECT_EQ(as_is.exit_code, 0) << as_is.err;
+  EXPECT_NE(as_is.err.find("note: " + damaged.string() + ": damaged (1 damaged byte ranges"), std::string::npos) << as_is.err;
+  EXPECT_NE(as_is.err.find("every tick and command the recorder wrote is intact: scored"), std::string::npos) << as_is.err;
+  EXPECT_EQ(json::parse(as_is.out)["scored"][0]["metrics"], both["scored"][0]["metrics"]);
 }
 
 // Cut between two chunks (a run killed between the recorder's writes), a file holds no damage and reads
