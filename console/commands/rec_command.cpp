@@ -1,5 +1,6 @@
 // `resecto rec info|verify|recover|export`: the recording tools (recordings/README.md has the file's
 // layout). Every one reads damaged and cut files: what is intact is used, what is not is named.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -30,6 +31,19 @@ struct InfoOptions {
   std::string file;
   bool json = false;
 };
+
+
+/// Whether the file ends with its index, as the recorder closes it; if not, whether an intact index
+/// chunk shows it was closed all the same (bytes appended after the trailer, or the trailer damaged:
+/// "not closed" said of such a file was false; audit 25, F6).
+std::string index_state(const rec::Recording& r) {
+  if (r.index_present()) return "present";
+  const auto index = std::find_if(r.chunks().begin(), r.chunks().end(),
+                                  [](const rec::ChunkLocation& c) { return c.type == static_cast<std::uint16_t>(rec::ChunkType::kIndex); });
+  if (index == r.chunks().end()) return "absent: the recording was not closed";
+  return "intact at byte " + std::to_string(index->offset) + ", but the file does not end with its trailer after it (bytes follow at byte " +
+         std::to_string(index->end()) + ", or the trailer is damaged): the recording was closed";
+}
 
 void info(const InfoOptions& o) {
   const rec::Recording r = open_recording(o.file);
@@ -95,7 +109,7 @@ void info(const InfoOptions& o) {
   for (const auto& [name, count] : byte_counts.items()) {
     if (name != "file" && count.get<std::uint64_t>() > 0) std::printf(" %s %llu", name.c_str(), static_cast<unsigned long long>(count.get<std::uint64_t>()));
   }
-  std::printf("\n  index      %s; %zu damaged ranges\n", r.index_present() ? "present" : "absent (not closed: `rec recover` rebuilds it)", r.damaged().size());
+  std::printf("\n  index      %s; %zu damaged ranges\n", index_state(r).c_str(), r.damaged().size());
   for (const rec::DamagedRange& d : r.damaged()) std::printf("  damaged    %s\n", rec::describe(d).c_str());
 }
 
@@ -111,7 +125,7 @@ void verify(const std::string& file) {
     ++problems;
   }
   if (!r.index_present()) {
-    std::fprintf(stderr, "%s: no index: the recording was not closed (`resecto rec recover %s OUT` rebuilds it)\n", file.c_str(), file.c_str());
+    std::fprintf(stderr, "%s: index %s (`resecto rec recover %s OUT` writes a sound copy)\n", file.c_str(), index_state(r).c_str(), file.c_str());
     ++problems;
   }
   // A chunk whose CRC holds can still be unusable (written wrong, or rewritten with a new CRC): the

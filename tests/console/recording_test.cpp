@@ -177,6 +177,14 @@ TEST(RecordingCommands, DamageThatTouchesNoHashIsReportedAsSuch) {
   EXPECT_NE(replay.err.find("`resecto rec recover` keeps what is intact"), std::string::npos) << replay.err;
   EXPECT_EQ(replay.out.find("end or break"), std::string::npos) << replay.out;
   EXPECT_NE(replay.out.find("every recorded tick replayed"), std::string::npos) << replay.out;
+  // The recorder closed it: its index is intact, the bytes after the trailer are what is wrong.
+  const testing::CommandOutput verify = run_resecto("rec verify " + appended.string());
+  EXPECT_EQ(verify.exit_code, 1);
+  EXPECT_NE(verify.err.find("index intact at byte "), std::string::npos) << verify.err;
+  EXPECT_NE(verify.err.find("the recording was closed"), std::string::npos) << verify.err;
+  EXPECT_EQ(verify.err.find("not closed"), std::string::npos) << verify.err;
+  const testing::CommandOutput info = run_resecto("rec info " + appended.string());
+  EXPECT_NE(info.out.find("index      intact at byte "), std::string::npos) << info.out;
 }
 
 TEST(RecordingCommands, ACutRecordingRecoveredDoesNotVerifyAsWhole) {
