@@ -261,7 +261,14 @@ Result<SurfaceFrame> Recording::decode_keyframe(std::size_t k) const {
   return frame;
 }
 
-double Recording::duration_s() const { return static_cast<double>(ticks_.size()) * header_.simulation.tick_s(); }
+double Recording::duration_s() const {
+  if (ticks_.empty()) return 0.0;
+  return static_cast<double>(ticks_.back().tick + 1 - ticks_.front().tick) * header_.simulation.tick_s();
+}
+
+std::uint64_t Recording::missing_ticks() const {
+  return ticks_.empty() ? 0 : ticks_.back().tick + 1 - ticks_.front().tick - ticks_.size();
+}
 
 std::array<std::uint64_t, kChunkTypeCount> Recording::bytes_by_type() const {
   std::array<std::uint64_t, kChunkTypeCount> bytes{};

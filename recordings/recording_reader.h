@@ -90,8 +90,11 @@ class Recording {
   /// for a file no recovery made. What they held is lost, though the file itself is sound.
   std::uint64_t recovered_damaged_ranges() const;
 
-  /// Simulated seconds the ticks cover.
+  /// Simulated seconds from the first recorded tick to the end of the last (a gap a recovery left
+  /// counts: the procedure spans it, though its ticks are lost).
   double duration_s() const;
+  /// Ticks between the first and the last recorded one that are not in the file (a gap a recovery left).
+  std::uint64_t missing_ticks() const;
   /// Bytes of intact chunks (frames included) by chunk type (index = ChunkType value).
   std::array<std::uint64_t, kChunkTypeCount> bytes_by_type() const;
   std::array<std::uint64_t, kChunkTypeCount> chunks_by_type() const;

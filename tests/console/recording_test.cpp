@@ -187,6 +187,28 @@ TEST(RecordingCommands, DamageThatTouchesNoHashIsReportedAsSuch) {
   EXPECT_NE(info.out.find("index      intact at byte "), std::string::npos) << info.out;
 }
 
+// A ticks chunk lost in the middle: the recovered file is sound but its inputs break there. rec verify
+// said "ok" of it and rec info gave the duration of the ticks left (audit 25, F8).
+TEST(RecordingCommands, ARecoveryWithAGapIsSoundButNotOk) {
+  const auto [dir, file, r] = record_and_open("recording_gap", "--seconds 2");
+  ASSERT_TRUE(r);
+  std::string bytes = testing::read_text(file);
+  const std::string ticks_marker("CHNK\x02\x00", 6);
+  const std::size_t first = bytes.find(ticks_marker), second = bytes.find(ticks_marker, first + 1);
+  ASSERT_NE(second, std::string::npos);
+  ASSERT_NE(bytes.find(ticks_marker, second + 1), std::string::npos) << "fewer than three ticks chunks: no middle one to lose";
+  for (std::size_t i = second + 40; i < second + 48; ++i) bytes[i] = static_cast<char>(bytes[i] ^ 0xff);  // the second one's payload
+  const auto damaged = dir / "gap.rsrec", recovered = dir / "gap_recovered.rsrec";
+  std::ofstream(damaged, std::ios::binary) << bytes;
+  ASSERT_EQ(run_resecto("rec recover " + damaged.string() + " " + recovered.string()).exit_code, 0);
+  const testing::CommandOutput verify = run_resecto("rec verify " + recovered.string());
+  EXPECT_EQ(verify.out.find(": ok,"), std::string::npos) << verify.out;
+  EXPECT_NE(verify.out.find(": sound, "), std::string::npos) << verify.out;
+  EXPECT_NE(verify.out.find(" recorded ticks replay: the inputs break at tick "), std::string::npos) << verify.out;
+  const nlohmann::json info = json_of(run_resecto("rec info " + recovered.string() + " --json"));
+  EXPECT_DOUBLE_EQ(info["duration_s"].get<double>(), 2.0) << "the procedure spans the gap";
+}
+
 TEST(RecordingCommands, ACutRecordingRecoveredDoesNotVerifyAsWhole) {
   const auto [dir, file, r] = record_and_open("recording_cut_recovered", "--seconds 2");
   ASSERT_TRUE(r);
