@@ -113,8 +113,8 @@ void score(const ScoreOptions& o) {
   } else {
     for (const RecordingScore& s : scored) {
       const ScoreMetrics& m = s.score.metrics;
-      std::printf("%s (%s, %.1f s): %.2f g resected (%.2f g adenoma, %.1f%% of it left), %.2f g/min, %llu cuts, %llu perforations, "
-                  "%llu sphincter-zone violations, %.2f s loop on idle, tool path %.0f mm\n",
+      std::printf("%s (%s, %.1f s): %.2f g resected (%.2f g adenoma, %.1f%% of it left), %.2f g/min, cuts %llu, perforations %llu, "
+                  "sphincter-zone violations %llu, pedal down with nothing cut %.2f s, tool path %.0f mm\n",
                   s.file.c_str(), s.procedure.c_str(), m.procedure_time_s, m.resected_total_g, m.resected_adenoma_g,
                   100.0 * m.remaining_adenoma_fraction, m.grams_per_minute, static_cast<unsigned long long>(m.cuts),
                   static_cast<unsigned long long>(m.perforations), static_cast<unsigned long long>(m.sphincter_zone_violations), m.loop_on_idle_s,

@@ -364,8 +364,8 @@ std::string summarize_report(const ordered_json& r) {
   }
   const auto& topology = r.at("stages").at("topology");
   std::snprintf(text, sizeof text,
-                "  resection  %.2f g resected (adenoma %.2f, capsule %.2f), %.1f%% of the adenoma remains; %llu cuts, %llu chips "
-                "(%.2f g), %llu refined; perforations %llu, sphincter-zone violations %llu; topology update p99 %.0f us\n",
+                "  resection  %.2f g resected (adenoma %.2f, capsule %.2f), %.1f%% of the adenoma remains; cuts %llu, chips %llu "
+                "(%.2f g), refined tetrahedra %llu; perforations %llu, sphincter-zone violations %llu; topology update p99 %.0f us\n",
                 m.at("resected_g").at("total").get<double>(), m.at("resected_g").at("adenoma").get<double>(),
                 m.at("resected_g").at("capsule").get<double>(), 100.0 * m.at("remaining_adenoma_fraction").get<double>(),
                 static_cast<unsigned long long>(m.at("cuts").get<std::uint64_t>()), static_cast<unsigned long long>(m.at("chips").get<std::uint64_t>()),

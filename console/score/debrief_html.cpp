@@ -37,6 +37,13 @@ struct MetricRow {
   const char* reference;
 };
 
+/// A lobe as a reader writes it: "left lateral", not the report's key "left_lateral".
+std::string lobe_display_name(int lobe) {
+  std::string name = kLobeNames[lobe];
+  std::replace(name.begin(), name.end(), '_', ' ');
+  return name;
+}
+
 std::string number(double v, int decimals) {
   char pattern[8];
   std::snprintf(pattern, sizeof pattern, "%%.%df", decimals);
@@ -67,7 +74,10 @@ std::vector<MetricRow> metric_rows() {
       {"Sphincter-zone violations", "strokes", count(&ScoreMetrics::sphincter_zone_violations),
        "Cuts distal to the verumontanum; Sweet 2004 error; target 0"},
       {"Sphincter-zone cutting", "s", real(&ScoreMetrics::sphincter_zone_cut_s, 2), "Target 0"},
-      {"Loop on without contact", "s", real(&ScoreMetrics::loop_on_idle_s, 2), "Bright 2012 (TURPsim): experts less active diathermy time without contact than novices (p < 0.01)"},
+      // The metric is the pedal down with nothing cut (the loop out in fluid, or retracted against the
+      // beak while the sheath presses tissue), the simulator's measure of Bright's idle diathermy.
+      {"Cutting pedal down, nothing cut", "s", real(&ScoreMetrics::loop_on_idle_s, 2),
+       "Bright 2012 (TURPsim): experts less active diathermy time without contact than novices (p < 0.01)"},
       {"Tool-tip path", "mm", real(&ScoreMetrics::tool_path_mm, 0), "K\u00e4llstr\u00f6m 2010: students' resectoscope-tip path longer than urologists'"},
       {"Tool-tip mean speed", "mm/s", real(&ScoreMetrics::tool_mean_speed_mm_s, 1), ""},
       {"Time in contact", "s", real(&ScoreMetrics::contact_time_s, 2), ""},
@@ -75,7 +85,7 @@ std::vector<MetricRow> metric_rows() {
       {"Mean contact force", "N", real(&ScoreMetrics::mean_contact_force_n, 3), ""},
       {"Lobe order", "", [](const ScoreMetrics& m) {
          std::string text;
-         for (std::size_t i = 0; i < m.lobe_order.size(); ++i) text += (i ? " &rarr; " : "") + std::string(kLobeNames[m.lobe_order[i]]);
+         for (std::size_t i = 0; i < m.lobe_order.size(); ++i) text += (i ? " &rarr; " : "") + lobe_display_name(m.lobe_order[i]);
          return text.empty() ? std::string("none resected") : text;
        }, "Standard order: median lobe first, then the lateral lobes"},
       {"Blood loss per gram", "ml/g", [](const ScoreMetrics&) { return std::string("unavailable (no bleeding model yet)"); },
@@ -189,7 +199,7 @@ std::string debrief_html(std::span<const RecordingScore> scores) {
   for (const MetricRow& row : metric_rows()) {
     html += "<tr><td>" + std::string(row.label) + "</td><td>" + row.unit + "</td>";
     for (const RecordingScore& s : scores) html += "<td>" + row.value(s.score.metrics) + "</td>";
-    html += "<td class=\"ref\">" + std::string(row.reference) + "</td></tr>";
+    html += "<td class=\"ref\">" + escape(row.reference) + "</td></tr>";
   }
   html += "</table><div class=\"cols\">";
   for (const RecordingScore& s : scores) html += section_for(s);
