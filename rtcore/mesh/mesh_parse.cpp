@@ -157,8 +157,12 @@ Result<TriangleMesh> triangulate(const RawMesh& raw, const std::string& name, do
                      ", but the file has " + std::to_string(raw.points.size()) + " vertices"};
       }
     }
-    for (std::uint32_t c = first + 1; c + 1 < end; ++c) mesh.triangles.push_back({raw.corners[first], raw.corners[c], raw.corners[c + 1]});
+    for (std::uint32_t c = first + 1; c + 1 < end; ++c) {
+      mesh.triangles.push_back({raw.corners[first], raw.corners[c], raw.corners[c + 1]});
+      mesh.file_faces.push_back(static_cast<std::uint32_t>(f));
+    }
   }
+  if (mesh.triangles.size() == raw.face_count()) mesh.file_faces.clear();  // triangles only: face t is triangle t
   return mesh;
 }
 

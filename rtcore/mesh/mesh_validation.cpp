@@ -22,7 +22,11 @@
 namespace resecto {
 namespace {
 
-std::string face_name(std::size_t f) { return "face " + std::to_string(f); }
+// The face as the file numbers it: a polygon's triangles (fan order) name their polygon too.
+std::string face_name(const TriangleMesh& mesh, std::size_t f) {
+  if (mesh.file_faces.size() != mesh.triangle_count()) return "face " + std::to_string(f);
+  return "face " + std::to_string(mesh.file_faces[f]) + " (its fan triangle " + std::to_string(f) + ")";
+}
 std::string vertex_name(std::size_t v) { return "vertex " + std::to_string(v); }
 
 /// One undirected edge occurrence: its endpoints sorted, the face it came from and whether the
@@ -62,10 +66,10 @@ Status check_faces(const TriangleMesh& mesh, const ValidationOptions& options) {
   for (std::size_t f = 0; f < mesh.triangle_count(); ++f) {
     const Triangle& t = mesh.triangles[f];
     for (std::uint32_t v : t) {
-      if (v >= vertex_count) return Error{face_name(f) + " refers to missing " + vertex_name(v)};
+      if (v >= vertex_count) return Error{face_name(mesh, f) + " refers to missing " + vertex_name(v)};
     }
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
-      return Error{"degenerate triangle: " + face_name(f) + " uses a vertex twice"};
+      return Error{"degenerate triangle: " + face_name(mesh, f) + " uses a vertex twice"};
     }
   }
   if (Status bounded = check_coordinate_bound(mesh.positions, units::kMillimetresPerMetre); !bounded) return bounded;
@@ -74,7 +78,7 @@ Status check_faces(const TriangleMesh& mesh, const ValidationOptions& options) {
   for (std::size_t f = 0; f < mesh.triangle_count(); ++f) {
     const double area = triangle_area(mesh, f);
     if (!(area > threshold)) {
-      return Error{"degenerate triangle: " + face_name(f) + " has area " + mm2(area) + " (mean " + mm2(mean_area) + ")"};
+      return Error{"degenerate triangle: " + face_name(mesh, f) + " has area " + mm2(area) + " (mean " + mm2(mean_area) + ")"};
     }
   }
   return Ok{};
@@ -105,13 +109,13 @@ Status check_edges(const TriangleMesh& mesh, std::vector<EdgeUse>& uses) {
     const std::string edge = "edge (" + std::to_string(uses[i].low) + ", " + std::to_string(uses[i].high) + ")";
     std::string problem;
     if (count == 1) {
-      problem = "open surface: " + edge + " of " + face_name(uses[i].face) + " has no neighbouring face";
+      problem = "open surface: " + edge + " of " + face_name(mesh, uses[i].face) + " has no neighbouring face";
     } else if (count > 2) {
-      problem = "non-manifold " + edge + " is shared by " + std::to_string(count) + " faces (" + face_name(uses[i].face);
+      problem = "non-manifold " + edge + " is shared by " + std::to_string(count) + " faces (" + face_name(mesh, uses[i].face);
       for (std::size_t k = i + 1; k < std::min(j, i + 6); ++k) problem += ", " + std::to_string(uses[k].face);
       problem += count > 6 ? ", ...)" : ")";
     } else if (uses[i].forward == uses[i + 1].forward) {
-      problem = "inconsistent orientation: " + face_name(uses[i].face) + " and " + face_name(uses[i + 1].face) +
+      problem = "inconsistent orientation: " + face_name(mesh, uses[i].face) + " and " + face_name(mesh, uses[i + 1].face) +
                 " walk " + edge + " the same way";
     }
     if (!problem.empty() && uses[i].face < error_face) {
@@ -224,7 +228,14 @@ Status check_self_intersections(const TriangleMesh& mesh) {
     }
   }
   if (first_hit.first != UINT32_MAX) {
-    return Error{"self-intersection: " + face_name(first_hit.first) + " crosses " + face_name(first_hit.second)};
+    const bool one_polygon = mesh.file_faces.size() == mesh.triangle_count() &&
+                             mesh.file_faces[first_hit.first] == mesh.file_faces[first_hit.second];
+    if (one_polygon) {
+      return Error{"self-intersection inside face " + std::to_string(mesh.file_faces[first_hit.first]) +
+                   ": its fan triangulation (around its first corner) crosses itself, fan triangles " + std::to_string(first_hit.first) +
+                   " and " + std::to_string(first_hit.second) + "; the polygon is not convex from that corner: split it into triangles"};
+    }
+    return Error{"self-intersection: " + face_name(mesh, first_hit.first) + " crosses " + face_name(mesh, first_hit.second)};
   }
   return Ok{};
 }
@@ -268,8 +279,8 @@ Status check_no_nested_shells(const TriangleMesh& mesh, DisjointSets& components
     for (const auto& [outer_root, outer] : shells) {
       if (outer_root == inner_root || glm::any(glm::lessThan(probe, outer.low)) || glm::any(glm::greaterThan(probe, outer.high))) continue;
       if (winding_number(mesh, outer.faces, probe) < 0.5) continue;
-      return Error{"nested shells: the component containing " + face_name(component_first_face[inner_root]) + " lies inside the component containing " +
-                   face_name(component_first_face[outer_root]) + "; a solid with a cavity is not read (each component must be a solid of its own, outside the others)"};
+      return Error{"nested shells: the component containing " + face_name(mesh, component_first_face[inner_root]) + " lies inside the component containing " +
+                   face_name(mesh, component_first_face[outer_root]) + "; a solid with a cavity is not read (each component must be a solid of its own, outside the others)"};
     }
   }
   return Ok{};
@@ -320,7 +331,7 @@ Result<SurfaceReport> validate_closed_surface(const TriangleMesh& mesh, const Va
   }
   for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
     if (component_first_face[v] != UINT32_MAX && component_volume[v] <= 0.0) {
-      return Error{"inward orientation: the component containing " + face_name(component_first_face[v]) +
+      return Error{"inward orientation: the component containing " + face_name(mesh, component_first_face[v]) +
                    " encloses negative volume; faces must wind counter-clockwise seen from outside"};
     }
   }

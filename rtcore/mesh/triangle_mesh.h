@@ -25,6 +25,9 @@ inline constexpr double kMaxSurfaceCoordinateMm = 1e6;
 struct TriangleMesh {
   std::vector<Vec3> positions;
   std::vector<Triangle> triangles;
+  /// For a mesh read from a file with polygons: per triangle, the file's face it is part of (fans keep
+  /// file order), so messages name the face a person can find. Empty: triangle t is face t.
+  std::vector<std::uint32_t> file_faces;
 
   std::size_t vertex_count() const { return positions.size(); }
   std::size_t triangle_count() const { return triangles.size(); }

@@ -109,6 +109,22 @@ TEST(MeshFiles, PolygonsAreFanTriangulatedInFileOrder) {
   EXPECT_TRUE(validate_closed_surface(*mesh));
 }
 
+// A polygon file's errors name the file's faces: its triangles (fans, in file order) were named as
+// faces, "face 9" of a 6-face file (audit 25, F3).
+TEST(MeshFiles, PolygonErrorsNameTheFilesFaces) {
+  const std::string corners = "0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 1\n1 0 1\n0 1 1\n1 1 1\n";
+  // The cube as six quads, the fifth reversed.
+  const std::string quads = "OFF\n8 6 0\n" + corners + "4 0 1 3 2\n4 4 6 7 5\n4 0 4 5 1\n4 2 3 7 6\n4 4 6 2 0\n4 1 5 7 3\n";
+  const std::string error = validation_error(write_file("quads.off", quads));
+  EXPECT_NE(error.find("inconsistent orientation"), std::string::npos) << error;
+  EXPECT_NE(error.find("face 4 (its fan triangle "), std::string::npos) << error;
+  // An L-shaped cap, not convex from its first corner: its own fan crosses itself.
+  // (Its cap walks 5 4 3 2 1 0: the fan around corner 5 leaves the L.)
+  const std::string prism = "OFF\n12 8 0\n10.0 3.0 0.0\n3.0 3.0 0.0\n3.0 10.0 0.0\n0.0 10.0 0.0\n0.0 0.0 0.0\n10.0 0.0 0.0\n10.0 3.0 5.0\n3.0 3.0 5.0\n3.0 10.0 5.0\n0.0 10.0 5.0\n0.0 0.0 5.0\n10.0 0.0 5.0\n6 5 4 3 2 1 0\n6 6 7 8 9 10 11\n4 0 1 7 6\n4 1 2 8 7\n4 2 3 9 8\n4 3 4 10 9\n4 4 5 11 10\n4 5 0 6 11\n";
+  const std::string crossing = validation_error(write_file("lprism.off", prism));
+  EXPECT_NE(crossing.find("its fan triangulation (around its first corner) crosses itself"), std::string::npos) << crossing;
+}
+
 TEST(MeshFiles, ObjStatementsContinueOverLinesEndingInABackslash) {
   // The format's continuation, as some exporters wrap long faces: the same cube as on single lines.
   std::string obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 \\\n  1\nv 1 1 1\nv 0 1 1\n";
