@@ -261,14 +261,19 @@ Result<SurfaceFrame> Recording::decode_keyframe(std::size_t k) const {
   return frame;
 }
 
-double Recording::duration_s() const {
-  if (ticks_.empty()) return 0.0;
-  return static_cast<double>(ticks_.back().tick + 1 - ticks_.front().tick) * header_.simulation.tick_s();
+namespace {
+/// Ticks from the first recorded to the last, both in (at least the count held, whatever order the
+/// file's chunks left them in).
+std::uint64_t tick_span(const std::vector<TickRecord>& ticks) {
+  if (ticks.empty()) return 0;
+  const std::uint64_t span = ticks.back().tick >= ticks.front().tick ? ticks.back().tick + 1 - ticks.front().tick : 0;
+  return std::max<std::uint64_t>(span, ticks.size());
 }
+}  // namespace
 
-std::uint64_t Recording::missing_ticks() const {
-  return ticks_.empty() ? 0 : ticks_.back().tick + 1 - ticks_.front().tick - ticks_.size();
-}
+double Recording::duration_s() const { return static_cast<double>(tick_span(ticks_)) * header_.simulation.tick_s(); }
+
+std::uint64_t Recording::missing_ticks() const { return tick_span(ticks_) - ticks_.size(); }
 
 std::array<std::uint64_t, kChunkTypeCount> Recording::bytes_by_type() const {
   std::array<std::uint64_t, kChunkTypeCount> bytes{};
