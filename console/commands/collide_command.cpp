@@ -143,6 +143,8 @@ void run_collide(const CollideOptions& options) {
       }
     }
   }
+  // A count of the first repeat, averaged over its queries.
+  const auto per_query = [&](auto total) { return static_cast<double>(total) / static_cast<double>(poses.size()); };
   std::size_t total_pairs = 0;
   for (const auto& f : found) total_pairs += f.size();
 
@@ -174,13 +176,9 @@ void run_collide(const CollideOptions& options) {
         {"query_us", {{"median", median}, {"p95", p95}, {"max", times_us.back()}}},
     };
     if (!shared) {
-      const double n = static_cast<double>(poses.size());
-      report["work_per_query"] = {{"bound_tests", static_cast<double>(work.sphere_tests) / n},
-                                  {"near_leaves", static_cast<double>(near_leaves) / n},
-                                  {"leaf_candidates", static_cast<double>(work.leaf_pairs) / n},
-                                  {"triangle_tests", static_cast<double>(work.triangle_tests) / n},
-                                  {"front_kept", static_cast<double>(work.front_kept) / n},
-                                  {"front_renewed", static_cast<double>(work.front_renewed) / n}};
+      report["work_per_query"] = {{"bound_tests", per_query(work.sphere_tests)}, {"near_leaves", per_query(near_leaves)},
+                                  {"leaf_candidates", per_query(work.leaf_pairs)}, {"triangle_tests", per_query(work.triangle_tests)},
+                                  {"front_kept", per_query(work.front_kept)}, {"front_renewed", per_query(work.front_renewed)}};
     }
     std::printf("%s\n", report.dump().c_str());
     return;
@@ -195,14 +193,9 @@ void run_collide(const CollideOptions& options) {
   if (!dual) std::printf("tool field build  %.3f ms (once per tool)\n", field_ms);
   std::printf("query             median %.1f us, p95 %.1f us\n", median, p95);
   if (!shared) {
-    const double n = static_cast<double>(poses.size());
     std::printf("work per query    %.0f bound tests, %.0f near tissue leaves, %.0f leaf candidates, %.0f triangle tests",
-                static_cast<double>(work.sphere_tests) / n, static_cast<double>(near_leaves) / n,
-                static_cast<double>(work.leaf_pairs) / n, static_cast<double>(work.triangle_tests) / n);
-    if (options.sequence) {
-      std::printf(", front %.0f kept / %.0f renewed", static_cast<double>(work.front_kept) / n,
-                  static_cast<double>(work.front_renewed) / n);
-    }
+                per_query(work.sphere_tests), per_query(near_leaves), per_query(work.leaf_pairs), per_query(work.triangle_tests));
+    if (options.sequence) std::printf(", front %.0f kept / %.0f renewed", per_query(work.front_kept), per_query(work.front_renewed));
     std::printf("\n");
   }
 }

@@ -59,6 +59,13 @@ bool is_count(const char* name) {
 /// What a sound file (no damage left in it) lacks of the procedure it was recorded from, or empty: a
 /// recovery's left-out damaged ranges, unless the recorder's summary shows every tick and command it
 /// wrote still there (the ranges held only keyframes or hashes, which the score does not use).
+/// Whether the recorder's summary (written when it closed the file) counts exactly the ticks and
+/// commands the file holds: whatever else was lost (keyframes, hashes), the procedure is whole.
+bool holds_every_tick_and_command(const rec::Recording& recording) {
+  const std::optional<std::uint64_t> ticks = recording.summary_count("ticks"), commands = recording.summary_count("commands");
+  return ticks && commands && *ticks == recording.ticks().size() && *commands == recording.commands().size();
+}
+
 std::string lost_part_of_procedure(const rec::Recording& recording) {
   const std::uint64_t dropped = recording.recovered_damaged_ranges();
   const std::optional<std::uint64_t> ticks = recording.summary_count("ticks"), commands = recording.summary_count("commands");
@@ -69,7 +76,7 @@ std::string lost_part_of_procedure(const rec::Recording& recording) {
     return "the recorder never closed it (the run was killed or the file cut after " + std::to_string(recording.ticks().size()) +
            " ticks), so how much of the procedure it lacks is unknown";
   }
-  if (ticks && commands && *ticks == recording.ticks().size() && *commands == recording.commands().size()) return {};
+  if (holds_every_tick_and_command(recording)) return {};
   return "recovered (`rec recover`) from a damaged recording, " + std::to_string(dropped) + " damaged ranges left out" +
          (ticks && commands
               ? ": " + std::to_string(recording.ticks().size()) + " of the " + std::to_string(*ticks) + " ticks and " +
@@ -136,9 +143,8 @@ Result<RecordingScore> score_recording(const std::filesystem::path& path, const 
     const rec::DamagedRange& d = recording->damaged().front();
     const std::string damaged = "damaged (" + std::to_string(recording->damaged().size()) + " damaged byte ranges, the first at byte " +
                                 std::to_string(d.offset) + ")";
-    const std::optional<std::uint64_t> ticks = recording->summary_count("ticks"), commands = recording->summary_count("commands");
-    const bool whole = ticks && commands && *ticks == recording->ticks().size() && *commands == recording->commands().size() &&
-                       recording->content_errors().empty() && recording->replayable_ticks() == recording->ticks().size();
+    const bool whole = holds_every_tick_and_command(*recording) && recording->content_errors().empty() &&
+                       recording->replayable_ticks() == recording->ticks().size();
     if (!whole) return Error{name + ": " + damaged + "; a score from part of a procedure would mislead"};
     note = name + ": " + damaged + ", but every tick and command the recorder wrote is intact: scored";
   }

@@ -327,7 +327,7 @@ Result<SurfaceReport> validate_closed_surface(const TriangleMesh& mesh, const Va
     const std::uint32_t root = components.find(t[0]);
     component_first_face[root] = std::min(component_first_face[root], static_cast<std::uint32_t>(f));
     const Vec3& from = mesh.positions[mesh.triangles[component_first_face[root]][0]];
-    component_volume[root] += dot(mesh.positions[t[0]] - from, cross(mesh.positions[t[1]] - from, mesh.positions[t[2]] - from)) / 6.0;
+    component_volume[root] += six_volume_from(from, mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]) / 6.0;
   }
   for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
     if (component_first_face[v] != UINT32_MAX && component_volume[v] <= 0.0) {

@@ -33,8 +33,7 @@ double signed_volume(const TriangleMesh& mesh) {
   const Vec3 centre = 0.5 * (box.min + box.max);
   double six_volume = 0.0;
   for (const Triangle& tri : mesh.triangles) {
-    const Vec3 a = mesh.positions[tri[0]] - centre;
-    six_volume += dot(a, cross(mesh.positions[tri[1]] - centre, mesh.positions[tri[2]] - centre));
+    six_volume += six_volume_from(centre, mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]]);
   }
   return six_volume / 6.0;
 }

@@ -54,6 +54,12 @@ inline bool boxes_overlap(const Aabb& a, const Aabb& b) {
 Vec3 triangle_normal_x2(const TriangleMesh& mesh, std::size_t t);
 double triangle_area(const TriangleMesh& mesh, std::size_t t);
 double surface_area(const TriangleMesh& mesh);
+/// Six times the signed volume of the tetrahedron from `from` to triangle (a, b, c), positive when the
+/// triangle winds counter-clockwise seen from outside. Summed over a closed surface, six times its
+/// volume from any point; from one near the surface, without the cancellation a far origin brings.
+inline double six_volume_from(const Vec3& from, const Vec3& a, const Vec3& b, const Vec3& c) {
+  return dot(a - from, cross(b - from, c - from));
+}
 /// Signed enclosed volume by the divergence theorem; positive for a closed, outward-oriented mesh.
 double signed_volume(const TriangleMesh& mesh);
 Aabb bounding_box(const TriangleMesh& mesh);

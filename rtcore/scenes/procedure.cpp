@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
-#include <sstream>
 
 #include "rtcore/base/checked_number.h"
 #include "rtcore/base/quoted_word.h"
@@ -156,8 +155,8 @@ Result<Procedure> parse_procedure(const std::string& text, const std::string& so
     double v[8];
     for (std::size_t c = 0; c < 8; ++c) {
       // Decimal only, as the mesh readers take numbers: strtod also took hexadecimal ("0x3").
-      const std::optional<double> parsed = parse_finite(std::string(words[c].text));
-      if (!parsed) return error_at(c, std::string(kColumns[c]) + " is not a number: " + quoted_word(std::string(words[c].text)));
+      const std::optional<double> parsed = parse_finite(words[c].text);
+      if (!parsed) return error_at(c, std::string(kColumns[c]) + " is not a number: " + quoted_word(words[c].text));
       v[c] = *parsed;
     }
     constexpr double kLimits[6][2] = {{0.0, 86400.0},           {-kMaxGimbalDeg, kMaxGimbalDeg}, {-kMaxGimbalDeg, kMaxGimbalDeg},

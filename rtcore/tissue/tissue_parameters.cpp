@@ -43,7 +43,6 @@ constexpr TissueParameterSpec kSpecs[] = {
 };
 static_assert(std::size(kSpecs) == kTissueParameterCount);
 
-
 }  // namespace
 
 std::span<const TissueParameterSpec> tissue_parameter_specs() { return kSpecs; }
