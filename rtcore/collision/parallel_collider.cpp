@@ -8,7 +8,7 @@ ParallelCollider::ParallelCollider(int threads) {
   starts_.reserve(std::size_t{1} << kSplitDepth);
   for (auto& half : halves_) half.reserve(starts_.capacity());
   walk_.reserve(2 * kSplitDepth + 2);
-  if (threads >= 2) helper_ = std::make_unique<JobThread>([this] { run_share(1); });
+  if (threads >= 2) helper_ = std::make_unique<LoopHelper>();
 }
 
 void ParallelCollider::set_method(CollisionMethod method) {
@@ -48,7 +48,7 @@ void ParallelCollider::reset_sequence() {
   for (Collider& c : colliders_) c.reset_sequence();
 }
 
-void ParallelCollider::run_share(int share) {
+void ParallelCollider::run_share(std::uint32_t share) {
   Collider& collider = colliders_[share];
   const Query& q = query_;
   share_ok_[share] = q.sequence ? collider.collide_sequence(*q.tissue_tree, *q.tissue, *q.tool_tree, *q.tool, q.pose, q.tissue_travel_m,
@@ -80,9 +80,16 @@ bool ParallelCollider::run_shares() {
   // A sequence's second half is empty only for a tree of one node (and an empty list of starts
   // would mean the whole tree).
   const bool helper_runs = helper_ && !(query_.sequence && halves_[1].empty());
-  if (helper_runs) helper_->launch();  // what was written above is visible to the helper's share
-  run_share(0);
-  if (helper_runs) helper_->wait();  // and the helper's share is visible here
+  if (helper_runs) {
+    // Share k is Collider k's whichever thread claims it (a sequence's front stays with its
+    // Collider), and each share is claimed once: what the query wrote above is visible to both, and
+    // both shares' writes are visible here once the loop returns.
+    helper_->call_in();
+    auto share = [this](std::uint32_t k) { run_share(k); };
+    helper_->for_each_chunk(2, share);
+  } else {
+    run_share(0);
+  }
   // Each share is sorted and holds each pair once; a sliced tissue triangle's leaves may have gone
   // to both, so the merge drops repeats.
   const std::span<const TrianglePair> a = colliders_[0].pairs();

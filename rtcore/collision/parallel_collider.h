@@ -1,6 +1,9 @@
 // One collision query on two threads. The tissue tree's top is cut into a few dozen subtrees; the
 // caller's thread and a helper each run a Collider of their own and claim the subtrees from a shared
-// counter, whole (walk and exact tests), until none is left; their sorted pairs are merged. A rigid
+// counter, whole (walk and exact tests), until none is left; their sorted pairs are merged. The
+// helper is a LoopHelper: called in for each query, it spins between queries that come less than a
+// few milliseconds apart, so a query of a few hundred microseconds does not wait tens of them for a
+// sleeping thread to wake. A rigid
 // tool's pairs are spread over the gland along the whole sheath, so the claims even out the work
 // without a schedule worked out in advance. Which thread ran which subtree changes no pair.
 #pragma once
@@ -12,7 +15,7 @@
 #include <vector>
 
 #include "rtcore/collision/collide.h"
-#include "rtcore/concurrency/job_thread.h"
+#include "rtcore/concurrency/loop_helper.h"
 
 namespace resecto {
 
@@ -38,6 +41,11 @@ class ParallelCollider {
   /// own fixed half of the subtrees (alternate ones, so both halves span the gland). False on overflow.
   bool collide_sequence(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree, const TriangleMesh& tool,
                         const RigidPose& tool_pose, double tissue_travel_m = 0.0);
+  /// Lets the helper sleep now rather than spin for the next query (it goes by itself a few
+  /// milliseconds after the last one): for a caller that does other timed work before the next.
+  void release_helper() {
+    if (helper_) helper_->send_home();
+  }
   /// Forgets both threads' fronts (Collider::reset_sequence).
   void reset_sequence();
   std::span<const TrianglePair> pairs() const { return {pairs_.data(), pair_count_}; }
@@ -47,8 +55,9 @@ class ParallelCollider {
  private:
   /// The nodes kSplitDepth below the root (or leaves above it), depth first: the claims.
   void split(const SphereTree& tissue_tree);
-  void run_share(int share);
-  /// Runs both shares (the helper's on its thread) and merges their pairs.
+  void run_share(std::uint32_t share);
+  /// Runs both shares (the helper's on its thread, or both here should it not come in time) and
+  /// merges their pairs.
   bool run_shares();
 
   static constexpr int kSplitDepth = 6;  // up to 64 subtrees: far more than two threads need to even out
@@ -74,7 +83,7 @@ class ParallelCollider {
   std::vector<TrianglePair> pairs_;
   std::size_t pair_count_ = 0;
   CollisionStats stats_;
-  std::unique_ptr<JobThread> helper_;  // last: its thread starts once the rest exists
+  std::unique_ptr<LoopHelper> helper_;  // last: its thread starts once the rest exists
 };
 
 }  // namespace resecto
