@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "console/headless/lockstep_device.h"
+#include "console/headless/realtime_advice.h"
 #include "console/live/live_device.h"
 #include "console/score/rescore.h"
 #include "device/link/calibration_adapter.h"
@@ -274,6 +275,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
                     {"max_late_us", deadlines.max_late_us},
                     {"p99_late_us", deadlines.late_us.quantile(0.99)},
                     {"resynchronizations", deadlines.resynchronizations}};
+  if (std::string advice = realtime_advice(r); !advice.empty()) r["deadlines"]["advice"] = std::move(advice);
   if (lockstep) {
     const LockstepCounters& c = lockstep->counters();
     r["device"] = {{"transport", "emulator (lockstep)"}, {"reports", c.reports}, {"accepted", c.accepted}, {"lost", c.lost},
@@ -383,6 +385,7 @@ std::string summarize_report(const ordered_json& r) {
                   d.at("max_late_us").get<double>(), static_cast<unsigned long long>(d.at("resynchronizations").get<std::uint64_t>()),
                   r.at("scheduling").at("core").get<std::string>().c_str(), r.at("scheduling").at("collision").get<std::string>().c_str());
     summary += text;
+    if (d.contains("advice")) summary += "  advice     " + d.at("advice").get<std::string>() + "\n";
   }
   return summary;
 }
