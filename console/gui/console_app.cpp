@@ -23,6 +23,7 @@
 #include "console/gui/scene_renderer.h"
 #include "console/gui/screenshot.h"
 #include "console/headless/headless_run.h"
+#include "console/headless/realtime_advice.h"
 #include "rtcore/base/atomic_file.h"
 #include "rtcore/base/units.h"
 #include "rtcore/core/thread_priority.h"
@@ -407,6 +408,12 @@ ordered_json make_report(CoreSession& session, ConsoleUi& ui, const ConsoleOptio
                {"max_late_us", d.max_late_us},
                {"resynchronizations", d.resynchronizations},
                {"scheduling", session.realtime_priority_held() ? "SCHED_FIFO " + std::to_string(kCoreFifoPriority) : std::string("normal")}};
+  const std::string advice = realtime_advice({.miss_fraction = r["core"]["miss_fraction"].get<double>(),
+                                              .tick_p99_us = session.profiler().statistics(Stage::kTick).p99_us,
+                                              .collision_hz = static_cast<double>(sim.config().collision_hz),
+                                              .substeps = sim.config().physics_per_collision,
+                                              .surface_triangles = sim.prostate().surface.triangle_count()});
+  if (!advice.empty()) r["core"]["advice"] = advice;
   ordered_json stages = ordered_json::object();
   for (int s = 0; s < kStageCount; ++s) {
     const StageStatistics st = session.profiler().statistics(static_cast<Stage>(s));
@@ -575,7 +582,9 @@ std::string summarize_console_report(const ordered_json& r) {
                 static_cast<unsigned long long>(core.at("deadline_misses").get<std::uint64_t>()),
                 static_cast<unsigned long long>(core.at("deadline_ticks").get<std::uint64_t>()), 100.0 * core.at("miss_fraction").get<double>(),
                 core.at("max_late_us").get<double>(), core.at("state_hash").get<std::string>().c_str());
-  return text;
+  std::string summary = text;
+  if (core.contains("advice")) summary += "  advice           " + core.at("advice").get<std::string>() + "\n";
+  return summary;
 }
 
 }  // namespace resecto::gui

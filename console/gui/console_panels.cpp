@@ -10,6 +10,7 @@
 #include <string>
 #include <system_error>
 
+#include "console/headless/realtime_advice.h"
 #include "rtcore/base/units.h"
 
 namespace resecto::gui {
@@ -204,6 +205,21 @@ void draw_profiler_panel(ConsoleController& console) {
               s.deadline_misses, s.deadline_ticks,
               s.deadline_ticks ? 100.0 * static_cast<double>(s.deadline_misses) / static_cast<double>(s.deadline_ticks) : 0.0,
               s.max_late_us, s.resynchronizations, console.session().realtime_priority_held() ? "SCHED_FIFO" : "normal priority");
+  // Once a second of ticks has run, a machine too slow for the rate is told what would fit.
+  const SimulationConfig& config = console.session().simulation().config();
+  if (s.deadline_ticks >= static_cast<std::uint64_t>(config.collision_hz * config.physics_per_collision)) {
+    const std::string advice = realtime_advice(
+        {.miss_fraction = static_cast<double>(s.deadline_misses) / static_cast<double>(s.deadline_ticks),
+         .tick_p99_us = s.p99_us[static_cast<std::size_t>(Stage::kTick)],
+         .collision_hz = static_cast<double>(config.collision_hz),
+         .substeps = config.physics_per_collision,
+         .surface_triangles = console.session().simulation().prostate().surface.triangle_count()});
+    if (!advice.empty()) {
+      ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.75f, 0.3f, 1.0f));
+      ImGui::TextWrapped("%s", advice.c_str());
+      ImGui::PopStyleColor();
+    }
+  }
   ImGui::Text("frame: median %.1f ms, p99 %.1f ms   input-to-photon: median %.1f ms, p99 %.1f ms (%" PRIu64 " frames)",
               ui.frame_ms_as_us.quantile(0.5) * 1e-3, ui.frame_ms_as_us.quantile(0.99) * 1e-3,
               ui.input_to_photon_us.quantile(0.5) * 1e-3, ui.input_to_photon_us.quantile(0.99) * 1e-3, ui.input_to_photon_us.count());

@@ -1,9 +1,10 @@
 // What to change when a real-time run could not keep its deadlines: on a machine slower than the
 // one the defaults were set on, the physics step outgrows its tick, and the run misses a tick in
-// twenty. The report says so, and names the physics rate at which this run's own ticks would have
-// fit, so a person need not find the option by trial.
+// twenty. The headless report and the console say so, and name the physics rate at which the run's
+// own ticks would have fit, so a person need not find the option by trial.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -17,11 +18,23 @@ inline constexpr double kAdviceMissFraction = 0.01;
 /// The part of a tick the advice lets the tick's p99 fill: room for the jitter the p99 does not see.
 inline constexpr double kAdviceTickShare = 0.75;
 
-/// Empty for a batch run, or a real-time run that kept its deadlines (misses at most
-/// kAdviceMissFraction). Otherwise a sentence: the fewest halvings of --substeps at which the run's
-/// tick p99 fills at most kAdviceTickShare of the longer tick, or, when not even one physics step
-/// per collision step would fit, a coarser gland. Reads `mode`, `deadlines`, `stages.tick`,
-/// `rates_hz` and `model` of a `resecto run --headless` report.
+/// What the advice reads of a real-time run.
+struct RealtimeFigures {
+  double miss_fraction = 0.0;
+  double tick_p99_us = 0.0;  ///< the whole tick's p99 (the profiler's `tick` stage)
+  double collision_hz = 60.0;
+  std::int64_t substeps = 16;  ///< physics steps per collision step
+  std::uint64_t surface_triangles = 0;
+};
+
+/// Empty for a run that kept its deadlines (misses at most kAdviceMissFraction). Otherwise a
+/// sentence: the fewest halvings of --substeps at which the run's tick p99 fills at most
+/// kAdviceTickShare of the longer tick, or, when not even one physics step per collision step
+/// would fit, a coarser gland.
+std::string realtime_advice(const RealtimeFigures& run);
+
+/// The same for a `resecto run --headless` report (`mode`, `deadlines`, `stages.tick`, `rates_hz`,
+/// `model`); empty for a batch run.
 std::string realtime_advice(const nlohmann::ordered_json& report);
 
 }  // namespace resecto
