@@ -1,6 +1,6 @@
 // What to change when a real-time run could not keep its deadlines: on a machine slower than the
-// one the defaults were set on, the physics step outgrows its tick, and the run misses a tick in
-// twenty. The headless report and the console say so, and name the physics rate at which the run's
+// one the defaults were set on, the physics step outgrows its tick, and the run misses several
+// ticks in a hundred. The headless report and the console say so, and name the physics rate at which the run's
 // own ticks would have fit, so a person need not find the option by trial.
 #pragma once
 

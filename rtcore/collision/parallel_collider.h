@@ -1,11 +1,11 @@
 // One collision query on two threads. The tissue tree's top is cut into a few dozen subtrees; the
 // caller's thread and a helper each run a Collider of their own and claim the subtrees from a shared
-// counter, whole (walk and exact tests), until none is left; their sorted pairs are merged. The
-// helper is a LoopHelper: called in for each query, it spins between queries that come less than a
-// few milliseconds apart, so a query of a few hundred microseconds does not wait tens of them for a
-// sleeping thread to wake. A rigid
+// counter, whole (walk and exact tests), until none is left; their sorted pairs are merged. A rigid
 // tool's pairs are spread over the gland along the whole sheath, so the claims even out the work
 // without a schedule worked out in advance. Which thread ran which subtree changes no pair.
+// The helper is a LoopHelper: called in for each query, it spins between queries that come less
+// than a few milliseconds apart, so a query of a few hundred microseconds does not wait tens of them
+// for a sleeping thread to wake, and a helper that comes late finds its share already taken.
 #pragma once
 
 #include <atomic>
