@@ -2,7 +2,9 @@
 # The main job of the README's first command: generate and validate the procedural models, then, where
 # there is a display (DISPLAY or WAYLAND_DISPLAY set), open the operator console on the built-in demo;
 # otherwise run the demo headless through the emulated device, recording it, print a summary of its
-# report, and replay the recording with every collision step's state hash verified.
+# report, and replay the recording with every collision step's state hash verified; then ten seconds
+# against the clock (again at the advised physics rate on a machine too slow for 960 Hz) beside the
+# machine's own deadline floor.
 set -euo pipefail
 bin="$1"
 out="${RESECTO_OUT:-out}"
@@ -28,6 +30,14 @@ echo
 "$bin" run --headless --realtime --procedure demo --seconds 10 --report "$out/realtime-report.json" \
   --trace "$out/realtime-trace.json"
 echo
+# A machine too slow for 960 Hz gets the report's advice; the run is then shown at the advised rate.
+advised="$(sed -n 's/.*"advised_substeps": *\([0-9][0-9]*\).*/\1/p' "$out/realtime-report.json" | head -1)"
+if [ -n "$advised" ]; then
+  echo "the same ten seconds at the advised --substeps $advised:"
+  "$bin" run --headless --realtime --procedure demo --seconds 10 --substeps "$advised" \
+    --report "$out/realtime-advised-report.json" | grep -E 'physics|tick|deadlines'
+  echo
+fi
 # The machine's own floor for that schedule: the same scheduler and priority with ticks that compute
 # nothing. Misses it shows too are the machine's (docs/commands.md, "Running the simulator"; benchmarks/results/README.md).
 floor="$(dirname "$bin")/../benchmarks/deadline_floor_bench"

@@ -275,7 +275,13 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
                     {"max_late_us", deadlines.max_late_us},
                     {"p99_late_us", deadlines.late_us.quantile(0.99)},
                     {"resynchronizations", deadlines.resynchronizations}};
-  if (std::string advice = realtime_advice(r); !advice.empty()) r["deadlines"]["advice"] = std::move(advice);
+  if (options.realtime) {
+    const RealtimeFigures figures = realtime_figures(r);
+    if (std::string advice = realtime_advice(figures); !advice.empty()) {
+      r["deadlines"]["advice"] = std::move(advice);
+      if (const std::int64_t substeps = advised_substeps(figures); substeps > 0) r["deadlines"]["advised_substeps"] = substeps;
+    }
+  }
   if (lockstep) {
     const LockstepCounters& c = lockstep->counters();
     r["device"] = {{"transport", "emulator (lockstep)"}, {"reports", c.reports}, {"accepted", c.accepted}, {"lost", c.lost},

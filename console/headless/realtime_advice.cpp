@@ -5,23 +5,29 @@
 
 namespace resecto {
 
-std::string realtime_advice(const RealtimeFigures& run) {
-  if (!(run.miss_fraction > kAdviceMissFraction)) return {};
-  const double physics_hz = run.collision_hz * static_cast<double>(run.substeps);
-  char text[512];
+std::int64_t advised_substeps(const RealtimeFigures& run) {
+  if (!(run.miss_fraction > kAdviceMissFraction)) return 0;
   // A physics step costs the same at any rate, so the tick measured here is the tick a slower rate
   // would have; fewer substeps give each one a longer period.
   for (std::int64_t fewer = run.substeps / 2; fewer >= 1; fewer /= 2) {
-    const double period_us = 1e6 / (run.collision_hz * static_cast<double>(fewer));
-    if (run.tick_p99_us <= kAdviceTickShare * period_us) {
-      std::snprintf(text, sizeof text,
-                    "%.1f%% of the deadlines were missed: this machine's ticks (p99 %.0f us) do not fit the %.0f us of %.0f Hz physics. "
-                    "--substeps %lld (%.0f Hz, a tick every %.0f us) would hold them; the tissue then steps more coarsely, so the "
-                    "state hashes differ from this rate's",
-                    100.0 * run.miss_fraction, run.tick_p99_us, 1e6 / physics_hz, physics_hz, static_cast<long long>(fewer),
-                    run.collision_hz * static_cast<double>(fewer), period_us);
-      return text;
-    }
+    if (run.tick_p99_us <= kAdviceTickShare * 1e6 / (run.collision_hz * static_cast<double>(fewer))) return fewer;
+  }
+  return 0;
+}
+
+std::string realtime_advice(const RealtimeFigures& run) {
+  if (!(run.miss_fraction > kAdviceMissFraction)) return {};
+  char text[512];
+  if (const std::int64_t fewer = advised_substeps(run); fewer > 0) {
+    const double physics_hz = run.collision_hz * static_cast<double>(run.substeps);
+    const double advised_hz = run.collision_hz * static_cast<double>(fewer);
+    std::snprintf(text, sizeof text,
+                  "%.1f%% of the deadlines were missed: this machine's ticks (p99 %.0f us) do not fit the %.0f us of %.0f Hz physics. "
+                  "--substeps %lld (%.0f Hz, a tick every %.0f us) would hold them; the tissue then steps more coarsely, so the "
+                  "state hashes differ from this rate's",
+                  100.0 * run.miss_fraction, run.tick_p99_us, 1e6 / physics_hz, physics_hz, static_cast<long long>(fewer), advised_hz,
+                  1e6 / advised_hz);
+    return text;
   }
   std::snprintf(text, sizeof text,
                 "%.1f%% of the deadlines were missed: this machine's ticks (p99 %.0f us) do not fit even one physics step per "
@@ -31,15 +37,14 @@ std::string realtime_advice(const RealtimeFigures& run) {
   return text;
 }
 
-std::string realtime_advice(const nlohmann::ordered_json& report) {
-  if (report.at("mode") != "realtime") return {};
+RealtimeFigures realtime_figures(const nlohmann::ordered_json& report) {
   RealtimeFigures run;
   run.miss_fraction = report.at("deadlines").at("miss_fraction").get<double>();
   run.tick_p99_us = report.at("stages").at("tick").at("p99_us").get<double>();
   run.collision_hz = report.at("rates_hz").at("collision").get<double>();
   run.substeps = std::llround(report.at("rates_hz").at("physics").get<double>() / run.collision_hz);
   run.surface_triangles = report.at("model").at("surface_triangles").get<std::uint64_t>();
-  return realtime_advice(run);
+  return run;
 }
 
 }  // namespace resecto

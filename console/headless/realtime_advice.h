@@ -27,14 +27,19 @@ struct RealtimeFigures {
   std::uint64_t surface_triangles = 0;
 };
 
+/// The substeps realtime_advice() names: the fewest halvings of `run.substeps` at which the run's
+/// tick p99 fills at most kAdviceTickShare of the longer tick. 0 when the run kept its deadlines or
+/// not even one substep would fit.
+std::int64_t advised_substeps(const RealtimeFigures& run);
+
 /// Empty for a run that kept its deadlines (misses at most kAdviceMissFraction). Otherwise a
 /// sentence: the fewest halvings of --substeps at which the run's tick p99 fills at most
 /// kAdviceTickShare of the longer tick, or, when not even one physics step per collision step
 /// would fit, a coarser gland.
 std::string realtime_advice(const RealtimeFigures& run);
 
-/// The same for a `resecto run --headless` report (`mode`, `deadlines`, `stages.tick`, `rates_hz`,
-/// `model`); empty for a batch run.
-std::string realtime_advice(const nlohmann::ordered_json& report);
+/// What the advice reads of a `resecto run --headless` report (`deadlines`, `stages.tick`,
+/// `rates_hz`, `model`).
+RealtimeFigures realtime_figures(const nlohmann::ordered_json& report);
 
 }  // namespace resecto
