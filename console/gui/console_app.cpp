@@ -408,11 +408,8 @@ ordered_json make_report(CoreSession& session, ConsoleUi& ui, const ConsoleOptio
                {"max_late_us", d.max_late_us},
                {"resynchronizations", d.resynchronizations},
                {"scheduling", session.realtime_priority_held() ? "SCHED_FIFO " + std::to_string(kCoreFifoPriority) : std::string("normal")}};
-  const std::string advice = realtime_advice({.miss_fraction = r["core"]["miss_fraction"].get<double>(),
-                                              .tick_p99_us = session.profiler().statistics(Stage::kTick).p99_us,
-                                              .collision_hz = static_cast<double>(sim.config().collision_hz),
-                                              .substeps = sim.config().physics_per_collision,
-                                              .surface_triangles = sim.prostate().surface.triangle_count()});
+  const std::string advice =
+      realtime_advice(realtime_figures(sim, r["core"]["miss_fraction"].get<double>(), session.profiler().statistics(Stage::kTick).p99_us));
   if (!advice.empty()) r["core"]["advice"] = advice;
   ordered_json stages = ordered_json::object();
   for (int s = 0; s < kStageCount; ++s) {

@@ -206,14 +206,10 @@ void draw_profiler_panel(ConsoleController& console) {
               s.deadline_ticks ? 100.0 * static_cast<double>(s.deadline_misses) / static_cast<double>(s.deadline_ticks) : 0.0,
               s.max_late_us, s.resynchronizations, console.session().realtime_priority_held() ? "SCHED_FIFO" : "normal priority");
   // Once a second of ticks has run, a machine too slow for the rate is told what would fit.
-  const SimulationConfig& config = console.session().simulation().config();
-  if (s.deadline_ticks >= static_cast<std::uint64_t>(config.collision_hz * config.physics_per_collision)) {
-    const std::string advice = realtime_advice(
-        {.miss_fraction = static_cast<double>(s.deadline_misses) / static_cast<double>(s.deadline_ticks),
-         .tick_p99_us = s.p99_us[static_cast<std::size_t>(Stage::kTick)],
-         .collision_hz = static_cast<double>(config.collision_hz),
-         .substeps = config.physics_per_collision,
-         .surface_triangles = console.session().simulation().prostate().surface.triangle_count()});
+  const Simulation& sim = console.session().simulation();
+  if (s.deadline_ticks >= static_cast<std::uint64_t>(sim.config().collision_hz * sim.config().physics_per_collision)) {
+    const std::string advice = realtime_advice(realtime_figures(sim, static_cast<double>(s.deadline_misses) / static_cast<double>(s.deadline_ticks),
+                                                                s.p99_us[static_cast<std::size_t>(Stage::kTick)]));
     if (!advice.empty()) {
       ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.75f, 0.3f, 1.0f));
       ImGui::TextWrapped("%s", advice.c_str());

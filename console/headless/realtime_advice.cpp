@@ -37,6 +37,14 @@ std::string realtime_advice(const RealtimeFigures& run) {
   return text;
 }
 
+RealtimeFigures realtime_figures(const Simulation& sim, double miss_fraction, double tick_p99_us) {
+  return {.miss_fraction = miss_fraction,
+          .tick_p99_us = tick_p99_us,
+          .collision_hz = static_cast<double>(sim.config().collision_hz),
+          .substeps = sim.config().physics_per_collision,
+          .surface_triangles = sim.prostate().surface.triangle_count()};
+}
+
 RealtimeFigures realtime_figures(const nlohmann::ordered_json& report) {
   RealtimeFigures run;
   run.miss_fraction = report.at("deadlines").at("miss_fraction").get<double>();

@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rtcore/core/simulation.h"
+
 namespace resecto {
 
 /// Misses above this fraction of the ticks are more than a machine's scheduling jitter (its floor,
@@ -37,6 +39,9 @@ std::int64_t advised_substeps(const RealtimeFigures& run);
 /// kAdviceTickShare of the longer tick, or, when not even one physics step per collision step
 /// would fit, a coarser gland.
 std::string realtime_advice(const RealtimeFigures& run);
+
+/// The figures of a running simulation (its rates and gland) with its deadlines so far.
+RealtimeFigures realtime_figures(const Simulation& sim, double miss_fraction, double tick_p99_us);
 
 /// What the advice reads of a `resecto run --headless` report (`deadlines`, `stages.tick`,
 /// `rates_hz`, `model`).
