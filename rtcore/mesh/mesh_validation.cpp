@@ -28,6 +28,17 @@ std::string face_name(const TriangleMesh& mesh, std::size_t f) {
   return "face " + std::to_string(mesh.file_faces[f]) + " (its fan triangle " + std::to_string(f) + ")";
 }
 std::string vertex_name(std::size_t v) { return "vertex " + std::to_string(v); }
+// Where a vertex is, in the file's millimetres: an STL file numbers no vertices (its corners are
+// numbered in order of first appearance), so a number alone would not find the place in it.
+std::string millimetres(const Vec3& p) {
+  char text[96];
+  std::snprintf(text, sizeof text, "(%.6g, %.6g, %.6g)", units::m_to_mm(p.x), units::m_to_mm(p.y), units::m_to_mm(p.z));
+  return text;
+}
+std::string located_vertex(const TriangleMesh& mesh, std::size_t v) { return vertex_name(v) + " at " + millimetres(mesh.positions[v]) + " mm"; }
+std::string edge_place(const TriangleMesh& mesh, std::uint32_t a, std::uint32_t b) {
+  return "; the edge runs from " + millimetres(mesh.positions[a]) + " to " + millimetres(mesh.positions[b]) + " mm";
+}
 
 /// One undirected edge occurrence: its endpoints sorted, the face it came from and whether the
 /// face walks it from low to high index.
@@ -120,7 +131,7 @@ Status check_edges(const TriangleMesh& mesh, std::vector<EdgeUse>& uses) {
     }
     if (!problem.empty() && uses[i].face < error_face) {
       error_face = uses[i].face;
-      error = problem;
+      error = problem + edge_place(mesh, uses[i].low, uses[i].high);
     }
     i = j;
   }
@@ -169,7 +180,7 @@ Status check_vertex_fans(const TriangleMesh& mesh) {
       }
     }
     if (seen != count) {
-      return Error{"non-manifold " + vertex_name(v) + ": its faces form separate fans (faces " +
+      return Error{"non-manifold " + located_vertex(mesh, v) + ": its faces form separate fans (faces " +
                    std::to_string(incident[begin]) + " and others meet only at this vertex)"};
     }
   }

@@ -212,7 +212,22 @@ TEST(MeshFiles, BowtieVertexIsNonManifold) {
       "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
       "f 1 6 5\nf 1 5 7\nf 1 7 6\nf 5 6 7\n";
   const std::string error = validation_error(write_file("bowtie.obj", obj));
-  EXPECT_NE(error.find("non-manifold vertex 0"), std::string::npos) << error;
+  EXPECT_NE(error.find("non-manifold vertex 0 at (0, 0, 0) mm"), std::string::npos) << error;
+}
+
+// An STL file numbers no vertices (the reader numbers the merged corners in order of first
+// appearance), so an error about an edge says where the edge is, in the file's millimetres.
+TEST(MeshFiles, OpenStlSurfaceNamesWhereTheEdgeIs) {
+  const std::string stl =
+      "solid open\n"
+      "facet normal 0 0 -1\nouter loop\nvertex 0 0 0\nvertex 0 10 0\nvertex 10 0 0\nendloop\nendfacet\n"
+      "facet normal 0 -1 0\nouter loop\nvertex 0 0 0\nvertex 10 0 0\nvertex 0 0 10\nendloop\nendfacet\n"
+      "facet normal -1 0 0\nouter loop\nvertex 0 0 0\nvertex 0 0 10\nvertex 0 10 0\nendloop\nendfacet\n"
+      "endsolid open\n";
+  const std::string error = validation_error(write_file("open.stl", stl));
+  EXPECT_NE(error.find("open surface: edge (1, 2) of face 0 has no neighbouring face; the edge runs from (0, 10, 0) to (10, 0, 0) mm"),
+            std::string::npos)
+      << error;
 }
 
 TEST(MeshFiles, DegenerateTriangleIsNamed) {
