@@ -138,7 +138,7 @@ std::string section_for(const RecordingScore& s) {
                      " collision steps re-simulated and verified against the recording</p>";
   html += "<h3>Plots over time</h3>";
   const std::vector<ScoreSample>& series = s.score.series;
-  html += plot_svg(series, "Reaction force", "N", "#1d3557", [](const ScoreSample& x) { return x.force_n; });
+  html += plot_svg(series, "Reaction force, largest of each step", "N", "#1d3557", [](const ScoreSample& x) { return x.force_n; });
   html += plot_svg(series, "Cutting pedal", "down = 1", "#d62828", [](const ScoreSample& x) { return x.cutting ? 1.0 : 0.0; });
   html += plot_svg(series, "Insertion depth past the apex", "mm", "#2a9d8f", [](const ScoreSample& x) { return x.insertion_mm; });
   html += plot_svg(series, "Resected tissue", "g", "#e76f51", [](const ScoreSample& x) { return x.resected_g; });

@@ -419,6 +419,8 @@ void Simulation::update_metrics(const TickInput& input, bool collision_tick) {
   const double force = length(reaction_.force_n);
   const bool cutting = input.tool_present && input.cut;
   metrics_.peak_reaction_force_n = std::max(metrics_.peak_reaction_force_n, force);
+  step_peak_force_n_ = step_peak_restarts_ ? force : std::max(step_peak_force_n_, force);
+  step_peak_restarts_ = collision_tick;
   if (contact) {
     metrics_.contact_time_s = static_cast<double>(++contact_ticks_) * h;
     contact_force_sum_n_ += force;

@@ -221,6 +221,11 @@ class Simulation {
   const SimulationConfig& config() const { return config_; }
   const ToolPoses& tool_poses() const { return placed_.poses; }
   const ToolReaction& reaction() const { return reaction_; }
+  /// The largest reaction force over the ticks after the previous collision tick, the latest
+  /// included: read right after a collision tick, over that collision step's ticks. A plot sampled
+  /// once per collision step shows every spike between its samples with it (reaction() is the last
+  /// tick's alone). Derived, not part of the state.
+  double largest_reaction_force_n_of_step() const { return step_peak_force_n_; }
   std::size_t tetrahedron_count() const { return tetrahedra_; }
   /// The thread that runs the collision refit and search; null when they run inline.
   JobThread* collision_thread() { return collision_thread_.get(); }
@@ -322,6 +327,8 @@ class Simulation {
   std::uint64_t state_hash_ = 0;
   std::uint64_t contact_ticks_ = 0;
   double contact_force_sum_n_ = 0.0;
+  double step_peak_force_n_ = 0.0;  // largest_reaction_force_n_of_step()
+  bool step_peak_restarts_ = true;  // the coming tick is the first of a collision step's ticks
   ProcedureMetrics metrics_;
   /// Whether the next physics step may share its loops with the helper: not while the core is
   /// overloaded (below).

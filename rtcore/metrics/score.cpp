@@ -138,7 +138,7 @@ void ScoreTracker::observe(const Simulation& sim) {
 
   ScoreSample s;
   s.time_s = time_s;
-  s.force_n = length(sim.reaction().force_n);
+  s.force_n = sim.largest_reaction_force_n_of_step();
   s.tool_placed = placed;
   s.insertion_mm = placed ? units::m_to_mm(poses.sheath.translation.z) : 0.0;
   s.resected_g = m.resected_total_g;

@@ -24,7 +24,7 @@ inline constexpr const char* kLobeNames[kLobeCount] = {"median", "left_lateral",
 /// One collision step's sample for the debrief's plots.
 struct ScoreSample {
   double time_s = 0.0;
-  double force_n = 0.0;         ///< reaction force of the tissue on the tool
+  double force_n = 0.0;         ///< the largest reaction force of the tissue on the tool over the step's ticks
   double insertion_mm = 0.0;    ///< sheath tip past the apex along the channel (negative: outside the gland); 0 while withdrawn
   bool tool_placed = false;     ///< the device had placed the tool (else it waits withdrawn, far from the gland)
   double resected_g = 0.0;      ///< total removed so far

@@ -7,6 +7,8 @@
 #include <memory>
 #include <numeric>
 
+#include <glm/geometric.hpp>
+
 #include "rtcore/metrics/score.h"
 #include "rtcore/scenes/procedure.h"
 #include "tests/support/procedure_input.h"
@@ -17,6 +19,8 @@ namespace {
 struct DemoRun {
   std::unique_ptr<Simulation> sim;
   ProcedureScore score;
+  std::vector<double> step_peak_force_n;  // per observation, the largest |reaction| of its ticks, measured tick by tick
+  bool peak_after_last_observation = false;
 };
 
 DemoRun run_demo() {
@@ -30,11 +34,21 @@ DemoRun run_demo() {
   ScoreTracker tracker(s);
   const double tick_s = s.config().tick_s();
   const auto ticks = static_cast<std::uint64_t>(std::llround(demo->duration_s() / tick_s));
+  DemoRun run;
+  double largest = 0.0;
   for (std::uint64_t t = 0; t < ticks; ++t) {
     s.step(procedure_input(*demo, t, tick_s), {});
-    if (s.is_collision_tick(t)) tracker.observe(s);
+    const double force = glm::length(s.reaction().force_n);
+    largest = std::max(largest, force);
+    if (s.is_collision_tick(t)) {
+      tracker.observe(s);
+      run.step_peak_force_n.push_back(largest);
+      largest = 0.0;
+      run.peak_after_last_observation = false;
+    } else if (force > 0.0 && force == s.metrics().peak_reaction_force_n) {
+      run.peak_after_last_observation = true;  // until an observation covers it
+    }
   }
-  DemoRun run;
   run.score = tracker.finish(s);
   run.sim = std::move(*sim);
   return run;
@@ -68,6 +82,23 @@ TEST(Score, ReadsTheCoresTotalsAndDerivesTheRates) {
   EXPECT_NEAR(static_cast<double>(cutting) / static_cast<double>(run.score.series.size()), m.cut_pedal_time_s / m.procedure_time_s, 0.01);
   // Lobe attribution accounts for all the adenoma.
   EXPECT_NEAR(m.lobe_adenoma_g[0] + m.lobe_adenoma_g[1] + m.lobe_adenoma_g[2], m.resected_adenoma_g, 1e-9);
+}
+
+// The force plot is sampled once per collision step, and a spike lasts a tick or two: each sample is
+// the largest force of its step's ticks, so the plot's highest point is the table's peak (the turp
+// debrief showed 12.3 N at the plot's top beside a 59.3 N peak).
+TEST(Score, ForceSamplesHoldTheLargestForceOfTheirStep) {
+  const DemoRun& run = demo_run();
+  ASSERT_EQ(run.score.series.size(), run.step_peak_force_n.size());
+  double highest = 0.0;
+  for (std::size_t i = 0; i < run.score.series.size(); ++i) {
+    EXPECT_EQ(run.score.series[i].force_n, run.step_peak_force_n[i]) << "sample " << i;
+    highest = std::max(highest, run.score.series[i].force_n);
+  }
+  EXPECT_GT(highest, 0.0);
+  if (!run.peak_after_last_observation) {
+    EXPECT_EQ(highest, run.sim->metrics().peak_reaction_force_n);
+  }
 }
 
 // A procedure that ends in a stroke: what the run's last collision job removes (collected at the
