@@ -60,13 +60,15 @@ constexpr const char* kCarelessProcedure = R"(# careless: idle loop, sphincter z
 14.0   0.0  0.0    0.0  125.0   0.0  0 0
 )";
 
-void expect_rescore_equals_live(const std::string& procedure, const std::string& extra) {
+/// Records the procedure's run, rescores the recording and expects the live score; returns the run's report.
+json expect_rescore_equals_live(const std::string& procedure, const std::string& extra) {
   SCOPED_TRACE(procedure + extra);
   const auto dir = scratch_directory("score_equal_" + procedure);
   const json live = run_and_record(procedure, dir / "run.resecto", extra);
   const json scored = score_json((dir / "run.resecto").string());
-  ASSERT_EQ(scored.at("scored").size(), 1u);
+  EXPECT_EQ(scored.at("scored").size(), 1u);
   EXPECT_TRUE(scored.at("skipped").empty());
+  if (scored.at("scored").size() != 1u) return live;
   const json& rescored = scored.at("scored")[0].at("metrics");
   std::printf("%s: live score %s\n", procedure.c_str(), live.at("score").dump().c_str());
   // Every metric, bit for bit: the same module over the same deterministic simulation.
@@ -78,13 +80,23 @@ void expect_rescore_equals_live(const std::string& procedure, const std::string&
   EXPECT_EQ(scored.at("scored")[0].at("ticks"), live.at("ticks"));
   EXPECT_FALSE(rescored.at("blood_loss_ml_per_g").at("available").get<bool>());
   EXPECT_TRUE(rescored.at("blood_loss_ml_per_g").at("value").is_null());
+  return live;
 }
 
 TEST(ScoreCommand, RescoringTheDemoEqualsTheLiveRunsScore) { expect_rescore_equals_live("demo", ""); }
 
-// The whole `turp` (81 simulated seconds, nine median-lobe strokes and both lateral lobes), recorded
-// and re-simulated: about a minute of CPU on the small gland.
-TEST(ScoreCommand, RescoringTheWholeTurpEqualsTheLiveRunsScore) { expect_rescore_equals_live("turp", ""); }
+// The whole `turp` (159 simulated seconds, nine median-lobe strokes and both lateral lobes), recorded
+// and re-simulated: about a minute of CPU each on the small gland. It is the expert's reference, so it
+// also holds issue 13's bar for it: most of the adenoma resected (at least 60%), no perforation, no
+// stroke into the sphincter zone, and no move faster than the contact search follows.
+TEST(ScoreCommand, TheWholeTurpResectsMostOfTheAdenomaSafelyAndRescoresAsLive) {
+  const json live = expect_rescore_equals_live("turp", "");
+  const json& metrics = live.at("metrics");
+  EXPECT_LE(metrics.at("remaining_adenoma_fraction").get<double>(), 0.4);
+  EXPECT_EQ(metrics.at("perforations").get<int>(), 0);
+  EXPECT_EQ(metrics.at("sphincter_zone_violations").get<int>(), 0);
+  EXPECT_EQ(metrics.at("contact_margin_exceeded_ticks").get<int>(), 0);
+}
 
 TEST(ScoreCommand, CarelessProcedureScoresWorseOnItsFaults) {
   const auto dir = scratch_directory("score_careless");
