@@ -68,20 +68,25 @@ double work(std::int64_t rounds) {
   return sum;
 }
 
-/// Passes of work() that take `busy_us` on this machine at its quickest: the least of many timings,
-/// so that a slow stretch during the calibration does not shorten every tick.
-std::int64_t rounds_for(std::int64_t busy_us) {
-  constexpr std::int64_t kTrialRounds = 64;
-  std::int64_t quickest_ns = std::numeric_limits<std::int64_t>::max();
-  for (int trial = 0; trial < 200; ++trial) {
+/// The least time of `trials` runs of work(rounds): the machine at its quickest, whatever slow
+/// stretch some of the runs fell in.
+std::int64_t quickest_ns(std::int64_t rounds, int trials) {
+  std::int64_t quickest = std::numeric_limits<std::int64_t>::max();
+  for (int trial = 0; trial < trials; ++trial) {
     const std::int64_t start = FrameProfiler::now_ns();
-    benchmark::DoNotOptimize(work(kTrialRounds));
-    quickest_ns = std::min(quickest_ns, std::max<std::int64_t>(1, FrameProfiler::now_ns() - start));
+    benchmark::DoNotOptimize(work(rounds));
+    quickest = std::min(quickest, std::max<std::int64_t>(1, FrameProfiler::now_ns() - start));
   }
-  return std::max<std::int64_t>(1, busy_us * 1000 * kTrialRounds / quickest_ns);
+  return quickest;
 }
 
-/// Runs `seconds` of ticks at the real-time settings, each calling `tick_work`, into `floor`.
+/// Passes of work() that take `busy_us` on this machine at its quickest.
+std::int64_t rounds_for(std::int64_t busy_us) {
+  constexpr std::int64_t kTrialRounds = 64;
+  return std::max<std::int64_t>(1, busy_us * 1000 * kTrialRounds / quickest_ns(kTrialRounds, 200));
+}
+
+/// Runs `seconds` of ticks at the real-time settings, each calling `tick_work`.
 template <typename TickWork>
 Floor run_floor(std::int64_t seconds, const TickWork& tick_work) {
   // The default rates, rounded to a period as the headless runner rounds them.
@@ -123,14 +128,8 @@ void BM_DeadlineFloorWork(benchmark::State& state) {
   const std::int64_t rounds = rounds_for(busy_us);
   for (auto _ : state) floor = run_floor(seconds, [&] { benchmark::DoNotOptimize(work(rounds)); });
   count(state, floor);
-  // What a tick's work took here afterwards, at its quickest: the calibration's check.
-  std::int64_t quickest_ns = std::numeric_limits<std::int64_t>::max();
-  for (int trial = 0; trial < 20; ++trial) {
-    const std::int64_t start = FrameProfiler::now_ns();
-    benchmark::DoNotOptimize(work(rounds));
-    quickest_ns = std::min(quickest_ns, FrameProfiler::now_ns() - start);
-  }
-  state.counters["tick_work_us"] = static_cast<double>(quickest_ns) / 1000.0;
+  // The calibration's check: what a tick's work takes here afterwards, at its quickest.
+  state.counters["tick_work_us"] = static_cast<double>(quickest_ns(rounds, 20)) / 1000.0;
 }
 BENCHMARK(BM_DeadlineFloorWork)->Args({300, 10})->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 
