@@ -158,7 +158,8 @@ int main(int argc, char** argv) {
     std::printf("busy waiting: a tick is late only when the thread did not run until past its deadline\n");
   }
   if (!resecto::work_floors().empty()) {
-    std::printf("fixed work: a tick is late also when a stall or a slow stretch of the machine delays its work, as it delays a physics step\n");
+    std::printf(
+        "fixed work: a tick is late also when a stall or a slow stretch of the machine delays its work, as it delays a physics step\n");
   }
   return 0;
 }
