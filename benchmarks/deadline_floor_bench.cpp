@@ -21,6 +21,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <tuple>
 
 #include "rtcore/core/fixed_step_scheduler.h"
 #include "rtcore/core/simulation.h"
@@ -35,13 +36,12 @@ struct Floor {
   bool fifo = false;
   double missed_percent() const { return 100.0 * static_cast<double>(misses) / static_cast<double>(std::max<std::uint64_t>(ticks, 1)); }
 };
-using FloorTable = std::map<std::pair<std::int64_t, std::int64_t>, Floor>;
-FloorTable& floors() {
-  static FloorTable f;
-  return f;
-}
-FloorTable& work_floors() {
-  static FloorTable f;
+/// What a floor's ticks do; the table lists the busy-waiting floors first.
+enum class TickKind { kBusyWaiting, kFixedWork };
+const char* name(TickKind kind) { return kind == TickKind::kBusyWaiting ? "busy waiting" : "fixed work"; }
+/// Per kind of tick, busy time (us) and seconds: the floor measured.
+std::map<std::tuple<TickKind, std::int64_t, std::int64_t>, Floor>& floors() {
+  static std::map<std::tuple<TickKind, std::int64_t, std::int64_t>, Floor> f;
   return f;
 }
 
@@ -115,7 +115,7 @@ void count(benchmark::State& state, const Floor& floor) {
 
 void BM_DeadlineFloor(benchmark::State& state) {
   const std::int64_t busy_us = state.range(0), seconds = state.range(1);
-  Floor& floor = floors()[{busy_us, seconds}];
+  Floor& floor = floors()[{TickKind::kBusyWaiting, busy_us, seconds}];
   for (auto _ : state) floor = run_floor(seconds, [&] { burn_until(FrameProfiler::now_ns() + busy_us * 1000); });
   count(state, floor);
 }
@@ -124,7 +124,7 @@ BENCHMARK(BM_DeadlineFloor)->Args({300, 10})->Args({0, 10})->Iterations(1)->UseR
 
 void BM_DeadlineFloorWork(benchmark::State& state) {
   const std::int64_t busy_us = state.range(0), seconds = state.range(1);
-  Floor& floor = work_floors()[{busy_us, seconds}];
+  Floor& floor = floors()[{TickKind::kFixedWork, busy_us, seconds}];
   const std::int64_t rounds = rounds_for(busy_us);
   for (auto _ : state) floor = run_floor(seconds, [&] { benchmark::DoNotOptimize(work(rounds)); });
   count(state, floor);
@@ -132,16 +132,6 @@ void BM_DeadlineFloorWork(benchmark::State& state) {
   state.counters["tick_work_us"] = static_cast<double>(quickest_ns(rounds, 20)) / 1000.0;
 }
 BENCHMARK(BM_DeadlineFloorWork)->Args({300, 10})->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
-
-void print_table(const FloorTable& table, const char* kind) {
-  for (const auto& [key, floor] : table) {
-    std::printf("%10lld %8lld | %8llu %8llu %9.3f%% %12.0f %12llu | %s, %s\n", static_cast<long long>(key.first),
-                static_cast<long long>(key.second), static_cast<unsigned long long>(floor.ticks),
-                static_cast<unsigned long long>(floor.misses), floor.missed_percent(), floor.worst_late_us,
-                static_cast<unsigned long long>(floor.resynchronizations),
-                floor.fifo ? ("SCHED_FIFO " + std::to_string(kCoreFifoPriority)).c_str() : "normal (SCHED_FIFO not permitted)", kind);
-  }
-}
 
 }  // namespace
 }  // namespace resecto
@@ -152,12 +142,19 @@ int main(int argc, char** argv) {
   benchmark::Shutdown();
   std::printf("\n%10s %8s | %8s %8s %10s %12s %12s | %s\n", "busy us", "seconds", "ticks", "misses", "missed %", "worst late us",
               "re-anchored", "scheduling, ticks");
-  resecto::print_table(resecto::floors(), "busy waiting");
-  resecto::print_table(resecto::work_floors(), "fixed work");
-  if (!resecto::floors().empty()) {
-    std::printf("busy waiting: a tick is late only when the thread did not run until past its deadline\n");
+  bool kinds[2] = {false, false};
+  for (const auto& [key, floor] : resecto::floors()) {
+    const auto& [kind, busy_us, seconds] = key;
+    kinds[static_cast<int>(kind)] = true;
+    std::printf("%10lld %8lld | %8llu %8llu %9.3f%% %12.0f %12llu | %s, %s\n", static_cast<long long>(busy_us),
+                static_cast<long long>(seconds), static_cast<unsigned long long>(floor.ticks),
+                static_cast<unsigned long long>(floor.misses), floor.missed_percent(), floor.worst_late_us,
+                static_cast<unsigned long long>(floor.resynchronizations),
+                floor.fifo ? ("SCHED_FIFO " + std::to_string(resecto::kCoreFifoPriority)).c_str() : "normal (SCHED_FIFO not permitted)",
+                resecto::name(kind));
   }
-  if (!resecto::work_floors().empty()) {
+  if (kinds[0]) std::printf("busy waiting: a tick is late only when the thread did not run until past its deadline\n");
+  if (kinds[1]) {
     std::printf(
         "fixed work: a tick is late also when a stall or a slow stretch of the machine delays its work, as it delays a physics step\n");
   }

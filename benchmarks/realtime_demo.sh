@@ -47,15 +47,17 @@ import bisect, json, statistics, sys
 out, runs, before, after = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
 work_floor = max(int(sys.argv[5]), int(sys.argv[6]))
 met = met_work = 0
+# The bound for a floor: its misses as a fraction of this run's deadlines, plus 0.1%.
+bound = lambda floor, ticks: floor / 9600 * ticks + 0.001 * ticks
 for run in range(1, runs + 1):
     report = json.load(open(f"{out}/run{run}.json"))
     deadlines, stages = report["deadlines"], report["stages"]
     ticks = deadlines["ticks"]
-    # The bound: the worse floor of the sitting, as a fraction of this run's deadlines, plus 0.1%.
-    allowed = max(before, after) / 9600 * ticks + 0.001 * ticks
+    # The figure's: the sitting's worse floor.
+    allowed = bound(max(before, after), ticks)
     ok = deadlines["misses"] <= allowed
     met += ok
-    allowed_work = work_floor / 9600 * ticks + 0.001 * ticks
+    allowed_work = bound(work_floor, ticks)
     met_work += deadlines["misses"] <= allowed_work
     per_collision = round(report["rates_hz"]["physics"] / report["rates_hz"]["collision"])
     trace = json.load(open(f"{out}/run{run}.trace.json"))
