@@ -49,6 +49,10 @@ class ToolField {
   void prefetch_near(const Vec3& p, double radius) const {
     if (const ToolProximityGrid* grid = lists_for(radius)) grid->prefetch(p);
   }
+  /// Starts loading the list near(p, radius) will read, once prefetch_near() has loaded its bounds.
+  void prefetch_near_list(const Vec3& p, double radius) const {
+    if (const ToolProximityGrid* grid = lists_for(radius)) grid->prefetch_list(p);
+  }
   /// Per tool triangle, its plane: a ball that stays off it by more than the thickness cannot meet
   /// the triangle (the cheap test ahead of the box and exact tests).
   const ToolPlane& plane(std::uint32_t triangle) const { return planes_[triangle]; }

@@ -36,6 +36,11 @@ class ToolProximityGrid {
     std::size_t cell;
     if (cells_.locate(p, cell)) __builtin_prefetch(first_.data() + cell);
   }
+  /// Starts loading the triangles candidates(p) will read, once prefetch(p) has loaded their bounds.
+  void prefetch_list(const Vec3& p) const {
+    std::size_t cell;
+    if (cells_.locate(p, cell)) __builtin_prefetch(triangles_.data() + first_[cell]);
+  }
 
   /// The box the cells cover: the mesh's bounding box grown by the reach. Nothing outside it is
   /// within the reach of the mesh.
