@@ -4,6 +4,7 @@
 #include <exception>
 
 #include "console/commands/command_registry.h"
+#include "console/live/interrupt.h"
 #include "rtcore/base/atomic_file.h"
 
 int main(int argc, char** argv) {
@@ -17,6 +18,13 @@ int main(int argc, char** argv) {
     // missing file, an unknown option, a value out of range) is a usage error: 2, as for most Unix
     // tools, rather than CLI11's own codes (105 to 109) that scripts would have to learn.
     return app.exit(e) == 0 ? 0 : 2;
+  } catch (const resecto::InterruptedRun& e) {
+    // The run stopped early but wrote everything it had: its outputs are whole, the exit code a
+    // shell's for the signal.
+    resecto::Status flushed = resecto::flush_standard_output();
+    std::fprintf(stderr, "resecto: %s\n", e.what());
+    if (!flushed) std::fprintf(stderr, "resecto: %s\n", flushed.error().c_str());
+    return e.exit_code();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "resecto: %s\n", e.what());
     return 1;

@@ -12,6 +12,7 @@
 #include "console/commands/parameter_options.h"
 #include "console/gui/console_app.h"
 #include "console/gui/tissue_presets.h"
+#include "console/live/interrupt.h"
 #include "rtcore/base/atomic_file.h"
 
 namespace resecto::cli {
@@ -116,10 +117,14 @@ void open_console(const ConsoleCliOptions& o) {
   options.slow_frame_every = o.slow_frame_every;
   options.vsync = !o.no_vsync;
   options.view_scale = o.view_scale;
+  catch_interrupts();
   Result<nlohmann::ordered_json> report = gui::run_console(options);
   if (!report) throw std::runtime_error(report.error());
   std::fputs(gui::summarize_console_report(*report).c_str(), stdout);
   if (!o.screenshot.empty()) std::printf("  screenshot       %s\n", o.screenshot.c_str());
+  if (const int signal_number = interrupt_signal(); signal_number != 0) {
+    throw InterruptedRun(signal_number, "console closed by " + signal_name(signal_number) + "; its recording and report are complete");
+  }
 }
 
 namespace {

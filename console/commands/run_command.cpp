@@ -16,6 +16,7 @@
 #include "console/commands/console_command.h"
 #include "console/commands/parameter_options.h"
 #include "console/headless/headless_run.h"
+#include "console/live/interrupt.h"
 #include "rtcore/base/atomic_file.h"
 #include "rtcore/base/units.h"
 
@@ -111,6 +112,7 @@ void run(const RunOptions& o) {
     options.calibration = *calibration;
   }
 
+  catch_interrupts();
   Result<HeadlessResult> result = run_headless(options);
   if (!result) throw std::runtime_error(result.error());
   if (!o.report.empty()) {
@@ -122,6 +124,12 @@ void run(const RunOptions& o) {
     std::printf("%s\n", result->report.dump(2).c_str());
   } else {
     std::fputs(summarize_report(result->report).c_str(), stdout);
+  }
+  if (result->interrupted_by != 0) {
+    char simulated[32];
+    std::snprintf(simulated, sizeof simulated, "%.3f", result->report.at("simulated_s").get<double>());
+    throw InterruptedRun(result->interrupted_by, "interrupted by " + signal_name(result->interrupted_by) + " after " + simulated +
+                                                     " simulated s; every output holds the run up to there");
   }
 }
 

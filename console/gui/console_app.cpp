@@ -24,6 +24,7 @@
 #include "console/gui/screenshot.h"
 #include "console/headless/headless_run.h"
 #include "console/headless/realtime_advice.h"
+#include "console/live/interrupt.h"
 #include "rtcore/base/atomic_file.h"
 #include "rtcore/base/units.h"
 #include "rtcore/core/thread_priority.h"
@@ -306,7 +307,8 @@ Status ConsoleWindow::choose_shown(bool fresh_live_frame) {
 Status ConsoleWindow::run() {
   std::int64_t last_frame_ns = now_ns();
   Status failure = Ok{};
-  while (!quit_ && !glfwWindowShouldClose(window_)) {
+  // Ctrl-C in the terminal closes the window as its close button does (console/live/interrupt.h).
+  while (!quit_ && !glfwWindowShouldClose(window_) && interrupt_signal() == 0) {
     glfwPollEvents();
     const std::int64_t begin_ns = now_ns();
     const double dt_s = std::min(0.25, static_cast<double>(begin_ns - last_frame_ns) * 1e-9);

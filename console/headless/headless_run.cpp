@@ -12,6 +12,7 @@
 
 #include "console/headless/lockstep_device.h"
 #include "console/headless/realtime_advice.h"
+#include "console/live/interrupt.h"
 #include "console/live/live_device.h"
 #include "console/score/rescore.h"
 #include "device/link/calibration_adapter.h"
@@ -221,8 +222,9 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
       }
     }
     profiler.record(Stage::kTick, tick, tick_begin_ns, FrameProfiler::now_ns());
-    return true;
+    return interrupt_signal() == 0;
   });
+  result.interrupted_by = interrupt_signal();
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   const bool core_raised = core_priority.raised();
   core_priority.restore();
@@ -246,6 +248,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   r["contact_searches"] = {{"searched", sim.contact_searches()}, {"reused", sim.contact_searches_reused()}};
   r["mode"] = options.realtime ? "realtime" : "batch";
   r["procedure"] = options.procedure.name;
+  if (result.interrupted_by != 0) r["interrupted"] = signal_name(result.interrupted_by);
   r["simulated_s"] = static_cast<double>(result.ticks) * tick_s;
   r["wall_s"] = wall_s;
   r["rates_hz"] = {{"physics", 1.0 / tick_s}, {"collision", config.collision_hz}};

@@ -42,9 +42,12 @@ struct HeadlessResult {
   std::uint64_t final_hash = 0;
   std::vector<std::uint64_t> collision_hashes;  ///< the state hash at every collision step
   nlohmann::ordered_json report;
+  int interrupted_by = 0;  ///< the signal that ended the run early (console/live/interrupt.h), or 0
 };
 
-/// Runs the procedure; an error only for a setup failure (a bad model or an unwritable trace).
+/// Runs the procedure; an error only for a setup failure (a bad model or an unwritable trace). A
+/// SIGINT or SIGTERM noted by catch_interrupts() ends it at the next tick, with every output written
+/// for the ticks run (the report says `"interrupted": "SIGINT"`).
 Result<HeadlessResult> run_headless(const HeadlessOptions& options);
 
 /// A few lines a person reads at the end of a run.

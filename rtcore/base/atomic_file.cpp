@@ -41,9 +41,38 @@ int create_temporary_beside(const std::filesystem::path& target, std::filesystem
   return -1;
 }
 
+/// Whether `path` lies under /dev or /proc, where a name stands for a device, a process or an open
+/// descriptor (/dev/stdout is a link to /proc/self/fd/1), never a file of the user's.
+bool names_a_system_object(const std::filesystem::path& path) {
+  const std::filesystem::path absolute = std::filesystem::absolute(path).lexically_normal();
+  auto element = absolute.begin();
+  if (element == absolute.end() || ++element == absolute.end()) return false;
+  return *element == "dev" || *element == "proc";
+}
+
+/// The file an output at `target` really is: a symbolic link is followed to the file it names (so
+/// the link stays a link and its file is the one replaced), link by link, each relative link from its
+/// own folder. A link into /dev or /proc (/dev/stdout, /proc/self/fd/1) is refused: renaming over it
+/// would destroy the system's link, and its file may be a pipe or a terminal.
+Result<std::filesystem::path> resolve_links(const std::filesystem::path& target) {
+  std::filesystem::path path = target;
+  for (int hops = 0; hops < 40; ++hops) {
+    struct stat link {};
+    if (::lstat(path.c_str(), &link) != 0 || !S_ISLNK(link.st_mode)) return path;
+    if (names_a_system_object(path)) {
+      return Error{target.string() + ": is a link to a device or an open file (" + path.string() + "), not a regular file; not replaced"};
+    }
+    std::error_code error;
+    const std::filesystem::path named = std::filesystem::read_symlink(path, error);
+    if (error) return Error{target.string() + ": cannot read the link " + path.string() + ": " + error.message()};
+    path = named.is_absolute() ? named : path.parent_path() / named;
+  }
+  return Error{target.string() + ": too many levels of symbolic links"};
+}
+
 /// The checks every output path gets: a file name, and only a regular file in the way (renaming over
-/// a device or a folder would destroy it). `stat_errno` is 0 when the target exists (`existing` is
-/// its stat), else stat's errno.
+/// a device or a folder would destroy it), `target` being the path with its links followed.
+/// `stat_errno` is 0 when the target exists (`existing` is its stat), else stat's errno.
 Status inspect_target(const std::filesystem::path& target, struct stat& existing, int& stat_errno) {
   if (target.empty()) return Error{"an output path is empty"};
   if (target.filename().empty() || target.filename() == "." || target.filename() == "..") {
@@ -69,16 +98,19 @@ Status AtomicFile::open(const std::filesystem::path& target) {
   discard();
   target_ = target;
   first_error_.clear();
+  Result<std::filesystem::path> resolved = resolve_links(target);
+  if (!resolved) return Error{resolved.error()};
+  destination_ = *resolved;
   struct stat existing {};
   int stat_errno = 0;
-  if (Status replaceable = inspect_target(target, existing, stat_errno); !replaceable) return replaceable;
+  if (Status replaceable = inspect_target(destination_, existing, stat_errno); !replaceable) return replaceable;
   keep_mode_ = stat_errno == 0;
   if (keep_mode_) {
     mode_ = static_cast<int>(existing.st_mode & 07777);
   } else if (stat_errno != ENOENT) {
     return failure("cannot inspect the target", stat_errno);
   }
-  fd_ = create_temporary_beside(target, temporary_);
+  fd_ = create_temporary_beside(destination_, temporary_);
   if (fd_ < 0) {
     const int error_number = errno;
     temporary_.clear();
@@ -116,7 +148,7 @@ Status AtomicFile::commit() {
   const int fd = fd_;
   fd_ = -1;
   if (::close(fd) != 0 && status) status = failure("cannot write", errno);
-  if (status && std::rename(temporary_.c_str(), target_.c_str()) != 0) status = failure("cannot replace the file", errno);
+  if (status && std::rename(temporary_.c_str(), destination_.c_str()) != 0) status = failure("cannot replace the file", errno);
   if (!status) {
     ::unlink(temporary_.c_str());
     temporary_.clear();
@@ -181,9 +213,13 @@ Status check_output_folder(const std::filesystem::path& output, const std::strin
 }
 
 Status check_output_path(const std::filesystem::path& output, std::span<const std::filesystem::path> inputs) {
+  Result<std::filesystem::path> resolved = resolve_links(output);
+  if (!resolved) return Error{resolved.error()};
   struct stat existing {};
   int stat_errno = 0;
-  if (Status replaceable = inspect_target(output, existing, stat_errno); !replaceable) return replaceable;
+  if (Status replaceable = inspect_target(*resolved, existing, stat_errno); !replaceable) {
+    return *resolved == output ? replaceable : Error{output.string() + " (a link to " + resolved->string() + "): " + replaceable.error()};
+  }
   if (stat_errno == 0) {
     for (const std::filesystem::path& input : inputs) {
       if (!input.empty() && same_file(input, output)) {
@@ -193,7 +229,7 @@ Status check_output_path(const std::filesystem::path& output, std::span<const st
   } else if (stat_errno != ENOENT && stat_errno != ENOTDIR) {  // ENOTDIR: a file where its folder should be, named below
     return Error{output.string() + ": cannot inspect: " + std::strerror(stat_errno)};
   }
-  return check_writable_folder(output.parent_path().empty() ? std::filesystem::path(".") : output.parent_path(), output);
+  return check_writable_folder(resolved->parent_path().empty() ? std::filesystem::path(".") : resolved->parent_path(), output);
 }
 
 Status check_output_paths(std::span<const std::filesystem::path> outputs, std::span<const std::filesystem::path> inputs) {

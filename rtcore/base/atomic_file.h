@@ -21,7 +21,9 @@ class AtomicFile {
   AtomicFile& operator=(const AtomicFile&) = delete;
   ~AtomicFile();
 
-  /// Creates the temporary beside `target`. Fails if the target exists and is not a regular file.
+  /// Creates the temporary beside `target`, or beside the file it names if it is a symbolic link
+  /// (the link stays; its file is replaced). Fails if the target exists and is not a regular file,
+  /// or is a link into /dev or /proc (/dev/stdout).
   Status open(const std::filesystem::path& target);
   /// Appends bytes; after the first failure every later call reports it again.
   Status write(std::string_view bytes);
@@ -36,7 +38,8 @@ class AtomicFile {
  private:
   Error failure(const std::string& what, int error_number);
 
-  std::filesystem::path target_;
+  std::filesystem::path target_;       // as given, for messages
+  std::filesystem::path destination_;  // the file replaced: the target with its links followed
   std::filesystem::path temporary_;
   int fd_ = -1;
   int mode_ = 0666;  // the replaced file's permission bits, or the umask's default
@@ -48,9 +51,9 @@ class AtomicFile {
 Status write_file_atomically(const std::filesystem::path& target, std::string_view bytes);
 
 /// Whether `output` can be written, checked before the work that produces it (a long run, a
-/// recovery) so a mistyped path costs nothing: an empty path, a folder or device in the way, a
-/// missing folder, or the very file of one of `inputs` (which the output would destroy) is an
-/// error naming the path.
+/// recovery) so a mistyped path costs nothing: an empty path, a folder or device in the way (links
+/// followed; a link into /dev or /proc refused), a missing folder, or the very file of one of
+/// `inputs` (which the output would destroy) is an error naming the path.
 Status check_output_path(const std::filesystem::path& output, std::span<const std::filesystem::path> inputs = {});
 /// The same for an output that is a folder of files, made with its missing parents when written:
 /// a file in its place (the error says `what` the folder is for), or a nearest existing folder this

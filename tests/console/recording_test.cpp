@@ -10,6 +10,7 @@
 #include <iterator>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 #include <sys/stat.h>
@@ -475,6 +476,61 @@ TEST(RecordingCommands, AKilledRealTimeRecordingRecoversAtLeastFourOfFiveSeconds
   EXPECT_GE(r["simulated_s"].get<double>(), 4.0);
   EXPECT_EQ(r["mismatches"], 0);
   EXPECT_GT(r["verified_hashes"].get<int>(), 4 * 60 - 1);
+}
+
+/// Starts `resecto run --headless` with `extra` options recording to `file` (stdout to `out`), waits
+/// for the recording's header, lets it run `seconds`, then sends `signal_number`; returns its status.
+int interrupt_headless_run(const std::filesystem::path& file, const std::filesystem::path& out, const std::vector<std::string>& extra,
+                           double seconds, int signal_number) {
+  const pid_t child = ::fork();
+  if (child < 0) return -1;
+  if (child == 0) {
+    std::freopen(out.c_str(), "w", stdout);
+    std::vector<std::string> words{RESECTO_EXE, "run", "--headless", "--procedure", "demo", "--record", file.string()};
+    words.insert(words.end(), extra.begin(), extra.end());
+    std::vector<char*> argv;
+    for (std::string& word : words) argv.push_back(word.data());
+    argv.push_back(nullptr);
+    ::execv(RESECTO_EXE, argv.data());
+    ::_exit(127);
+  }
+  for (int i = 0; i < 600 && !(std::filesystem::exists(file) && std::filesystem::file_size(file) > 100); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+  ::kill(child, signal_number);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  return status;
+}
+
+TEST(RecordingCommands, CtrlCOrSigtermEndsARunWithEveryOutputWholeAndTheShellsExitCode) {
+  const auto dir = scratch_directory("recording_interrupted");
+  for (const int signal_number : {SIGINT, SIGTERM}) {
+    const std::string name = signal_number == SIGINT ? "SIGINT" : "SIGTERM";
+    const auto file = dir / (name + ".rsrec");
+    const auto report = dir / (name + ".json");
+    const auto surface = dir / (name + ".off");
+    std::ofstream(report) << "the previous report\n";
+    // The batch demo takes about 3 s on this class of machine; a signal 0.5 s after the recording starts lands mid-run.
+    const int status = interrupt_headless_run(file, dir / (name + ".out"), {"--report", report.string(), "--export-surface", surface.string()}, 0.5,
+                                              signal_number);
+    ASSERT_TRUE(WIFEXITED(status)) << name << ": ended by a signal, not by the handler";
+    EXPECT_EQ(WEXITSTATUS(status), 128 + signal_number) << name;
+    // The report is the run's, up to where it stopped, and says why it stopped.
+    const nlohmann::json r = nlohmann::json::parse(testing::read_text(report));
+    EXPECT_EQ(r["interrupted"], name);
+    EXPECT_LT(r["simulated_s"].get<double>(), 10.0) << name << ": the signal came after the run's end; the machine was too quick for the test";
+    // The recording is closed (its index written) and replays every hash; the surface is whole.
+    EXPECT_EQ(run_resecto("rec verify " + file.string()).exit_code, 0) << name;
+    const testing::CommandOutput replay = run_resecto("replay " + file.string() + " --verify --json");
+    ASSERT_EQ(replay.exit_code, 0) << replay.err;
+    EXPECT_EQ(json_of(replay)["mismatches"], 0);
+    EXPECT_EQ(json_of(replay)["ticks"], r["ticks"]);
+    EXPECT_EQ(run_resecto("mesh check " + surface.string()).exit_code, 0) << name;
+    // No temporary is left beside the outputs.
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) EXPECT_NE(entry.path().extension(), ".tmp") << entry.path();
+  }
 }
 
 }  // namespace

@@ -113,6 +113,37 @@ TEST(AtomicFile, RefusesFoldersDevicesAndMissingFolders) {
   EXPECT_EQ(entries(dir), 1u);
 }
 
+TEST(AtomicFile, WritesThroughALinkAndRefusesLinksIntoDevOrProc) {
+  const auto dir = scratch("links");
+  ASSERT_TRUE(write_file_atomically(dir / "target.json", "old\n").ok());
+  std::filesystem::create_directories(dir / "sub");
+  std::filesystem::create_symlink("../target.json", dir / "sub" / "latest.json");  // relative to its own folder
+  std::filesystem::create_symlink(dir / "sub" / "latest.json", dir / "chain.json");
+  ASSERT_TRUE(check_output_path(dir / "chain.json").ok());
+  ASSERT_TRUE(write_file_atomically(dir / "chain.json", "new\n").ok());
+  // Both links are still links; the file they name holds the new text, with no temporary left.
+  EXPECT_TRUE(std::filesystem::is_symlink(dir / "chain.json"));
+  EXPECT_TRUE(std::filesystem::is_symlink(dir / "sub" / "latest.json"));
+  EXPECT_EQ(contents(dir / "target.json"), "new\n");
+  EXPECT_EQ(entries(dir), 3u);  // target.json, sub, chain.json
+  // A dangling link: the file it names is created.
+  std::filesystem::create_symlink("made.json", dir / "dangling.json");
+  ASSERT_TRUE(write_file_atomically(dir / "dangling.json", "made\n").ok());
+  EXPECT_TRUE(std::filesystem::is_symlink(dir / "dangling.json"));
+  EXPECT_EQ(contents(dir / "made.json"), "made\n");
+  // /dev/stdout is a link to /proc/self/fd/1: renaming over it would remove the system's link for
+  // every process, so it is refused before any work, as is a user's link to it.
+  std::filesystem::create_symlink("/proc/self/fd/1", dir / "out.json");
+  for (const std::filesystem::path& system : {std::filesystem::path("/dev/stdout"), dir / "out.json"}) {
+    const Status checked = check_output_path(system);
+    ASSERT_FALSE(checked.ok()) << system;
+    EXPECT_NE(checked.error().find("is a link to a device or an open file"), std::string::npos) << checked.error();
+    EXPECT_FALSE(write_file_atomically(system, "x").ok()) << system;
+  }
+  EXPECT_TRUE(std::filesystem::is_symlink("/dev/stdout"));
+  EXPECT_TRUE(std::filesystem::is_symlink(dir / "out.json"));
+}
+
 TEST(AtomicFile, AFailedOpenKeepsItsReasonThroughWriteAndCommit) {
   // A full disk is tested end to end on a real full tmpfs (tests/console/hostile_input_test.cpp);
   // here: the first failure is the one every later call reports.
