@@ -166,6 +166,21 @@ Result<TetMesh> tetrahedralize(const TriangleMesh& input, const TetrahedralizeOp
   // TetGen can crash (not throw) on some invalid surfaces, so nothing invalid reaches it.
   Result<SurfaceReport> valid = validate_closed_surface(input);
   if (!valid) return Error{"cannot tetrahedralize: " + valid.error()};
+  // A volume bound that asks for more tetrahedra than any model here uses is refused before TetGen
+  // spends minutes and gigabytes on it (--max-volume 0.001 in a 42 ml gland asks for 42 million).
+  if (options.max_volume_m3 > 0.0) {
+    const double volume_m3 = std::abs(valid->volume_m3);
+    const double asked = volume_m3 / options.max_volume_m3;
+    if (asked > static_cast<double>(TetrahedralizeOptions::kMaxTetrahedraForVolumeBound)) {
+      char text[320];
+      std::snprintf(text, sizeof text,
+                    "maximum tetrahedron volume %.4g mm^3 asks for about %.3g tetrahedra in this surface's %.4g mm^3; at most %d are made "
+                    "(the 138,240-triangle gland has about 533,000): give %.3g mm^3 or more",
+                    options.max_volume_m3 * 1e9, asked, volume_m3 * 1e9, TetrahedralizeOptions::kMaxTetrahedraForVolumeBound,
+                    volume_m3 * 1e9 / TetrahedralizeOptions::kMaxTetrahedraForVolumeBound);
+      return Error{text};
+    }
+  }
   // Only the vertices the faces use reach TetGen: an unused one inside would become a node (and
   // slivers around it), one outside the hull crashes TetGen's cleanup.
   const TriangleMesh surface = without_unused_vertices(input);

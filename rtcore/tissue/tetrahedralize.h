@@ -25,12 +25,16 @@ struct TetrahedralizeOptions {
   static constexpr double kSteinerPointsPerSurfaceVertex = 50.0;
   static constexpr int kMinSteinerPoints = 20'000;
   static constexpr int kMaxSteinerPoints = 4'000'000;
+  /// The most tetrahedra a volume bound may ask for (the enclosed volume over max_volume_m3): past it
+  /// the bound is refused at once, before TetGen's minutes and gigabytes.
+  static constexpr int kMaxTetrahedraForVolumeBound = 3'000'000;
 };
 
 /// Fills the closed surface with tetrahedra, keeping its boundary faces exactly (TetGen -pY), so the
 /// tissue's surface is the input surface (over the vertices its faces use, renumbered in order when
 /// some are unused). Errors: a surface TetGen cannot mesh (self-intersecting, open), reported with
-/// TetGen's reason; quality bounds the refinement could not reach within max_steiner_points.
+/// TetGen's reason; a volume bound past kMaxTetrahedraForVolumeBound; quality bounds the refinement
+/// could not reach within max_steiner_points.
 Result<TetMesh> tetrahedralize(const TriangleMesh& surface, const TetrahedralizeOptions& options = {});
 
 }  // namespace resecto

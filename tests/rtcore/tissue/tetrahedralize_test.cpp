@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -163,6 +164,20 @@ TEST(Tetrahedralize, UnreachableQualityIsAnErrorAtTheSteinerBudget) {
   ASSERT_FALSE(tetra);
   EXPECT_NE(tetra.error().find("limit of 50 points"), std::string::npos) << tetra.error();
   EXPECT_NE(tetra.error().find("dihedral angles of 30 deg (reached"), std::string::npos) << tetra.error();
+}
+
+TEST(Tetrahedralize, AVolumeBoundAskingForMillionsOfTetrahedraIsRefusedAtOnce) {
+  // --max-volume 0.001 mm^3 in a 42 ml gland asks for 42 million tetrahedra: TetGen took 3 GB in a
+  // minute and went on. Refused before TetGen starts, naming a bound that would do.
+  const ProstateModel model = generate_prostate(1296);
+  TetrahedralizeOptions options = prostate_options(model);
+  options.max_volume_m3 = 0.001 * 1e-9;
+  const auto start = std::chrono::steady_clock::now();
+  Result<TetMesh> tetra = tetrahedralize(model.surface, options);
+  ASSERT_FALSE(tetra);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5)) << "TetGen ran";
+  EXPECT_NE(tetra.error().find("maximum tetrahedron volume 0.001 mm^3 asks for about"), std::string::npos) << tetra.error();
+  EXPECT_NE(tetra.error().find("mm^3 or more"), std::string::npos) << tetra.error();
 }
 
 TEST(Tetrahedralize, RejectsImpossibleOptions) {
