@@ -144,6 +144,12 @@ void Recording::number_keyframes() {
   }
 }
 
+const ChunkLocation* Recording::index_chunk() const {
+  const auto index = std::find_if(scan_.chunks.begin(), scan_.chunks.end(),
+                                  [](const ChunkLocation& c) { return c.type == static_cast<std::uint16_t>(ChunkType::kIndex); });
+  return index == scan_.chunks.end() ? nullptr : &*index;
+}
+
 Result<std::size_t> Recording::find_keyframe(std::uint64_t number) const {
   const auto at =
       std::lower_bound(keyframes_.begin(), keyframes_.end(), number, [](const KeyframeInfo& k, std::uint64_t n) { return k.number < n; });

@@ -56,6 +56,10 @@ class Recording {
   std::span<const ChunkLocation> chunks() const { return scan_.chunks; }
   std::span<const DamagedRange> damaged() const { return scan_.damaged; }
   bool index_present() const { return scan_.trailer_present; }
+  /// The intact index chunk the recorder writes when it closes the file, or null: a file without
+  /// one was never closed (the run was killed), though it may replay up to where it stops.
+  const ChunkLocation* index_chunk() const;
+  bool closed() const { return index_present() || index_chunk() != nullptr; }
   /// Chunks whose CRCs held but whose content did not decode (should never happen; counted).
   std::span<const std::string> content_errors() const { return content_errors_; }
 

@@ -38,9 +38,13 @@ struct InfoOptions {
 /// "not closed" said of such a file was false; audit 25, F6).
 std::string index_state(const rec::Recording& r) {
   if (r.index_present()) return "present";
-  const auto index = std::find_if(r.chunks().begin(), r.chunks().end(),
-                                  [](const rec::ChunkLocation& c) { return c.type == static_cast<std::uint16_t>(rec::ChunkType::kIndex); });
-  if (index == r.chunks().end()) return "absent: the recording was not closed";
+  const rec::ChunkLocation* index = r.index_chunk();
+  if (index == nullptr) return "absent: the recording was not closed";
+  // Cut right after the index, or bytes after it (appended, or a damaged trailer): said as it is.
+  if (index->end() >= r.bytes().size()) {
+    return "intact at byte " + std::to_string(index->offset) + ", but the file ends with it, at byte " + std::to_string(index->end()) +
+           ", without the trailer that follows it (the file was cut short): the recording was closed";
+  }
   return "intact at byte " + std::to_string(index->offset) + ", but the file does not end with its trailer after it (bytes follow at byte " +
          std::to_string(index->end()) + ", or the trailer is damaged): the recording was closed";
 }

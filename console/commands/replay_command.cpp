@@ -35,7 +35,9 @@ void replay(const ReplayOptions& o) {
   // (rec recover drops the damaged chunks), and those were never compared.
   const std::uint64_t written_steps = std::max(recorded_steps, recording->summary_count("steps").value_or(0));
   const std::string unverified = rec::unverified_hashes(*recording, r);
-  const bool complete = ticks == recording->ticks().size() && recording->damaged().empty();
+  // Complete: the whole run the recorder closed, every tick of it replayed. A file never closed
+  // (a killed run, or one cut short) replays up to where it stops, but is not the whole run.
+  const bool complete = ticks == recording->ticks().size() && recording->damaged().empty() && recording->closed();
 
   nlohmann::ordered_json out = {
       {"file", o.file},
@@ -48,6 +50,7 @@ void replay(const ReplayOptions& o) {
       {"mismatches", r.mismatches()},
       {"first_mismatch_tick", r.first_mismatch_tick() ? nlohmann::ordered_json(*r.first_mismatch_tick()) : nlohmann::ordered_json(nullptr)},
       {"complete", complete},
+      {"closed", recording->closed()},
       {"unverified", unverified.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(unverified)}};
   if (recording->summary().contains("run")) out["recorded_state_hash"] = recording->summary()["run"].value("state_hash", "");
   if (o.json) {
@@ -61,6 +64,9 @@ void replay(const ReplayOptions& o) {
                   static_cast<unsigned long long>(ticks), static_cast<unsigned long long>(recording->ticks().size()), recording->damaged().size());
     } else if (!recording->damaged().empty()) {
       std::printf("  every recorded tick replayed; the file has %zu damaged ranges (`resecto rec verify` names them)\n", recording->damaged().size());
+    }
+    if (!recording->closed()) {
+      std::printf("  the recording was never closed (no index): it ends where its run stopped writing, not necessarily at the run's end\n");
     }
     if (o.verify) {
       std::printf("  %llu of %llu recorded hashes verified, %llu mismatches\n", static_cast<unsigned long long>(r.verified_hashes()),

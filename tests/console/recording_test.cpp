@@ -186,6 +186,26 @@ TEST(RecordingCommands, DamageThatTouchesNoHashIsReportedAsSuch) {
   EXPECT_EQ(verify.err.find("not closed"), std::string::npos) << verify.err;
   const testing::CommandOutput info = run_resecto("rec info " + appended.string());
   EXPECT_NE(info.out.find("index      intact at byte "), std::string::npos) << info.out;
+
+  // Cut right after its index (the trailer gone): nothing follows, so the message says the file ends
+  // there rather than "bytes follow" at the very byte where it ends (audit 29, F6).
+  const std::string whole = testing::read_text(file);
+  const auto cut = dir / "cut_after_index.rsrec";
+  std::ofstream(cut, std::ios::binary) << whole.substr(0, whole.size() - 16);
+  const testing::CommandOutput cut_verify = run_resecto("rec verify " + cut.string());
+  EXPECT_EQ(cut_verify.exit_code, 1);
+  EXPECT_NE(cut_verify.err.find("but the file ends with it, at byte " + std::to_string(whole.size() - 16)), std::string::npos) << cut_verify.err;
+  EXPECT_EQ(cut_verify.err.find("bytes follow"), std::string::npos) << cut_verify.err;
+
+  // Cut between two chunks, before the index: it replays up to there, but is not the whole run, and
+  // replay says so rather than "complete": true (audit 29, F5).
+  const auto unclosed = dir / "unclosed.rsrec";
+  std::ofstream(unclosed, std::ios::binary) << whole.substr(0, r->chunks()[r->chunks().size() / 2].offset);
+  const nlohmann::json replayed = json_of(run_resecto("replay " + unclosed.string() + " --json"));
+  EXPECT_EQ(replayed["complete"], false);
+  EXPECT_EQ(replayed["closed"], false);
+  EXPECT_NE(run_resecto("replay " + unclosed.string()).out.find("the recording was never closed"), std::string::npos);
+  EXPECT_EQ(json_of(run_resecto("replay " + file.string() + " --json"))["complete"], true);
 }
 
 // A ticks chunk lost in the middle: the recovered file is sound but its inputs break there. rec verify
