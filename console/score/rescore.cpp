@@ -56,6 +56,10 @@ bool is_count(const char* name) {
   return n == "cuts" || n == "chips" || n == "perforations" || n == "sphincter_zone_violations";
 }
 
+/// Whether a metric has a value: grams per cut has none without a cut (0 would read as cuts that
+/// removed nothing). JSON writes null, CSV an empty cell, the debrief "n/a".
+bool has_value(const ScoreMetrics& m, const char* name) { return m.cuts > 0 || std::string(name) != "grams_per_cut"; }
+
 /// What a sound file (no damage left in it) lacks of the procedure it was recorded from, or empty: a
 /// recovery's left-out damaged ranges, unless the recorder's summary shows every tick and command it
 /// wrote still there (the ranges held only keyframes or hashes, which the score does not use).
@@ -89,7 +93,9 @@ std::string lost_part_of_procedure(const rec::Recording& recording) {
 ordered_json score_metrics_json(const ScoreMetrics& m) {
   ordered_json out = ordered_json::object();
   for_each_scalar(m, [&](const char* name, double v) {
-    if (is_count(name)) {
+    if (!has_value(m, name)) {
+      out[name] = nullptr;
+    } else if (is_count(name)) {
       out[name] = static_cast<std::uint64_t>(v);
     } else {
       out[name] = v;
@@ -121,7 +127,9 @@ std::string score_csv_row(const RecordingScore& s) {
   std::string line = quoted(s.file) + "," + quoted(s.procedure) + "," + std::to_string(s.ticks);
   for_each_scalar(s.score.metrics, [&](const char* name, double v) {
     char number[64];
-    if (is_count(name)) {
+    if (!has_value(s.score.metrics, name)) {
+      std::snprintf(number, sizeof number, ",");
+    } else if (is_count(name)) {
       std::snprintf(number, sizeof number, ",%llu", static_cast<unsigned long long>(v));
     } else {
       std::snprintf(number, sizeof number, ",%.17g", v);

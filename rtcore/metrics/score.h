@@ -49,7 +49,7 @@ struct ScoreMetrics {
   double resected_capsule_g = 0.0;
   double remaining_adenoma_fraction = 1.0;
   double grams_per_minute = 0.0;
-  double grams_per_cut = 0.0;           ///< 0 with no cut
+  double grams_per_cut = 0.0;           ///< 0 with no cut, where the reports write null (no value)
   std::uint64_t cuts = 0;
   std::uint64_t chips = 0;
   std::uint64_t perforations = 0;

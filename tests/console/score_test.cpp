@@ -160,6 +160,34 @@ TEST(ScoreCommand, CohortCsvSkipsTheDamagedRecording) {
   EXPECT_EQ(read_text(dir / "cohort.csv").find("damaged"), std::string::npos);
 }
 
+// Without a cut there are no grams per cut: 0 read as cuts that removed nothing (audit 29, F11). JSON
+// writes null, the CSV an empty cell, the debrief "n/a".
+TEST(ScoreCommand, GramsPerCutHasNoValueWithoutACut) {
+  const auto dir = scratch_directory("score_no_cut");
+  run_and_record("demo", dir / "short.resecto", " --seconds 1.2");  // the demo's first stroke starts later
+  const json scored = score_json((dir / "short.resecto").string());
+  const json& metrics = scored.at("scored")[0].at("metrics");
+  ASSERT_EQ(metrics["cuts"], 0) << metrics.dump();
+  EXPECT_TRUE(metrics["grams_per_cut"].is_null()) << metrics.dump();
+  ASSERT_EQ(run_resecto("score --quiet --csv " + (dir / "c.csv").string() + " --html " + (dir / "d.html").string() + " " +
+                        (dir / "short.resecto").string())
+                .exit_code,
+            0);
+  std::istringstream csv(read_text(dir / "c.csv"));
+  std::string header, row;
+  std::getline(csv, header);
+  std::getline(csv, row);
+  const auto cell = [](const std::string& line, std::size_t column) {
+    std::size_t begin = 0;
+    for (std::size_t c = 0; c < column; ++c) begin = line.find(',', begin) + 1;
+    return line.substr(begin, line.find(',', begin) - begin);
+  };
+  const auto column = static_cast<std::size_t>(std::count(header.begin(), header.begin() + static_cast<std::ptrdiff_t>(header.find(",grams_per_cut,")), ',') + 1);
+  EXPECT_EQ(cell(header, column), "grams_per_cut");
+  EXPECT_EQ(cell(row, column), "") << row;
+  EXPECT_NE(read_text(dir / "d.html").find("n/a (no cut)"), std::string::npos);
+}
+
 // A recording cut short is skipped as damaged; once `rec recover` has made a sound file of it, it is
 // still part of a procedure (it was scored as a whole one) and is skipped with the reason. A recovery
 // that lost only a keyframe kept every tick and command the recorder wrote, and scores.
