@@ -1,6 +1,7 @@
 // `resecto rec info|verify|recover|export`: the recording tools (recordings/README.md has the file's
 // layout). Every one reads damaged and cut files: what is intact is used, what is not is named.
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -185,13 +186,19 @@ struct ExportOptions {
 };
 
 void export_recording(const ExportOptions& o) {
-  const rec::Recording r = open_recording(o.file);
+  // Options that cannot be run as given are usage errors (exit 2), named before the file is read.
   const int choices = (o.keyframe >= 0 ? 1 : 0) + (o.time_s >= 0.0 ? 1 : 0) + (o.inputs ? 1 : 0);
-  if (choices != 1) throw std::runtime_error("rec export: give exactly one of --keyframe N, --time S or --inputs");
+  if (choices != 1) refuse_command_line("rec export: give exactly one of --keyframe N, --time S or --inputs");
   const std::filesystem::path input(o.file);
   if (Status ok = check_output_path(o.out, std::span(&input, 1)); !ok) throw std::runtime_error("rec export: " + ok.error());
+  std::string extension = std::filesystem::path(o.out).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (o.inputs && extension != ".csv") refuse_command_line("rec export --inputs: " + o.out + ": the inputs are written as CSV; name the file .csv");
+  if (!o.inputs && extension != ".drc" && extension != ".ply" && extension != ".obj" && extension != ".off" && extension != ".stl") {
+    refuse_command_line("rec export -o " + o.out + ": unknown surface format '" + extension + "' (use .drc, .ply, .obj, .off or .stl)");
+  }
+  const rec::Recording r = open_recording(o.file);
   if (o.inputs) {
-    if (std::filesystem::path(o.out).extension() != ".csv") throw std::runtime_error("rec export --inputs: " + o.out + ": the inputs are written as CSV; name the file .csv");
     if (Status written = rec::export_inputs_csv(r, o.out); !written) throw std::runtime_error(written.error());
     std::printf("%s: %zu ticks' inputs\n", o.out.c_str(), r.ticks().size());
     return;

@@ -1,5 +1,6 @@
 // `resecto run`: the simulator. `--headless` drives the core through the emulated device with a
 // scripted procedure and writes the JSON report of DESIGN.md's contract.
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -95,8 +96,18 @@ void run(const RunOptions& o) {
   options.simulation.collision_thread = !o.inline_collision;
   options.simulation.physics_threads = o.physics_threads;
   options.simulation.input_filter.enabled = !o.raw_input;
+  if (o.contact_margin_mm) {
+    // A margin given alone keeps the default's proportion of reuse shift to margin (0.3 to 1.5 mm):
+    // the default 0.3 mm shift would refuse every margin up to it.
+    TissueConfig& tissue = options.simulation.tissue;
+    const double reuse_per_margin = tissue.contact_reuse_m / tissue.contact_margin_m;
+    tissue.contact_margin_m = units::mm_to_m(*o.contact_margin_mm);
+    tissue.contact_reuse_m = std::min(tissue.contact_reuse_m, tissue.contact_margin_m * reuse_per_margin);
+  }
   if (o.contact_reuse_mm) options.simulation.tissue.contact_reuse_m = units::mm_to_m(*o.contact_reuse_mm);
-  if (o.contact_margin_mm) options.simulation.tissue.contact_margin_m = units::mm_to_m(*o.contact_margin_mm);
+  if (o.contact_reuse_mm && o.contact_margin_mm && !(*o.contact_reuse_mm < *o.contact_margin_mm)) {
+    refuse_command_line("--contact-reuse-mm " + exact_number(*o.contact_reuse_mm) + " must be below --contact-margin-mm " + exact_number(*o.contact_margin_mm));
+  }
   options.spin_us = o.spin_us;
   options.simulation.parameters = parameters_from_assignments(o.sets);
   // Options valid alone that do not go together (--contact-reuse-mm past --contact-margin-mm, a

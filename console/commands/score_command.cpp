@@ -41,7 +41,7 @@ void score(const ScoreOptions& o) {
   if (comparing && !o.files.empty()) refuse_command_line("score --compare A B takes no other FILE");
   if (comparing && o.html.empty()) refuse_command_line("score --compare A B needs --html OUT (the side-by-side page)");
   const std::vector<std::string>& files = comparing ? o.compare : o.files;
-  if (files.empty()) throw std::runtime_error("score: no recording given (resecto score FILE... or --compare A B)");
+  if (files.empty()) refuse_command_line("score: no recording given (resecto score FILE... or --compare A B)");
 
   // The outputs checked before minutes of re-simulation: never a recording being scored, never the
   // same file twice. With several recordings --html is a folder of pages, made later.
@@ -83,8 +83,9 @@ void score(const ScoreOptions& o) {
   if (!o.html.empty()) {
     if (comparing || files.size() == 1) {
       if (!scored.empty()) write_or_throw(o.html, debrief_html(scored));
-    } else {
-      // Several recordings: OUT is a directory holding one page per recording.
+    } else if (!scored.empty()) {
+      // Several recordings: OUT is a directory holding one page per recording (none made when every
+      // recording was skipped: no empty folders left behind).
       std::error_code error;
       std::filesystem::create_directories(o.html, error);
       if (error) throw std::runtime_error("score --html " + o.html + ": cannot create the directory: " + error.message());

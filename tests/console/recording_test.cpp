@@ -430,6 +430,16 @@ TEST(RecordingCommands, ExportsKeyframesAndInputsThatOtherProgramsRead) {
     EXPECT_LT(refused.err.size(), 200u) << option << ": " << refused.err;
     EXPECT_FALSE(std::filesystem::exists(dir / "bad.off")) << option;
   }
+  // Options that cannot run together, or an output of no known format, are usage errors: exit 2,
+  // the formats named, .drc among them (audit 29, F8).
+  for (auto [options, says] : {std::pair<const char*, const char*>{"--keyframe 1 --time 1 -o x.stl", "give exactly one of"},
+                               {"-o x.stl", "give exactly one of"},
+                               {"--time 1 -o x.xyz", "(use .drc, .ply, .obj, .off or .stl)"},
+                               {"--inputs -o x.txt", "name the file .csv"}}) {
+    const testing::CommandOutput refused = run_resecto("rec export " + file.string() + " " + options);
+    EXPECT_EQ(refused.exit_code, 2) << options << ": " << refused.err;
+    EXPECT_NE(refused.err.find(says), std::string::npos) << options << ": " << refused.err;
+  }
   ASSERT_EQ(run_resecto("rec export " + file.string() + " --inputs -o " + (dir / "inputs.csv").string()).exit_code, 0);
   const std::string csv = testing::read_text(dir / "inputs.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 961);  // header + 960 ticks

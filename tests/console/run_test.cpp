@@ -119,10 +119,13 @@ TEST(RunCommand, TheContactMarginIsTheUsersToChooseWithinItsRange) {
     hashes[k] = nlohmann::json::parse(read_text(path)).at("state_hash").get<std::string>();
   }
   EXPECT_EQ(hashes[0], hashes[1]);
-  // Below the reuse shift it is refused, naming both; outside its range, named by the option.
-  const CommandOutput below_reuse = run_resecto(std::string(kShortRun) + " --contact-margin-mm 0.2");
+  // A margin given alone below the default reuse shift (0.3 mm) takes a shift in the default's
+  // proportion (a fifth of it) and runs (audit 29, F10: it was refused, naming an option not given);
+  // a shift given that is not below the margin is refused, naming both options.
+  EXPECT_EQ(run_resecto(std::string(kShortRun) + " --contact-margin-mm 0.2").exit_code, 0);
+  const CommandOutput below_reuse = run_resecto(std::string(kShortRun) + " --contact-margin-mm 0.2 --contact-reuse-mm 0.3");
   EXPECT_EQ(below_reuse.exit_code, 2);
-  EXPECT_NE(below_reuse.err.find("contact reuse shift 0.3 mm is outside [0, the contact margin 0.2 mm)"), std::string::npos) << below_reuse.err;
+  EXPECT_NE(below_reuse.err.find("--contact-reuse-mm 0.3 must be below --contact-margin-mm 0.2"), std::string::npos) << below_reuse.err;
   const CommandOutput out_of_range = run_resecto(std::string(kShortRun) + " --contact-margin-mm 0");
   EXPECT_NE(out_of_range.exit_code, 0);
   EXPECT_NE(out_of_range.err.find("--contact-margin-mm"), std::string::npos) << out_of_range.err;

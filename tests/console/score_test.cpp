@@ -270,8 +270,8 @@ TEST(ScoreCommand, RecordingsOfOneNameFromTwoFoldersGetAPageEach) {
 }
 
 TEST(ScoreCommand, BadArgumentsAreNamed) {
-  const CommandOutput none = run_resecto("score");
-  EXPECT_NE(none.exit_code, 0);
+  const CommandOutput none = run_resecto("score --quiet");
+  EXPECT_EQ(none.exit_code, 2) << "a command line that cannot run is a usage error";
   EXPECT_NE(none.err.find("no recording given"), std::string::npos) << none.err;
   const CommandOutput missing = run_resecto("score --quiet /nonexistent/x.resecto");
   EXPECT_EQ(missing.exit_code, 1);
@@ -288,6 +288,10 @@ TEST(ScoreCommand, BadArgumentsAreNamed) {
   EXPECT_NE(file_for_folder.err.find("page.html: is a file; with several recordings --html names a folder of pages"), std::string::npos)
       << file_for_folder.err;
   EXPECT_EQ(file_for_folder.err.find("skipped"), std::string::npos) << file_for_folder.err;
+  // Every recording skipped: the folder of pages, and its missing parents, are not made (audit 29, F9).
+  const CommandOutput all_skipped = run_resecto("score --quiet /nonexistent/a.resecto /nonexistent/b.resecto --html " + (dir / "new" / "pages").string());
+  EXPECT_EQ(all_skipped.exit_code, 1);
+  EXPECT_FALSE(std::filesystem::exists(dir / "new")) << all_skipped.err;
 }
 
 /// Counts the pixels of colour `rgb` in a PNG file (stb_image, as the console's screenshot tests), or
