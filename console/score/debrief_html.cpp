@@ -80,7 +80,7 @@ std::vector<MetricRow> metric_rows() {
       // beak while the sheath presses tissue), the simulator's measure of Bright's idle diathermy.
       {"Cutting pedal down, nothing cut", "s", real(&ScoreMetrics::loop_on_idle_s, 2),
        "Bright 2012 (TURPsim): experts less active diathermy time without contact than novices (p < 0.01)"},
-      {"Tool-tip path", "mm", real(&ScoreMetrics::tool_path_mm, 0), "K\u00e4llstr\u00f6m 2010: students' resectoscope-tip path longer than urologists'"},
+      {"Tool path (the loop wire's middle)", "mm", real(&ScoreMetrics::tool_path_mm, 0), "K\u00e4llstr\u00f6m 2010: students' resectoscope-tip path longer than urologists'"},
       {"Tool-tip mean speed", "mm/s", real(&ScoreMetrics::tool_mean_speed_mm_s, 1), ""},
       {"Time in contact", "s", real(&ScoreMetrics::contact_time_s, 2), ""},
       {"Peak reaction force", "N", real(&ScoreMetrics::peak_force_n, 3), ""},

@@ -162,7 +162,11 @@ Result<Calibration> parse_calibration(const std::string& text, const std::string
     c.loop_mm[i] = loops[i];
   }
   for (unsigned a = 0; a < LP3500_ENCODER_COUNT; ++a) {
-    if (!is_whole(cpr[a], 1, 1e9)) in.fail("encoders.counts_per_revolution[" + std::to_string(a) + "]", "not a positive whole number");
+    // An optical encoder that counts fewer than 100 a turn places a joint to 3.6 degrees or worse: a
+    // typing slip (the reference device's 4096), which would swing the tool through the tissue.
+    if (!is_whole(cpr[a], 100, 1e9)) {
+      in.fail("encoders.counts_per_revolution[" + std::to_string(a) + "]", "not a whole number in 100-1000000000 (the reference device counts 4096)");
+    }
     c.encoder_counts_per_revolution[a] = static_cast<int>(cpr[a]);
   }
   bool rotation_shape = rotation->is_array() && rotation->size() == 3;

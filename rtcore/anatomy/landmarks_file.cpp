@@ -17,6 +17,10 @@ Result<std::pair<Vec3, Vec3>> parse_channel_axis(const std::string& text, const 
   if (!doc.is_object() || !doc.contains("channel_axis") || !doc["channel_axis"].is_object()) {
     return Error{source + ": channel_axis: missing (an object with apex and bladder_neck)"};
   }
+  // The file says its unit; a file in another would be read a thousandfold off (audit 29, F13).
+  if (doc.contains("units") && !(doc["units"].is_string() && doc["units"].get<std::string>() == "mm")) {
+    return Error{source + ": units: " + doc["units"].dump() + " (only \"mm\" is read: the coordinates are millimetres)"};
+  }
   const nlohmann::json& axis = doc["channel_axis"];
   Vec3 points[2];
   const char* names[2] = {"apex", "bladder_neck"};

@@ -334,15 +334,17 @@ TEST_F(HostileInput, CalibrationInputsOutsideTheDeviceAreRefused) {
 
 TEST_F(HostileInput, LandmarksMustBeFiniteAndDistinct) {
   const nlohmann::json good = nlohmann::json::parse(read_text(path("p.landmarks.json")));
-  for (int variant = 0; variant < 2; ++variant) {
+  const char* expected[] = {"apex and bladder_neck are less than 1 mm apart", "channel_axis.apex[2] 1e+308 is outside",
+                            "units: \"m\" (only \"mm\" is read"};
+  for (int variant = 0; variant < 3; ++variant) {
     const auto dir = scratch_directory("hostile_landmarks_" + std::to_string(variant));
     std::filesystem::copy_file(path("p.off"), dir / "p.off");
     nlohmann::json bad = good;
     if (variant == 0) bad["channel_axis"]["bladder_neck"] = bad["channel_axis"]["apex"];
     if (variant == 1) bad["channel_axis"]["apex"][2] = 1e308;
+    if (variant == 2) bad["units"] = "m";  // read as millimetres, it was a thousandfold off (audit 29, F13)
     write_bytes(dir / "p.landmarks.json", bad.dump());
-    expect_clean_failure(run_resecto_bounded("mesh tetra " + (dir / "p.off").string() + " -o " + (dir / "t.vtk").string()),
-                         variant == 0 ? "apex and bladder_neck are less than 1 mm apart" : "channel_axis.apex[2] 1e+308 is outside",
+    expect_clean_failure(run_resecto_bounded("mesh tetra " + (dir / "p.off").string() + " -o " + (dir / "t.vtk").string()), expected[variant],
                          bad.dump());
     EXPECT_FALSE(std::filesystem::exists(dir / "t.vtk"));
   }

@@ -71,6 +71,8 @@ TEST(Calibration, ReaderErrorsNameTheFileAndField) {
   expect_error(replace("\"gain_mm_per_count\"", "\"gain\""), "sheath.gain_mm_per_count: missing");
   expect_error(replace("\"resecto-calibration\"", "\"other\""), "format");
   expect_error(replace("4096,", "-3,"), "encoders.counts_per_revolution[0]");
+  // One count a turn would place the joint to 360 degrees (audit 29, F13: accepted, a 73 N peak).
+  expect_error(replace("4096,", "1,"), "not a whole number in 100-1000000000");
   expect_error(replace("-150.0", "\"far\""), "registration.translation_mm[2]: not a number");
   // A non-monotone table: swap two Hall sums.
   expect_error(replace("3091,", "2900,"), "hall_table[2]");
