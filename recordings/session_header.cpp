@@ -3,10 +3,12 @@
 #include "recordings/session_header.h"
 
 #include <array>
+#include <cmath>
 #include <string>
 
 #include "recordings/chunk_format.h"
 #include "recordings/json_fields.h"
+#include "rtcore/base/checked_number.h"
 #include "rtcore/base/json_text.h"
 
 namespace resecto::rec {
@@ -75,6 +77,12 @@ SimulationConfig config_from(const JsonFields& j) {
     if (!id) JsonFields::fail(parameters.path_of(key), "unknown tissue parameter");
     if (Status set = c.parameters.set(*id, parameters.get<double>(key.c_str())); !set) JsonFields::fail(parameters.path_of(key), set.error());
   }
+  // Every parameter the recorder wrote: one missing would replay at its default, silently another
+  // run than the one recorded (audit 29, F7).
+  for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
+    const std::string key(spec.key);
+    if (!parameters.json().contains(key)) JsonFields::fail(parameters.path_of(key), "is missing");
+  }
   const JsonFields gimbal = j.object("gimbal");
   const std::array<double, 3> pivot = gimbal.numbers<3>("pivot_m");
   c.gimbal.pivot_m = Vec3(pivot[0], pivot[1], pivot[2]);
@@ -86,6 +94,12 @@ SimulationConfig config_from(const JsonFields& j) {
   c.input_filter.linear_beta_per_m = f.get<double>("linear_beta_per_m");
   c.input_filter.angular_beta_s_per_rad = f.get<double>("angular_beta_s_per_rad");
   c.input_filter.enabled = f.get<bool>("enabled");
+  for (const auto& [name, value] : {std::pair{"min_cutoff_hz", c.input_filter.min_cutoff_hz}, std::pair{"derivative_cutoff_hz", c.input_filter.derivative_cutoff_hz}}) {
+    if (!(value > 0.0 && std::isfinite(value))) JsonFields::fail(f.path_of(name), "must be a positive cut-off, not " + exact_number(value));
+  }
+  for (const auto& [name, value] : {std::pair{"linear_beta_per_m", c.input_filter.linear_beta_per_m}, std::pair{"angular_beta_s_per_rad", c.input_filter.angular_beta_s_per_rad}}) {
+    if (!(value >= 0.0 && std::isfinite(value))) JsonFields::fail(f.path_of(name), "must be at least 0, not " + exact_number(value));
+  }
   c.predict_search_pose = j.get<bool>("predict_search_pose");
   const JsonFields t = j.object("tissue");
   const int integrator = t.get<int>("integrator");
@@ -154,6 +168,7 @@ Result<SessionHeader> header_from_json(std::string_view text) {
     h.build = j.get<std::string>("build");
     h.procedure = j.get<std::string>("procedure");
     h.mode = j.get<std::string>("mode");
+    if (h.mode != "batch" && h.mode != "realtime" && h.mode != "console") JsonFields::fail("mode", "\"" + h.mode + "\" (batch, realtime or console)");
     h.seed = j.get<std::uint64_t>("seed");
     h.start_tick = j.get<std::int64_t>("start_tick");
     if (h.start_tick < 0) JsonFields::fail("start_tick", "must be at least 0, not " + std::to_string(h.start_tick));
@@ -169,7 +184,14 @@ Result<SessionHeader> header_from_json(std::string_view text) {
     h.grid.bits = q.get<int>("bits");
     if (h.grid.bits < 1 || h.grid.bits > 30 || !(h.grid.range > 0.0f)) JsonFields::fail("quantisation", "bad grid (bits 1 to 30, a positive range)");
     h.simulation = config_from(j.object("simulation"));
-    h.calibration = j.contains("calibration") ? j.at("calibration") : ordered_json(nullptr);
+    // Written for the reader, derived from the rates on reading: a file whose tick disagrees with
+    // its rates (or lacks it) was not written by the recorder.
+    const double tick_s = j.get<double>("tick_s");
+    if (!(std::abs(tick_s - h.simulation.tick_s()) <= 1e-12 * h.simulation.tick_s())) {
+      JsonFields::fail("tick_s", exact_number(tick_s) + " disagrees with the rates (" + exact_number(h.simulation.tick_s()) + " s)");
+    }
+    if (!j.contains("calibration") || !j.at("calibration").is_object()) JsonFields::fail("calibration", "is missing (the device calibration, an object)");
+    h.calibration = j.at("calibration");
     return h;
   } catch (const std::exception& e) {
     return Error{"header: " + library_free(e.what())};

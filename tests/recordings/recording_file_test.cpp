@@ -321,6 +321,8 @@ namespace {
 SessionHeader sound_header() {
   SessionHeader header;
   header.format_version = kFormatVersion;
+  header.mode = "batch";
+  header.calibration = nlohmann::ordered_json::object();
   header.grid.bits = 11;
   header.grid.range = 0.1f;
   return header;
@@ -408,6 +410,26 @@ TEST(SessionHeaderJson, NamesTheFieldAtFault) {
   json = good;
   json["quantisation"] = 3;
   EXPECT_EQ(error_of(json), "header: quantisation: must be an object, not number");
+  // Fields the recorder always writes, missing or out of their sense, were taken for their defaults:
+  // a recording made with stiffness 100 replayed at 40 (audit 29, F7).
+  json = good;
+  json["simulation"]["parameters"].erase("stiffness");
+  EXPECT_EQ(error_of(json), "header: simulation.parameters.stiffness: is missing");
+  json = good;
+  json.erase("tick_s");
+  EXPECT_EQ(error_of(json), "header: tick_s: is missing");
+  json = good;
+  json["tick_s"] = 0.002;
+  EXPECT_NE(error_of(json).find("header: tick_s: 0.002 disagrees with the rates"), std::string::npos) << error_of(json);
+  json = good;
+  json.erase("calibration");
+  EXPECT_EQ(error_of(json), "header: calibration: is missing (the device calibration, an object)");
+  json = good;
+  json["mode"] = "xx";
+  EXPECT_EQ(error_of(json), "header: mode: \"xx\" (batch, realtime or console)");
+  json = good;
+  json["simulation"]["input_filter"]["min_cutoff_hz"] = -1;
+  EXPECT_EQ(error_of(json), "header: simulation.input_filter.min_cutoff_hz: must be a positive cut-off, not -1");
 }
 
 }  // namespace

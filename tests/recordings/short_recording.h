@@ -52,7 +52,8 @@ inline LiveRun record_short(const std::filesystem::path& path, std::uint64_t tic
   settings.steps_per_chunk = 2;
   SessionHeader description;
   description.procedure = "scripted";
-  description.mode = "test";
+  description.mode = "batch";
+  description.calibration = nlohmann::ordered_json::object();  // the device's, informational: none drove this run
   auto recorder = Recorder::start(path, description, **sim, settings);
   EXPECT_TRUE(recorder) << (recorder ? "" : recorder.error());
   live.commands = {{40, TissueParameter::kStiffness, 45.0}, {100, TissueParameter::kSpringDamping, 2.0}};
