@@ -114,8 +114,13 @@ void run(const RunOptions& o) {
   // --seconds shorter than one collision step at --collision-hz) are refused before the model is built.
   if (Status valid = options.simulation.validate(); !valid) refuse_command_line(valid.error());
   if (o.seconds > 0.0 && !options.simulation.holds_a_collision_step(o.seconds)) {
-    refuse_command_line("--seconds " + exact_number(o.seconds) + ": the run must last at least one collision step, " +
-                        exact_number(options.simulation.tick_s() * options.simulation.physics_per_collision) + " s");
+    // Seconds are rounded to whole ticks: the message gives the ticks too, so a --seconds a little
+    // under the step's length (0.0166 at 60 Hz, 16 ticks) is not mistaken for a bound broken.
+    char step[96];
+    std::snprintf(step, sizeof step, "%d ticks at %.6g Hz, %.6g s", options.simulation.physics_per_collision, 1.0 / options.simulation.tick_s(),
+                  options.simulation.tick_s() * options.simulation.physics_per_collision);
+    refuse_command_line("--seconds " + exact_number(o.seconds) + ": the run must last at least one collision step, " + step +
+                        " (--seconds is rounded to whole ticks)");
   }
   if (!o.calibration.empty()) {
     Result<device::Calibration> calibration = device::read_calibration(o.calibration);

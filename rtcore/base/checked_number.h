@@ -5,6 +5,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -44,6 +45,13 @@ inline std::optional<double> parse_finite(std::string_view text) {
   double value = 0.0;
   if (!text.empty() && text.front() == '+') text.remove_prefix(1);  // from_chars takes no '+'
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (!text.empty() && error == std::errc::result_out_of_range && end == text.data() + text.size()) {
+    // Past a double's range: a number too small for one (1e-400) is a number, its nearest double
+    // (zero or subnormal, as strtod gives it) for the range check to name; one too large is not finite.
+    const std::string whole(text);
+    value = std::strtod(whole.c_str(), nullptr);
+    return std::isfinite(value) ? std::optional<double>(value) : std::nullopt;
+  }
   if (text.empty() || error != std::errc{} || end != text.data() + text.size() || !std::isfinite(value)) return std::nullopt;
   return value;
 }

@@ -177,6 +177,12 @@ TEST(CheckedNumber, NanIsNeverInRangeAndValuesPrintExactly) {
   EXPECT_FALSE(parse_finite("1e309"));
   EXPECT_FALSE(parse_finite("1.5x"));
   EXPECT_EQ(parse_finite("+2.5").value(), 2.5);
+  // Too small for a double is still a number (audit 29, F12: it was called "not a finite number"):
+  // its nearest double, for the range check to name.
+  EXPECT_EQ(parse_finite("1e-400").value(), 0.0);
+  EXPECT_EQ(parse_finite("-1e-400").value(), 0.0);
+  EXPECT_GT(parse_finite("4e-320").value(), 0.0);  // subnormal
+  EXPECT_FALSE(parse_finite("-1e309"));
 }
 
 }  // namespace
