@@ -1,8 +1,6 @@
 // rec recover and rec export.
 #include "recordings/recover.h"
 
-#include <algorithm>
-#include <cctype>
 #include <cstdio>
 #include <string>
 #include <string_view>
@@ -84,9 +82,7 @@ Status export_keyframe(const Recording& recording, std::size_t k, const std::fil
   if (k >= recording.keyframes().size()) {
     return Error{recording.name() + ": keyframe " + std::to_string(k) + " does not exist (" + std::to_string(recording.keyframes().size()) + " recorded)"};
   }
-  std::string extension = out.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (extension == ".drc") return write_bytes_atomically(out, recording.keyframe_draco(k));
+  if (lower_extension(out) == ".drc") return write_bytes_atomically(out, recording.keyframe_draco(k));
   Result<SurfaceFrame> frame = recording.decode_keyframe(k);
   if (!frame) return Error{frame.error()};
   TriangleMesh mesh;

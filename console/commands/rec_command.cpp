@@ -1,7 +1,5 @@
 // `resecto rec info|verify|recover|export`: the recording tools (recordings/README.md has the file's
 // layout). Every one reads damaged and cut files: what is intact is used, what is not is named.
-#include <algorithm>
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -16,6 +14,7 @@
 #include "console/commands/command_registry.h"
 #include "recordings/recover.h"
 #include "rtcore/base/atomic_file.h"
+#include "rtcore/mesh/mesh_io.h"
 
 namespace resecto::cli {
 namespace {
@@ -191,10 +190,9 @@ void export_recording(const ExportOptions& o) {
   if (choices != 1) refuse_command_line("rec export: give exactly one of --keyframe N, --time S or --inputs");
   const std::filesystem::path input(o.file);
   if (Status ok = check_output_path(o.out, std::span(&input, 1)); !ok) throw std::runtime_error("rec export: " + ok.error());
-  std::string extension = std::filesystem::path(o.out).extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string extension = lower_extension(o.out);
   if (o.inputs && extension != ".csv") refuse_command_line("rec export --inputs: " + o.out + ": the inputs are written as CSV; name the file .csv");
-  if (!o.inputs && extension != ".drc" && extension != ".ply" && extension != ".obj" && extension != ".off" && extension != ".stl") {
+  if (!o.inputs && extension != ".drc" && !is_surface_mesh_extension(extension)) {
     refuse_command_line("rec export -o " + o.out + ": unknown surface format '" + extension + "' (use .drc, .ply, .obj, .off or .stl)");
   }
   const rec::Recording r = open_recording(o.file);

@@ -1,7 +1,6 @@
 // `resecto run`: the simulator. `--headless` drives the core through the emulated device with a
 // scripted procedure and writes the JSON report of DESIGN.md's contract.
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -20,6 +19,7 @@
 #include "console/live/interrupt.h"
 #include "rtcore/base/atomic_file.h"
 #include "rtcore/base/units.h"
+#include "rtcore/mesh/mesh_io.h"
 
 namespace resecto::cli {
 namespace {
@@ -77,9 +77,8 @@ void run(const RunOptions& o) {
   options.record_path = o.record;
   if (!o.export_surface.empty()) {
     // Checked before the run, so a typo does not cost the whole run.
-    std::string extension = std::filesystem::path(o.export_surface).extension().string();
-    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (extension != ".off" && extension != ".obj" && extension != ".ply" && extension != ".stl") {
+    const std::string extension = lower_extension(o.export_surface);
+    if (!is_surface_mesh_extension(extension)) {
       refuse_command_line("--export-surface " + o.export_surface + ": unknown format '" + extension + "' (use .off, .obj, .ply or .stl)");
     }
   }

@@ -68,7 +68,7 @@ std::vector<MetricRow> metric_rows() {
        "UroSim pass mark: at least 85% resected, i.e. at most 0.15 remaining (Soomro: faculty resection score 112 \u00b1 8.6 of 120, residents' first attempt 86.7 \u00b1 10.0)"},
       {"Resection rate", "g/min", real(&ScoreMetrics::grams_per_minute, 2), "Bright 2012 (TURPsim, median lobe): experts resected a greater percentage per minute than novices (p < 0.01)"},
       {"Grams per cut", "g",
-       [](const ScoreMetrics& m) { return m.cuts > 0 ? number(m.grams_per_cut, 3) : std::string("n/a (no cut)"); },
+       [](const ScoreMetrics& m) { return has_grams_per_cut(m) ? number(m.grams_per_cut, 3) : std::string("n/a (no cut)"); },
        "Sweet 2004 (UW trainer): experts resected more grams per cut (p = 0.002)"},
       {"Cuts", "strokes", count(&ScoreMetrics::cuts), ""},
       {"Chips", "", count(&ScoreMetrics::chips), ""},

@@ -56,9 +56,8 @@ bool is_count(const char* name) {
   return n == "cuts" || n == "chips" || n == "perforations" || n == "sphincter_zone_violations";
 }
 
-/// Whether a metric has a value: grams per cut has none without a cut (0 would read as cuts that
-/// removed nothing). JSON writes null, CSV an empty cell, the debrief "n/a".
-bool has_value(const ScoreMetrics& m, const char* name) { return m.cuts > 0 || std::string(name) != "grams_per_cut"; }
+/// Whether a metric has a value (only grams per cut can lack one).
+bool has_value(const ScoreMetrics& m, const char* name) { return has_grams_per_cut(m) || std::string(name) != "grams_per_cut"; }
 
 /// What a sound file (no damage left in it) lacks of the procedure it was recorded from, or empty: a
 /// recovery's left-out damaged ranges, unless the recorder's summary shows every tick and command it

@@ -22,7 +22,6 @@
 #include "rtcore/mesh/mesh_parse.h"
 
 namespace resecto {
-namespace {
 
 std::string lower_extension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
@@ -30,9 +29,11 @@ std::string lower_extension(const std::filesystem::path& path) {
   return ext;
 }
 
-bool is_supported_extension(const std::string& ext) {
-  return ext == ".off" || ext == ".obj" || ext == ".ply" || ext == ".stl";
+bool is_surface_mesh_extension(const std::string& extension) {
+  return extension == ".off" || extension == ".obj" || extension == ".ply" || extension == ".stl";
 }
+
+namespace {
 
 /// Double-precision points, so a written file carries the positions the generators computed.
 struct DoublePrecisionTraits : OpenMesh::DefaultTraits {
@@ -52,7 +53,7 @@ class QuietOpenMesh {
 Result<TriangleMesh> read_surface_mesh(const std::filesystem::path& path, double metres_per_unit) {
   const std::string name = path.string();
   const std::string ext = lower_extension(path);
-  if (!is_supported_extension(ext)) {
+  if (!is_surface_mesh_extension(ext)) {
     return Error{name + ": unsupported mesh format '" + ext + "' (expected .off, .obj, .ply or .stl)"};
   }
   Result<std::string> bytes = read_text_file(path, " the mesh", kMaxMeshFileBytes);
@@ -66,7 +67,7 @@ Result<TriangleMesh> read_surface_mesh(const std::filesystem::path& path, double
 Status write_surface_mesh(const std::filesystem::path& path, const TriangleMesh& mesh, double metres_per_unit) {
   const std::string name = path.string();
   const std::string ext = lower_extension(path);
-  if (!is_supported_extension(ext)) {
+  if (!is_surface_mesh_extension(ext)) {
     return Error{name + ": unsupported mesh format '" + ext + "' (expected .off, .obj, .ply or .stl)"};
   }
   PolyMesh out;

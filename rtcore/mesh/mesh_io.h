@@ -11,6 +11,11 @@ namespace resecto {
 
 inline constexpr double kMillimetreFile = 1e-3;  ///< metres per file unit for millimetre files
 
+/// A path's extension in lower case (".OFF" -> ".off"): formats are chosen by it.
+std::string lower_extension(const std::filesystem::path& path);
+/// Whether read_surface_mesh() and write_surface_mesh() take files with this (lower-case) extension.
+bool is_surface_mesh_extension(const std::string& extension);
+
 /// Reads a surface mesh: polygons are fan-triangulated in file order, faces keep file order.
 /// Only parsing errors fail here; call validate_closed_surface() for the topology checks.
 Result<TriangleMesh> read_surface_mesh(const std::filesystem::path& path,

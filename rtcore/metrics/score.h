@@ -49,7 +49,7 @@ struct ScoreMetrics {
   double resected_capsule_g = 0.0;
   double remaining_adenoma_fraction = 1.0;
   double grams_per_minute = 0.0;
-  double grams_per_cut = 0.0;           ///< 0 with no cut, where the reports write null (no value)
+  double grams_per_cut = 0.0;           ///< 0 with no cut, where it has no value (has_grams_per_cut)
   std::uint64_t cuts = 0;
   std::uint64_t chips = 0;
   std::uint64_t perforations = 0;
@@ -70,6 +70,10 @@ struct ScoreMetrics {
   static constexpr bool kBloodLossAvailable = false;
   static constexpr bool kIrrigantAvailable = false;
 };
+
+/// Whether grams per cut has a value: without a cut it has none (0 would read as cuts that removed
+/// nothing); the reports write null, the CSV an empty cell, the debrief "n/a".
+inline bool has_grams_per_cut(const ScoreMetrics& m) { return m.cuts > 0; }
 
 /// The whole score of one procedure: metrics, plots, heat map.
 struct ProcedureScore {
