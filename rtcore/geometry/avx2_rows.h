@@ -34,6 +34,17 @@ __attribute__((target("avx2"), always_inline)) inline __m256d load_point(const V
   return _mm256_maskload_pd(&p.x, _mm256_set_epi64x(0, -1, -1, -1));
 }
 
+/// A point's (x, y, z, 0) and back, with plain 16- and 8-byte moves. A masked store spans 32 bytes, so
+/// on AMD processors a load of the next point waits until it leaves the store buffer (no forwarding);
+/// a pass that reads and writes consecutive points, such as the node sums, stalls on every point.
+__attribute__((target("avx2"), always_inline)) inline __m256d load_xyz(const Vec3& p) {
+  return _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(&p.x)), _mm_load_sd(&p.z), 1);
+}
+__attribute__((target("avx2"), always_inline)) inline void store_xyz(Vec3& p, __m256d row) {
+  _mm_storeu_pd(&p.x, _mm256_castpd256_pd128(row));
+  _mm_store_sd(&p.z, _mm256_extractf128_pd(row, 1));
+}
+
 /// Four (x, y, z, _) rows as three columns: transpose4 without the fourth column's shuffle.
 __attribute__((target("avx2"), always_inline)) inline Points4 points_of(__m256d r0, __m256d r1, __m256d r2, __m256d r3) {
   const __m256d xz01 = _mm256_unpacklo_pd(r0, r1), y01 = _mm256_unpackhi_pd(r0, r1);

@@ -119,13 +119,12 @@ namespace {
 
 __attribute__((target("avx2"), always_inline)) inline void add_node_sum_avx2(const SpringIncidence& incidence, const SpringForce* f, Vec3* force,
                                                                              std::size_t n) {
-  const __m256i xyz = _mm256_set_epi64x(0, -1, -1, -1);
-  __m256d sum = _mm256_maskload_pd(&force[n].x, xyz);
+  __m256d sum = avx2::load_xyz(force[n]);
   for (std::uint32_t e = incidence.second_first[n]; e < incidence.second_first[n + 1]; ++e) {
     sum = _mm256_sub_pd(sum, _mm256_load_pd(&f[incidence.second_springs[e]].x));
   }
   for (std::uint32_t s = incidence.first_first[n]; s < incidence.first_first[n + 1]; ++s) sum = _mm256_add_pd(sum, _mm256_load_pd(&f[s].x));
-  _mm256_maskstore_pd(&force[n].x, xyz, sum);
+  avx2::store_xyz(force[n], sum);
 }
 
 struct SubtractRow {
@@ -157,21 +156,20 @@ __attribute__((target("avx2"))) void add_spring_sums_avx2(const SpringIncidence&
   // on its list's length; node by node, the pass waited on that latency and mispredicted the ends.
   // A group runs its four nodes' chains side by side over lists padded to one length, each chain in
   // its node's own order, so every sum keeps its bits.
-  const __m256i xyz = _mm256_set_epi64x(0, -1, -1, -1);
   std::size_t n = begin;
   for (; n < end && n % kSpringSumGroup != 0; ++n) add_node_sum_avx2(incidence, f, force, n);
   const std::size_t groups_end = std::min(end, incidence.group_second_first.empty() ? 0 : (incidence.group_second_first.size() - 1) * kSpringSumGroup);
   for (; n + kSpringSumGroup <= groups_end; n += kSpringSumGroup) {
     const std::size_t g = n / kSpringSumGroup;
-    __m256d s0 = _mm256_maskload_pd(&force[n].x, xyz), s1 = _mm256_maskload_pd(&force[n + 1].x, xyz);
-    __m256d s2 = _mm256_maskload_pd(&force[n + 2].x, xyz), s3 = _mm256_maskload_pd(&force[n + 3].x, xyz);
+    __m256d s0 = avx2::load_xyz(force[n]), s1 = avx2::load_xyz(force[n + 1]);
+    __m256d s2 = avx2::load_xyz(force[n + 2]), s3 = avx2::load_xyz(force[n + 3]);
     // Every node's springs as node j first (subtracted), then as node i (added), as the portable pass.
     add_group_rows(f, incidence.group_second.data(), incidence.group_second_first[g], incidence.group_second_first[g + 1], SubtractRow{}, s0, s1, s2, s3);
     add_group_rows(f, incidence.group_first.data(), incidence.group_first_first[g], incidence.group_first_first[g + 1], AddRow{}, s0, s1, s2, s3);
-    _mm256_maskstore_pd(&force[n].x, xyz, s0);
-    _mm256_maskstore_pd(&force[n + 1].x, xyz, s1);
-    _mm256_maskstore_pd(&force[n + 2].x, xyz, s2);
-    _mm256_maskstore_pd(&force[n + 3].x, xyz, s3);
+    avx2::store_xyz(force[n], s0);
+    avx2::store_xyz(force[n + 1], s1);
+    avx2::store_xyz(force[n + 2], s2);
+    avx2::store_xyz(force[n + 3], s3);
   }
   for (; n < end; ++n) add_node_sum_avx2(incidence, f, force, n);
 }
