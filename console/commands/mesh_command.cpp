@@ -64,6 +64,15 @@ SurfaceReport validated(const TriangleMesh& mesh, const std::string& what) {
   return *report;
 }
 
+/// An output named with a format this command does not write is a usage error (exit 2), refused
+/// before any work; the extension's case does not matter (.OFF is .off).
+void require_output_extension(const std::string& output, bool surface) {
+  const std::string extension = lower_extension(output);
+  if (surface ? !is_surface_mesh_extension(extension) : extension != ".vtk") {
+    refuse_command_line("-o " + output + ": unknown format '" + extension + "' (" + (surface ? "use .off, .obj, .ply or .stl" : "the tetrahedra are written as legacy VTK: use .vtk") + ")");
+  }
+}
+
 void write_or_fail(const std::filesystem::path& path, const TriangleMesh& mesh) {
   if (Status written = write_surface_mesh(path, mesh); !written) fail(written.error());
 }
@@ -79,6 +88,7 @@ void register_prostate(CLI::App& mesh) {
       ->transform(whole_in_range(200, 5'000'000))->capture_default_str();
   cmd->add_option("-o,--output", options->output, "Mesh file (.off, .obj, .ply, .stl), millimetres")->required();
   cmd->callback([options] {
+    require_output_extension(options->output, true);
     const ProstateModel model = generate_prostate(options->triangles);
     const SurfaceReport report = validated(model.surface, "generated prostate");
     write_or_fail(options->output, model.surface);
@@ -108,6 +118,7 @@ void register_resectoscope(CLI::App& mesh) {
       ->check(finite_range(0.0, 36.0))->capture_default_str();
   cmd->add_option("-o,--output", options->output, "Mesh file (.off, .obj, .ply, .stl), millimetres")->required();
   cmd->callback([options] {
+    require_output_extension(options->output, true);
     ResectoscopeShape shape;
     shape.loop_travel_m = units::mm_to_m(options->loop_travel_mm);
     const ResectoscopeModel model = generate_resectoscope(shape);
@@ -159,7 +170,7 @@ void register_tetra(CLI::App& mesh) {
       ->check(finite_range(0.0, 1e9))->capture_default_str();
   cmd->add_option("--capsule", options->capsule_mm, "Capsule shell thickness, mm")->check(finite_range(0.0, 20.0))->capture_default_str();
   cmd->callback([options, radius_edge, min_dihedral] {
-    if (std::filesystem::path(options->output).extension() != ".vtk") fail(options->output + ": the output must be a .vtk file");
+    require_output_extension(options->output, false);
     Result<TriangleMesh> surface = read_surface_mesh(options->input);
     if (!surface) fail(surface.error());
     const SurfaceReport report = validated(*surface, options->input);

@@ -28,15 +28,16 @@ class TextLines {
  public:
   TextLines(std::string_view text, const std::string& name) : text_(text), name_(name) {}
 
-  /// The next line without its end of line; false at the end of the text.
+  /// The next line without its end of line; false at the end of the text. A line ends at "\n",
+  /// "\r\n" or a lone "\r" (classic Mac OS exporters still write those).
   bool next(std::string_view& line) {
     if (offset_ >= text_.size()) return false;
-    const std::size_t end = text_.find('\n', offset_);
+    const std::size_t end = text_.find_first_of("\r\n", offset_);
     const std::size_t stop = end == std::string_view::npos ? text_.size() : end;
     line = text_.substr(offset_, stop - offset_);
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     line_start_ = offset_;
-    offset_ = end == std::string_view::npos ? text_.size() : end + 1;
+    const bool crlf = end != std::string_view::npos && text_[end] == '\r' && end + 1 < text_.size() && text_[end + 1] == '\n';
+    offset_ = end == std::string_view::npos ? text_.size() : end + (crlf ? 2 : 1);
     ++number_;
     return true;
   }
@@ -434,8 +435,8 @@ class PlyBody {
   /// the error named some later face instead of this row.
   Status expect_row_end(const std::string& row, std::size_t properties) {
     if (!ascii()) return Ok{};
-    while (offset_ < body_.size() && (body_[offset_] == ' ' || body_[offset_] == '\t' || body_[offset_] == '\r')) ++offset_;
-    if (offset_ >= body_.size() || body_[offset_] == '\n') return Ok{};
+    while (offset_ < body_.size() && (body_[offset_] == ' ' || body_[offset_] == '\t')) ++offset_;
+    if (offset_ >= body_.size() || body_[offset_] == '\n' || body_[offset_] == '\r') return Ok{};  // "\n", "\r\n" or a lone "\r"
     std::size_t end = offset_;
     while (end < body_.size() && !is_space(body_[end])) ++end;
     return Error{name_ + ": byte " + std::to_string(body_offset_ + offset_) + ": " + row + " has a value past its " + std::to_string(properties) +

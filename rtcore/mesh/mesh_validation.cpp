@@ -3,6 +3,7 @@
 #include "rtcore/mesh/mesh_validation.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -95,6 +96,18 @@ Status check_faces(const TriangleMesh& mesh, const ValidationOptions& options) {
   return Ok{};
 }
 
+/// How many vertices stand exactly where an earlier one does (a "triangle soup": every face with its
+/// own corners, as some exporters write OFF, OBJ and PLY). Only on the error path: a sort.
+std::size_t coincident_vertices(const TriangleMesh& mesh) {
+  std::vector<std::array<double, 3>> points;
+  points.reserve(mesh.vertex_count());
+  for (const Vec3& p : mesh.positions) points.push_back({p.x, p.y, p.z});
+  std::sort(points.begin(), points.end());
+  std::size_t repeats = 0;
+  for (std::size_t i = 1; i < points.size(); ++i) repeats += points[i] == points[i - 1] ? 1 : 0;
+  return repeats;
+}
+
 /// Every undirected edge must be used by exactly two faces walking it in opposite directions.
 Status check_edges(const TriangleMesh& mesh, std::vector<EdgeUse>& uses) {
   uses.clear();
@@ -135,7 +148,13 @@ Status check_edges(const TriangleMesh& mesh, std::vector<EdgeUse>& uses) {
     }
     i = j;
   }
-  if (!error.empty()) return Error{error};
+  if (!error.empty()) {
+    if (const std::size_t repeats = coincident_vertices(mesh); repeats > 0 && error.starts_with("open surface")) {
+      error += "; " + std::to_string(repeats) + " vertices repeat the coordinates of another, so faces that meet there are not joined " +
+               "(a triangle soup): merge coincident vertices (MeshLab: Remove Duplicate Vertices) or save it as STL, whose corners resecto merges";
+    }
+    return Error{error};
+  }
   return Ok{};
 }
 

@@ -57,6 +57,17 @@ TEST(MeshCommand, TetraReportsVolumesAndAngles) {
   const CommandOutput bounded = run_resecto("mesh tetra " + (dir / "p.ply").string() + " --max-volume 0.5 -o " + (dir / "q.vtk").string());
   ASSERT_EQ(bounded.exit_code, 0) << bounded.err;
   EXPECT_NE(bounded.err.find("above --max-volume 0.5"), std::string::npos) << bounded.err;
+
+  // Extensions in any case, as every reader takes them; another format is a usage error (exit 2)
+  // before any work, for every mesh output alike (audit 30, F8).
+  EXPECT_EQ(run_resecto("mesh tetra " + (dir / "p.ply").string() + " -o " + (dir / "P.VTK").string()).exit_code, 0);
+  for (const std::string& command : {"mesh tetra " + (dir / "p.ply").string() + " -o " + (dir / "p.vtu").string(),
+                                     "mesh prostate -o " + (dir / "p.vtk").string(), "mesh resectoscope -o " + (dir / "r.vtk").string()}) {
+    const CommandOutput refused = run_resecto(command);
+    EXPECT_EQ(refused.exit_code, 2) << command;
+    EXPECT_NE(refused.err.find(": unknown format '"), std::string::npos) << refused.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "p.vtu"));
 }
 
 TEST(MeshCommand, BrokenFileFailsWithOneLineNamingTheFace) {

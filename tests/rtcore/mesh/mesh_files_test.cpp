@@ -63,10 +63,20 @@ TEST(MeshFiles, ReadsAValidCubeInEveryFormat) {
     stl += "endloop\nendfacet\n";
   }
   stl += "endsolid cube\n";
-  for (const auto& [name, text] : {std::pair{"cube.off", cube_off()}, std::pair{"cube.obj", obj}, std::pair{"cube.ply", ply},
-                                   std::pair{"cube.stl", stl}}) {
-    SCOPED_TRACE(name);
-    Result<TriangleMesh> mesh = read_surface_mesh(write_file(name, text));
+  // Each with its lines ended by LF, CR LF and a lone CR (classic Mac OS exporters; audit 30, F6).
+  const auto line_ends = [](std::string text, const std::string& end) {
+    std::string out;
+    for (char c : text) {
+      if (c == '\n') out.append(end);
+      else out.push_back(c);
+    }
+    return out;
+  };
+  for (const auto& [name, lf] : {std::pair{"cube.off", cube_off()}, std::pair{"cube.obj", obj}, std::pair{"cube.ply", ply},
+                                 std::pair{"cube.stl", stl}})
+  for (const std::string end : {"\n", "\r\n", "\r"}) {
+    SCOPED_TRACE(std::string(name) + (end == "\n" ? " LF" : end == "\r" ? " CR" : " CR LF"));
+    Result<TriangleMesh> mesh = read_surface_mesh(write_file(name, line_ends(lf, end)));
     ASSERT_TRUE(mesh) << mesh.error();
     EXPECT_EQ(mesh->triangle_count(), 12u);
     Result<SurfaceReport> report = validate_closed_surface(*mesh);
@@ -148,6 +158,23 @@ TEST(MeshFiles, OpenSurfaceNamesTheEdgeAndFace) {
   EXPECT_NE(error.find("open surface"), std::string::npos) << error;
   // Face 5 (0, 5, 4) is missing; of its neighbours, face 2 across (4, 5) comes first in the file.
   EXPECT_NE(error.find("edge (4, 5) of face 2"), std::string::npos) << error;
+}
+
+// A "triangle soup" (every face with its own three corners, as some exporters write OFF, OBJ and PLY)
+// reads as a surface of loose faces: the open-surface error says why and what to do (audit 30, F9).
+TEST(MeshFiles, ATriangleSoupIsNamedAsOne) {
+  const char* corner[8] = {"0 0 0", "1 0 0", "1 1 0", "0 1 0", "0 0 1", "1 0 1", "1 1 1", "0 1 1"};
+  std::string soup = "OFF\n36 12 0\n", faces;
+  for (int f = 0; f < 12; ++f) {
+    for (int c = 0; c < 3; ++c) soup += std::string(corner[kCubeFaces[f][c]]) + "\n";
+    faces += "3 " + std::to_string(3 * f) + " " + std::to_string(3 * f + 1) + " " + std::to_string(3 * f + 2) + "\n";
+  }
+  const std::string error = validation_error(write_file("soup.off", soup + faces));
+  EXPECT_NE(error.find("open surface"), std::string::npos) << error;
+  EXPECT_NE(error.find("; 28 vertices repeat the coordinates of another"), std::string::npos) << error;
+  EXPECT_NE(error.find("(a triangle soup): merge coincident vertices"), std::string::npos) << error;
+  // An open surface without repeated corners says nothing of soups.
+  EXPECT_EQ(validation_error(write_file("open_cube.off", cube_off(5))).find("soup"), std::string::npos);
 }
 
 TEST(MeshFiles, FlippedFaceIsInconsistentOrientation) {
