@@ -79,7 +79,12 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
       case ChunkType::kKeyframe: {
         Result<KeyframeRecord> k = decode_keyframe_payload(payload);
         if (!k) {
-          r.content_errors_.push_back(where + ": " + k.error());
+          r.keyframe_record_errors_.push_back(where + ": " + k.error());
+          break;
+        }
+        if (have_header && (k->vertex_count > most_nodes(r.header_.simulation) || k->triangle_count > most_surface_triangles(r.header_.simulation))) {
+          r.keyframe_record_errors_.push_back(where + ": a keyframe of " + std::to_string(k->vertex_count) + " vertices and " + std::to_string(k->triangle_count) +
+                                      " triangles, more than a gland of " + std::to_string(r.header_.simulation.prostate_triangles) + " triangles holds");
           break;
         }
         r.keyframes_.push_back({k->tick, 0.0, k->topology_version, k->topology_changed, k->has_node_ids, k->vertex_count, k->triangle_count,
@@ -264,7 +269,19 @@ Result<SurfaceFrame> Recording::decode_keyframe(std::size_t k) const {
                  std::to_string(keyframes_[k].triangle_count)};
   }
   if (frame->node_ids.empty()) return Error{keyframe_place(k) + ": carries no node ids"};
+  const std::size_t most = most_nodes(header_.simulation);
+  for (std::uint32_t id : frame->node_ids) {
+    if (id >= most) return Error{keyframe_place(k) + ": node id " + std::to_string(id) + " is past the most a gland of this size holds (" + std::to_string(most) + ")"};
+  }
   return frame;
+}
+
+std::vector<std::string> Recording::keyframe_problems() const {
+  std::vector<std::string> problems = keyframe_record_errors_;
+  for (std::size_t k = 0; k < keyframes_.size(); ++k) {
+    if (Result<SurfaceFrame> frame = decode_keyframe(k); !frame) problems.push_back(frame.error());
+  }
+  return problems;
 }
 
 namespace {

@@ -60,8 +60,13 @@ class Recording {
   /// one was never closed (the run was killed), though it may replay up to where it stops.
   const ChunkLocation* index_chunk() const;
   bool closed() const { return index_present() || index_chunk() != nullptr; }
-  /// Chunks whose CRCs held but whose content did not decode (should never happen; counted).
+  /// Chunks whose CRCs held but whose content did not decode (should never happen; counted). Keyframe
+  /// chunks are not among them: keyframe_problems() has those.
   std::span<const std::string> content_errors() const { return content_errors_; }
+  /// Why each keyframe chunk whose CRC held is unusable: its record does not decode, claims more than
+  /// the gland holds, or its Draco mesh does not decode (every keyframe is decoded: this takes a while).
+  /// Keyframes are pictures: the ticks, commands and hashes replay and score without them.
+  std::vector<std::string> keyframe_problems() const;
 
   /// Every tick recorded, sorted by tick (gaps where chunks were lost).
   std::span<const TickRecord> ticks() const { return ticks_; }
@@ -129,6 +134,7 @@ class Recording {
   std::uint64_t keyframe_period_ticks_ = 0, first_keyframe_slot_ = 0;
   nlohmann::ordered_json summary_;
   std::vector<std::string> content_errors_;
+  std::vector<std::string> keyframe_record_errors_;  ///< keyframe chunks whose record did not decode
 };
 
 }  // namespace resecto::rec

@@ -8,6 +8,7 @@
 #include "recordings/byte_io.h"
 #include "recordings/recording_writer.h"
 #include "rtcore/base/atomic_file.h"
+#include "rtcore/base/units.h"
 #include "rtcore/mesh/mesh_io.h"
 
 namespace resecto::rec {
@@ -92,14 +93,18 @@ Status export_keyframe(const Recording& recording, std::size_t k, const std::fil
 }
 
 Status export_inputs_csv(const Recording& recording, const std::filesystem::path& out) {
-  std::string text = "tick,time_s,yaw_rad,pitch_rad,roll_rad,insertion_m,loop_travel_m,cut,coagulate,tool_present\n";
+  // The edges' units (DESIGN.md): degrees and millimetres, in a procedure file's column order and
+  // names, so a recorded hand can be read beside (or turned into) a procedure. 17 digits: a double's
+  // every bit of the converted value.
+  std::string text = "tick,time_s,yaw_deg,pitch_deg,roll_deg,insertion_mm,loop_mm,cut,coagulate,tool_present\n";
   const double tick_s = recording.header().simulation.tick_s();
   char line[512];
   for (const TickRecord& t : recording.ticks()) {
     const DeviceJoints& j = t.input.joints;
     std::snprintf(line, sizeof line, "%llu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%d,%d,%d\n", static_cast<unsigned long long>(t.tick),
-                  static_cast<double>(t.tick) * tick_s, j.yaw_rad, j.pitch_rad, j.roll_rad, j.insertion_m, j.loop_travel_m, t.input.cut ? 1 : 0,
-                  t.input.coagulate ? 1 : 0, t.input.tool_present ? 1 : 0);
+                  static_cast<double>(t.tick) * tick_s, units::rad_to_deg(j.yaw_rad), units::rad_to_deg(j.pitch_rad), units::rad_to_deg(j.roll_rad),
+                  units::m_to_mm(j.insertion_m), units::m_to_mm(j.loop_travel_m), t.input.cut ? 1 : 0, t.input.coagulate ? 1 : 0,
+                  t.input.tool_present ? 1 : 0);
     text += line;
   }
   return write_file_atomically(out, text);

@@ -15,6 +15,15 @@ Result<std::unique_ptr<Replayer>> Replayer::create(const Recording& recording) {
   }
   Result<std::unique_ptr<Simulation>> sim = Simulation::create(recording.header().simulation);
   if (!sim) return Error{"replay: " + sim.error()};
+  // The header's counts describe the model its settings build; a file that claims others was not
+  // written by a recorder of this build (or was edited), and its hashes could not match anyway.
+  const SessionHeader& header = recording.header();
+  const std::size_t nodes = (*sim)->tissue().node_count(), triangles = (*sim)->prostate().surface.triangle_count();
+  if (header.nodes != nodes || header.surface_triangles != triangles) {
+    return Error{"replay: " + recording.name() + "'s header says " + std::to_string(header.nodes) + " nodes and " +
+                 std::to_string(header.surface_triangles) + " surface triangles, but the model its simulation settings build has " +
+                 std::to_string(nodes) + " and " + std::to_string(triangles) + ": the header was edited or written by another build"};
+  }
   std::unique_ptr<Replayer> replayer(new Replayer(recording));
   replayer->sim_ = std::move(*sim);
   replayer->end_tick_ = recording.replayable_ticks();

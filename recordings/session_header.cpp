@@ -2,6 +2,7 @@
 // config without a line here shows up as a replay mismatch in the end-to-end test, never silently.
 #include "recordings/session_header.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -125,6 +126,16 @@ SimulationConfig config_from(const JsonFields& j) {
 
 }  // namespace
 
+std::size_t most_nodes(const SimulationConfig& config) {
+  // The gland has about 0.86 nodes per surface triangle, and the core reserves room for three times
+  // its nodes (or 40,000): eight a triangle is ample.
+  return std::max<std::size_t>(40000, 8 * static_cast<std::size_t>(std::max(0, config.prostate_triangles)));
+}
+
+std::size_t most_surface_triangles(const SimulationConfig& config) {
+  return std::max<std::size_t>(160000, 16 * static_cast<std::size_t>(std::max(0, config.prostate_triangles)));
+}
+
 std::string build_identity() {
   std::string id = "resecto " RESECTO_VERSION_STRING;
 #if defined(__clang__)
@@ -178,12 +189,21 @@ Result<SessionHeader> header_from_json(std::string_view text) {
     h.keyframe_every_steps = j.get<int>("keyframe_every_steps");
     if (h.keyframe_every_steps < 1) JsonFields::fail("keyframe_every_steps", "must be at least 1");
     const JsonFields q = j.object("quantisation");
+    h.simulation = config_from(j.object("simulation"));
+    if (h.nodes > most_nodes(h.simulation)) {
+      JsonFields::fail("nodes", std::to_string(h.nodes) + " is more than a gland of " + std::to_string(h.simulation.prostate_triangles) +
+                                    " triangles holds (at most " + std::to_string(most_nodes(h.simulation)) + ")");
+    }
+    if (h.surface_triangles > most_surface_triangles(h.simulation)) {
+      JsonFields::fail("surface_triangles", std::to_string(h.surface_triangles) + " is more than a gland of " +
+                                                std::to_string(h.simulation.prostate_triangles) + " triangles holds (at most " +
+                                                std::to_string(most_surface_triangles(h.simulation)) + ")");
+    }
     const std::array<double, 3> origin = q.numbers<3>("origin_m");
     for (std::size_t i = 0; i < 3; ++i) h.grid.origin[i] = static_cast<float>(origin[i]);
     h.grid.range = q.get<float>("range_m");
     h.grid.bits = q.get<int>("bits");
     if (h.grid.bits < 1 || h.grid.bits > 30 || !(h.grid.range > 0.0f)) JsonFields::fail("quantisation", "bad grid (bits 1 to 30, a positive range)");
-    h.simulation = config_from(j.object("simulation"));
     // Written for the reader, derived from the rates on reading: a file whose tick disagrees with
     // its rates (or lacks it) was not written by the recorder.
     const double tick_s = j.get<double>("tick_s");

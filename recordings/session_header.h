@@ -34,6 +34,13 @@ struct SessionHeader {
   std::uint32_t metric_words = 0;       ///< 8-byte fields of ProcedureMetrics recorded per step
 };
 
+/// The most mesh nodes and surface triangles any keyframe of a recording with these settings can hold:
+/// well past what the core's reserved room for refinement allows. A reader sizes nothing by a count
+/// the file claims beyond these (a header or keyframe claiming a billion nodes is refused, not
+/// allocated).
+std::size_t most_nodes(const SimulationConfig& config);
+std::size_t most_surface_triangles(const SimulationConfig& config);
+
 /// This build's identity string.
 std::string build_identity();
 

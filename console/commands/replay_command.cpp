@@ -85,6 +85,15 @@ void replay(const ReplayOptions& o) {
   // --verify vouches for the whole recording: hashes it could not compare (damaged, left out by a
   // recovery, past where the inputs end) fail it, though every one compared matched.
   if (o.verify && !unverified.empty()) throw std::runtime_error(unverified);
+  // The keyframes take no part in the re-simulation, but --verify vouches for the file: a keyframe
+  // that does not decode (the console's timeline and `rec export` would fail on it) fails it.
+  if (o.verify) {
+    const std::vector<std::string> keyframes = recording->keyframe_problems();
+    if (!keyframes.empty()) {
+      throw std::runtime_error(keyframes.front() + " (" + std::to_string(keyframes.size()) +
+                               " unusable keyframes; every hash compared matched; `resecto rec verify` names them)");
+    }
+  }
 }
 
 void register_replay(CLI::App& app) {

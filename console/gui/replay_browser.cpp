@@ -22,12 +22,17 @@ Status ReplayBrowser::open(const std::filesystem::path& path) {
   Result<rec::Recording> opened = rec::Recording::open(path);
   if (!opened) return Error{opened.error()};  // it names the file
   if (opened->keyframes().empty()) return Error{path.string() + ": the recording holds no keyframe to show"};
+  const SimulationConfig& config = opened->header().simulation;
+  ProstateModel prostate = generate_prostate(config.prostate_triangles);
+  if (opened->header().surface_triangles != prostate.surface.triangle_count()) {
+    return Error{path.string() + ": the header says " + std::to_string(opened->header().surface_triangles) + " surface triangles, the gland its settings build has " +
+                 std::to_string(prostate.surface.triangle_count()) + ": the header was edited or written by another build"};
+  }
   close();
   recording_ = std::make_unique<rec::Recording>(std::move(*opened));
   path_ = path.string();
-  const SimulationConfig& config = recording_->header().simulation;
-  tick_s_ = config.tick_s();
-  prostate_ = generate_prostate(config.prostate_triangles);
+  tick_s_ = recording_->header().simulation.tick_s();  // `config` went with *opened
+  prostate_ = std::move(prostate);
   // Sized once for the largest node id and surface any keyframe can hold.
   snapshot_ = SimulationSnapshot{};
   std::uint32_t max_triangles = recording_->header().surface_triangles;
@@ -122,6 +127,8 @@ void ReplayBrowser::start_verification() {
       result.mismatches = r.mismatches();
       result.first_mismatch_tick = r.first_mismatch_tick();
       result.unverified = rec::unverified_hashes(*recording, r);
+      // As `replay --verify` says it: a file with no hash to compare vouches for nothing.
+      if (result.verified == 0 && result.mismatches == 0) result.error = recording->name() + ": no collision step's hash could be verified";
     }
     result.done = true;
     verification_ = std::move(result);

@@ -102,12 +102,6 @@ ordered_json metrics_json(const ProcedureMetrics& m) {
           {"topology_refusals", m.topology_refusals}};
 }
 
-std::string hex_hash(std::uint64_t hash) {
-  char text[17];
-  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
-  return text;
-}
-
 Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   SimulationConfig simulation = options.simulation;
   simulation.gimbal = gimbal_geometry_from(options.calibration);

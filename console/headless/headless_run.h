@@ -12,6 +12,7 @@
 
 #include "device/calibration/calibration.h"
 #include "rtcore/base/result.h"
+#include "rtcore/base/state_hash.h"
 #include "rtcore/core/fixed_step_scheduler.h"
 #include "rtcore/core/simulation.h"
 #include "rtcore/scenes/procedure.h"
@@ -55,8 +56,5 @@ std::string summarize_report(const nlohmann::ordered_json& report);
 
 /// The procedure's metrics as the reports write them (`metrics` in the headless and console reports).
 nlohmann::ordered_json metrics_json(const ProcedureMetrics& metrics);
-
-/// 16 lower-case hex digits.
-std::string hex_hash(std::uint64_t hash);
 
 }  // namespace resecto

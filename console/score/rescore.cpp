@@ -8,6 +8,7 @@
 #include <string>
 
 #include "recordings/replay.h"
+#include "rtcore/base/state_hash.h"
 
 namespace resecto {
 namespace {
@@ -75,7 +76,11 @@ std::string lost_part_of_procedure(const rec::Recording& recording) {
   // Cut between two chunks, a file looks whole up to its end; only the recorder's summary, written
   // when it closes the file, says the procedure ended there.
   if (dropped == 0) {
-    if (ticks) return {};
+    if (ticks && holds_every_tick_and_command(recording)) return {};
+    if (ticks) {  // closed, yet chunks are gone: removed by hand, or copied without them
+      return "it holds " + std::to_string(recording.ticks().size()) + " of the " + std::to_string(*ticks) + " ticks and " +
+             std::to_string(recording.commands().size()) + " of the " + std::to_string(commands.value_or(0)) + " commands its recorder wrote";
+    }
     return "the recorder never closed it (the run was killed or the file cut after " + std::to_string(recording.ticks().size()) +
            " ticks), so how much of the procedure it lacks is unknown";
   }
@@ -156,6 +161,11 @@ Result<RecordingScore> score_recording(const std::filesystem::path& path, const 
     note = name + ": " + damaged + ", but every tick and command the recorder wrote is intact: scored";
   }
   if (!recording->content_errors().empty()) return Error{name + ": " + recording->content_errors().front()};
+  // Keyframes are the debrief's pictures, not its figures: a file whose only fault is there scores.
+  if (const std::vector<std::string> keyframes = recording->keyframe_problems(); !keyframes.empty()) {
+    const std::string fault = std::to_string(keyframes.size()) + " unusable keyframes (the first: " + keyframes.front() + ")";
+    note = note.empty() ? name + ": " + fault + ", but every tick and command the recorder wrote is intact: scored" : note + "; " + fault;
+  }
   if (std::string lost = lost_part_of_procedure(*recording); !lost.empty())
     return Error{name + ": " + lost + "; a score from part of a procedure would mislead"};
   if (recording->replayable_ticks() == 0) return Error{name + ": no recorded input to replay"};
@@ -183,7 +193,7 @@ Result<RecordingScore> score_recording(const std::filesystem::path& path, const 
   replayer.run_to(end);
   if (replayer.mismatches() > 0) {
     return Error{name + ": re-simulation differs from the recording first at tick " + std::to_string(*replayer.first_mismatch_tick()) +
-                 " (recorded hash " + std::to_string(replayer.first_mismatch_recorded()) + "); recorded by a different build?"};
+                 " (recorded hash " + hex_hash(replayer.first_mismatch_recorded()) + ", re-simulated " + hex_hash(replayer.first_mismatch_replayed()) + "); recorded by a different build?"};
   }
   if (progress) progress(end, end);
   replayer.settle();

@@ -13,6 +13,7 @@
 #include "rtcore/base/atomic_file.h"
 #include "rtcore/base/checked_number.h"
 #include "rtcore/base/json_text.h"
+#include "rtcore/geometry/rigid_pose.h"
 #include "rtcore/base/text_file.h"
 
 namespace resecto::device {
@@ -188,19 +189,11 @@ Result<Calibration> parse_calibration(const std::string& text, const std::string
     }
   }
   if (!in.ok()) return Error{in.error()};
-  // R^T R = I and det R = +1, to 1e-6: a registration must be a rotation, not a scale or mirror.
-  double worst = 0.0;
-  for (unsigned i = 0; i < 3; ++i) {
-    for (unsigned j = 0; j < 3; ++j) {
-      double dot = 0.0;
-      for (unsigned k = 0; k < 3; ++k) dot += c.rotation[k][i] * c.rotation[k][j];
-      worst = std::max(worst, std::abs(dot - (i == j ? 1.0 : 0.0)));
-    }
+  glm::dmat3 matrix;  // glm is column-major: matrix[column][row]
+  for (unsigned r = 0; r < 3; ++r) {
+    for (unsigned k = 0; k < 3; ++k) matrix[k][r] = c.rotation[r][k];
   }
-  const auto& m = c.rotation;
-  const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                     m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-  if (worst > 1e-6 || det < 0.0) return Error{source + ": registration.rotation: not a proper rotation (orthonormal, det +1)"};
+  if (!is_proper_rotation(matrix)) return Error{source + ": registration.rotation: not a proper rotation (orthonormal, det +1)"};
   const auto board = to_board(c);
   if (!board) return Error{source + ": " + board.error()};
   return c;

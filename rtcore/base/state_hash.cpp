@@ -5,7 +5,15 @@
 // The length is mixed in last so spans that differ only in trailing zero bytes still differ.
 #include "rtcore/base/state_hash.h"
 
+#include <cstdio>
+
 namespace resecto {
+
+std::string hex_hash(std::uint64_t hash) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
+  return text;
+}
 
 void StateHasher::add_bytes(const void* data, std::size_t size) {
   constexpr std::uint64_t kPrime = 0x100000001b3ull;

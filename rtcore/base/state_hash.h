@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstring>
 #include <span>
+#include <string>
 
 namespace resecto {
 
@@ -24,5 +25,8 @@ class StateHasher {
  private:
   std::uint64_t hash_ = 0xcbf29ce484222325ull;
 };
+
+/// A state hash as every output writes it: sixteen lower-case hex digits.
+std::string hex_hash(std::uint64_t hash);
 
 }  // namespace resecto

@@ -57,6 +57,25 @@ Vec3 loop_front_point(const TriangleMesh& loop) {
 
 }  // namespace
 
+namespace {
+
+// The registration places the device in the world: a rotation (orthonormal, not a reflection) and a
+// pivot and translation within a metre of the origin (the device sits beside the patient). A header
+// with a zero matrix or a pivot at 1e300 m would otherwise replay as a different run, or as NaN.
+Status validate_gimbal(const GimbalGeometry& gimbal) {
+  const RigidPose& pose = gimbal.device_to_world;
+  constexpr double kFarthestM = 1.0;
+  auto within_reach = [](const Vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && glm::length(p) <= kFarthestM; };
+  if (!within_reach(gimbal.pivot_m)) return Error{"gimbal pivot is not a finite point within 1 m of the device's origin"};
+  if (!within_reach(pose.translation)) return Error{"device-to-world translation is not a finite offset within 1 m"};
+  if (!is_proper_rotation(pose.rotation)) {
+    return Error{"device-to-world rotation is not a rotation (orthonormal, determinant +1)"};
+  }
+  return Ok{};
+}
+
+}  // namespace
+
 Status SimulationConfig::validate() const {
   if (collision_hz < 10 || collision_hz > 1000) return Error{"collision rate " + std::to_string(collision_hz) + " Hz is outside [10, 1000]"};
   if (physics_per_collision < 1 || physics_per_collision > 64) {
@@ -74,6 +93,13 @@ Status SimulationConfig::validate() const {
     std::snprintf(text, sizeof text, "tetrahedron volume bound %g m^3 is neither 0 (none) nor within [1e-11, 1]", max_tet_volume_m3);
     return Error{text};
   }
+  // The command line's range (--contact-margin-mm): a recording's header must not reach past it.
+  if (!(tissue.contact_margin_m >= 1e-4 && tissue.contact_margin_m <= 0.010)) {
+    char text[128];
+    std::snprintf(text, sizeof text, "contact margin %g mm is outside [0.1, 10] mm", units::m_to_mm(tissue.contact_margin_m));
+    return Error{text};
+  }
+  if (Status registration = validate_gimbal(gimbal); !registration) return registration;
   if (!(tissue.contact_reuse_m >= 0.0 && tissue.contact_reuse_m < tissue.contact_margin_m)) {
     char text[160];
     std::snprintf(text, sizeof text, "contact reuse shift %g mm is outside [0, the contact margin %g mm)", units::m_to_mm(tissue.contact_reuse_m),

@@ -3,9 +3,12 @@
 // place the tool with it, and the registration of the device frame to the world is one.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 
 #include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
 
 #include "rtcore/geometry/vec3.h"
 
@@ -31,6 +34,18 @@ RigidPose compose(const RigidPose& outer, const RigidPose& inner);
 
 /// The inverse transform (rotation transposed).
 RigidPose inverse(const RigidPose& pose);
+
+/// Whether `m` is a proper rotation: R^T R = I to `tolerance` in every entry, and det R > 0 (no
+/// scale, shear or mirror). Registrations from files and recordings are held to it.
+/// Inline, so the device's calibration reader (which links only rtcore's base) holds its files to it too.
+inline bool is_proper_rotation(const glm::dmat3& m, double tolerance = 1e-6) {
+  const glm::dmat3 gram = glm::transpose(m) * m;
+  double worst = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    for (int r = 0; r < 3; ++r) worst = std::max(worst, std::abs(gram[c][r] - (r == c ? 1.0 : 0.0)));
+  }
+  return worst <= tolerance && glm::determinant(m) > 0.0;  // a NaN fails both
+}
 
 /// Rotation about a unit axis by `angle_rad`, right-handed.
 glm::dmat3 axis_angle_rotation(const Vec3& unit_axis, double angle_rad);

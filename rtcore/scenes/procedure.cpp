@@ -194,7 +194,9 @@ Result<Procedure> builtin_procedure(const std::string& name) {
   if (name == "turp") return Procedure{"turp", turp_keyframes()};
   // A name without '/' or '.' is taken for a built-in one; a file of that name is read as ./NAME.
   std::error_code error;
-  const std::string file_hint = std::filesystem::is_regular_file(name, error) ? "; to read the file " + name + ", write ./" + name : "";
+  std::string file_hint;
+  if (std::filesystem::is_regular_file(name, error)) file_hint = "; to read the file " + name + ", write ./" + name;
+  else if (std::filesystem::is_directory(name, error)) file_hint = "; " + name + " here is a folder, not a procedure file";
   return Error{"no built-in procedure '" + name + "' (built-in: demo, turp)" + file_hint};
 }
 

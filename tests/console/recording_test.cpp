@@ -333,12 +333,58 @@ TEST(RecordingCommands, VerifyDecodesEveryKeyframeAndFindsTicksThatCannotReplay)
   const testing::CommandOutput keyframe = run_resecto("rec verify " + garbled.string());
   EXPECT_NE(keyframe.exit_code, 0);
   EXPECT_NE(keyframe.err.find("undecodable: " + garbled.string() + ": keyframe 0"), std::string::npos) << keyframe.err;
+  // The other verdicts agree (audit 30, F2): replay --verify vouches for the file and fails on it,
+  // though every hash matched; the score, which needs no picture, scores it and says what it lacks.
+  const testing::CommandOutput replayed = run_resecto("replay --verify " + garbled.string());
+  EXPECT_EQ(replayed.exit_code, 1) << replayed.out;
+  EXPECT_NE(replayed.err.find("keyframe 0"), std::string::npos) << replayed.err;
+  EXPECT_NE(replayed.err.find("1 unusable keyframes; every hash compared matched"), std::string::npos) << replayed.err;
+  const testing::CommandOutput scored = run_resecto("score " + garbled.string());
+  EXPECT_EQ(scored.exit_code, 0) << scored.err;
+  EXPECT_NE(scored.err.find("1 unusable keyframes"), std::string::npos) << scored.err;
+  EXPECT_NE(scored.err.find("every tick and command the recorder wrote is intact: scored"), std::string::npos) << scored.err;
   const testing::CommandOutput ticks = run_resecto("rec verify " + late.string());
   EXPECT_NE(ticks.exit_code, 0);
   EXPECT_NE(ticks.err.find("no tick replays: the header starts at tick 0"), std::string::npos) << ticks.err;
   const testing::CommandOutput sound = run_resecto("rec verify " + file.string());
   EXPECT_EQ(sound.exit_code, 0) << sound.err;
   EXPECT_NE(sound.out.find("every keyframe decodes"), std::string::npos) << sound.out;
+}
+
+// Chunks gone from the end of a closed file leave no gap and no damage: only the recorder's summary
+// says the procedure was longer. Verify said "ok" and the score scored the shorter procedure
+// (audit 30, F3); a header whose counts are not the model's is refused by the replay by name.
+TEST(RecordingCommands, TicksLostFromTheEndOrAnEditedHeaderAreNamed) {
+  const auto [dir, file, r] = record_and_open("recording_lost_end", "--seconds 1");
+  ASSERT_TRUE(r);
+  const auto is = [](const rec::ChunkLocation& chunk, rec::ChunkType type) { return chunk.type == static_cast<std::uint16_t>(type); };
+  std::size_t last_ticks = 0;
+  for (std::size_t c = 0; c < r->chunks().size(); ++c) last_ticks = is(r->chunks()[c], rec::ChunkType::kTicks) ? c : last_ticks;
+  const auto shorter = dir / "shorter.rsrec";
+  std::size_t c = 0;
+  rewrite(*r, shorter, [&](const rec::ChunkLocation&, std::vector<std::uint8_t>&) { return c++ != last_ticks; });
+  const testing::CommandOutput verify = run_resecto("rec verify " + shorter.string());
+  EXPECT_EQ(verify.out.find(": ok,"), std::string::npos) << verify.out;
+  EXPECT_NE(verify.out.find(": sound, "), std::string::npos) << verify.out;
+  EXPECT_NE(verify.out.find(" ticks its recorder wrote (chunks were removed)"), std::string::npos) << verify.out;
+  const testing::CommandOutput scored = run_resecto("score " + shorter.string());
+  EXPECT_EQ(scored.exit_code, 1) << scored.out;
+  EXPECT_NE(scored.err.find(" ticks and "), std::string::npos) << scored.err;
+  EXPECT_NE(scored.err.find(" commands its recorder wrote"), std::string::npos) << scored.err;
+
+  const auto edited = dir / "edited.rsrec";
+  rewrite(*r, edited, [&](const rec::ChunkLocation& chunk, std::vector<std::uint8_t>& payload) {
+    if (is(chunk, rec::ChunkType::kHeader)) {
+      nlohmann::ordered_json header = nlohmann::ordered_json::parse(payload.begin(), payload.end());
+      header["nodes"] = header["nodes"].get<int>() + 1;
+      const std::string text = header.dump();
+      payload.assign(text.begin(), text.end());
+    }
+    return true;
+  });
+  const testing::CommandOutput replayed = run_resecto("replay " + edited.string());
+  EXPECT_EQ(replayed.exit_code, 1);
+  EXPECT_NE(replayed.err.find("'s header says " + std::to_string(r->header().nodes + 1) + " nodes"), std::string::npos) << replayed.err;
 }
 
 TEST(RecordingCommands, ADeviceOrPipeIsNeverReadAsARecording) {
@@ -443,6 +489,8 @@ TEST(RecordingCommands, ExportsKeyframesAndInputsThatOtherProgramsRead) {
   ASSERT_EQ(run_resecto("rec export " + file.string() + " --inputs -o " + (dir / "inputs.csv").string()).exit_code, 0);
   const std::string csv = testing::read_text(dir / "inputs.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 961);  // header + 960 ticks
+  // In the edges' units, a procedure file's names (audit 30, F7: it wrote radians and metres).
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), "tick,time_s,yaw_deg,pitch_deg,roll_deg,insertion_mm,loop_mm,cut,coagulate,tool_present");
 
   // Draco's own decoder reads the .drc: same vertex count, positions within the quantisation step of
   // the surface the replayed core had at that tick.

@@ -134,10 +134,15 @@ TEST(ScoreCommand, CohortCsvSkipsTheDamagedRecording) {
     run_and_record("demo", file, std::string(" --seconds 1.2 --seed ").append(std::to_string(i + 1)));
     files.append(" ").append(file.string());
   }
-  // A 21st recording, damaged in the middle: copied from the first with bytes overwritten.
+  // A 21st recording, damaged in the middle: copied from the first with bytes of a ticks chunk
+  // overwritten. (Not simply the file's middle byte: the recorder thread's timing orders the chunks,
+  // and a keyframe there is damage the score notes and scores through.)
   std::string bytes = read_text(dir / "r0.resecto");
   ASSERT_GT(bytes.size(), 4096u);
-  for (std::size_t i = bytes.size() / 2; i < bytes.size() / 2 + 64; ++i) bytes[i] = static_cast<char>(0x5a);
+  const std::string ticks_marker("CHNK\x02\x00", 6);
+  const std::size_t ticks_chunk = bytes.find(ticks_marker, bytes.size() / 3);
+  ASSERT_NE(ticks_chunk, std::string::npos);
+  for (std::size_t i = ticks_chunk + 40; i < ticks_chunk + 104 && i < bytes.size(); ++i) bytes[i] = static_cast<char>(0x5a);
   {
     std::ofstream(dir / "damaged.resecto", std::ios::binary) << bytes;
   }

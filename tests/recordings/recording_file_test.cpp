@@ -345,6 +345,31 @@ TEST(SessionHeaderJson, RefusesBoundsNoReplayCouldBuild) {
   EXPECT_NE(refused("max_tet_volume_m3", 1e-30).find("tetrahedron volume bound 1e-30 m^3"), std::string::npos);
   EXPECT_NE(refused("tissue.contact_capacity.max_pair_entries", 0).find("max_pair_entries 0 is outside"), std::string::npos);
   EXPECT_NE(refused("tissue.contact_capacity.max_tissue_nodes", 1 << 30).find("max_tissue_nodes"), std::string::npos);
+  // Values the command line refuses are refused here too (audit 30, F4).
+  EXPECT_NE(refused("tissue.contact_margin_m", 1e6).find("contact margin 1e+09 mm is outside [0.1, 10] mm"), std::string::npos);
+  nlohmann::ordered_json json = header_to_json(header);
+  json["simulation"]["gimbal"]["device_to_world"] = std::vector<double>(12, 0.0);
+  EXPECT_NE(header_from_json(json.dump()).error().find("device-to-world rotation is not a rotation"), std::string::npos);
+  json = header_to_json(header);
+  json["simulation"]["gimbal"]["pivot_m"][2] = 1e300;
+  EXPECT_NE(header_from_json(json.dump()).error().find("gimbal pivot is not a finite point within 1 m"), std::string::npos);
+}
+
+// A header's counts size what the console's replay allocates: a billion nodes claimed in a file of a
+// 1296-triangle gland took 23 GB and the out-of-memory killer (audit 30, F1). Now refused by name.
+TEST(SessionHeaderJson, CountsPastWhatTheGlandHoldsAreRefused) {
+  const SessionHeader header = sound_header();
+  nlohmann::ordered_json json = header_to_json(header);
+  json["nodes"] = 900000000;
+  const std::string most = std::to_string(most_nodes(header.simulation));
+  EXPECT_EQ(header_from_json(json.dump()).error(), "header: nodes: 900000000 is more than a gland of " + std::to_string(header.simulation.prostate_triangles) +
+                                                       " triangles holds (at most " + most + ")");
+  json = header_to_json(header);
+  json["surface_triangles"] = 1000000000;
+  EXPECT_NE(header_from_json(json.dump()).error().find("header: surface_triangles: 1000000000 is more than a gland"), std::string::npos);
+  json["surface_triangles"] = header.surface_triangles;
+  json["nodes"] = most_nodes(header.simulation);
+  EXPECT_TRUE(header_from_json(json.dump()));
 }
 
 // Headers written before the contact search could keep its candidates have no contact_reuse_m: such
@@ -480,6 +505,10 @@ TEST(RecordingFile, AKeyframeThatDoesNotDecodeIsNamedByFileAndChunk) {
   EXPECT_EQ(frame.error().substr(0, place.size()), place) << frame.error();
   EXPECT_TRUE(r->decode_keyframe(0));
   EXPECT_TRUE(r->decode_keyframe(2));
+  const std::vector<std::string> problems = r->keyframe_problems();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems.front(), frame.error());
+  EXPECT_TRUE(r->content_errors().empty()) << "a keyframe is not content the replay needs";
 }
 
 // A recording whose header starts past tick 0 (the console's record button, mid-session) holds no

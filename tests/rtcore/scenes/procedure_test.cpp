@@ -118,6 +118,11 @@ TEST(Procedure, AnUnknownNameThatIsAFileHereSaysHowToReadIt) {
   const Result<Procedure> absent = find_procedure("procedure_name_hint");
   ASSERT_FALSE(absent);
   EXPECT_EQ(absent.error().find("to read the file"), std::string::npos) << absent.error();
+  std::filesystem::create_directory(here);  // a folder of that name is said to be one (audit 30, F10)
+  const Result<Procedure> folder = find_procedure(here.string());
+  std::filesystem::remove(here);
+  ASSERT_FALSE(folder);
+  EXPECT_NE(folder.error().find("; procedure_name_hint here is a folder, not a procedure file"), std::string::npos) << folder.error();
 }
 
 }  // namespace
