@@ -99,11 +99,16 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
         }
         break;
       case ChunkType::kIndex:
-        if (Result<std::vector<IndexEntry>> index = decode_index(payload); !index) r.content_errors_.push_back(where + ": " + index.error());
+        if (Result<std::vector<IndexEntry>> index = decode_index(payload); !index) {
+          r.content_errors_.push_back(where + ": " + index.error());
+        } else {
+          r.check_index(*index, where);
+        }
         break;
     }
   }
   if (!have_header) return Error{name + ": no intact header chunk (nothing to replay from)"};
+  r.check_chunk_order();
 
   // Sorted by tick; a record seen twice (never written so, but a copied chunk could be) is kept once.
   auto by_tick = [](const auto& a, const auto& b) { return a.tick < b.tick; };
@@ -128,6 +133,46 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
   }
   r.replayable_ticks_ = next - start;
   return r;
+}
+
+void Recording::check_index(std::span<const IndexEntry> entries, const std::string& where) {
+  // The recorder lists every chunk before the index: an entry must name an intact chunk as it is,
+  // or a place the scan found damaged (its chunk lost). Readers never need the index (the scan finds
+  // every chunk), so a wrong one costs nothing but `rec verify`'s word that the file is sound.
+  for (std::size_t e = 0; e < entries.size(); ++e) {
+    const IndexEntry& entry = entries[e];
+    const auto chunk = std::lower_bound(scan_.chunks.begin(), scan_.chunks.end(), entry.offset,
+                                        [](const ChunkLocation& c, std::uint64_t offset) { return c.offset < offset; });
+    const bool at_chunk = chunk != scan_.chunks.end() && chunk->offset == entry.offset;
+    const bool in_damage = std::any_of(scan_.damaged.begin(), scan_.damaged.end(),
+                                       [&](const DamagedRange& d) { return entry.offset >= d.offset && entry.offset < d.offset + d.bytes; });
+    std::string problem;
+    if (at_chunk && (chunk->type != entry.type || chunk->sequence != entry.sequence || chunk->payload_bytes != entry.payload_bytes)) {
+      problem = "lists a " + std::string(chunk_type_name(entry.type)) + " chunk " + std::to_string(entry.sequence) + " of " +
+                std::to_string(entry.payload_bytes) + " bytes there, the file has " + std::string(chunk_type_name(chunk->type)) + " chunk " +
+                std::to_string(chunk->sequence) + " of " + std::to_string(chunk->payload_bytes);
+    } else if (!at_chunk && !in_damage) {
+      problem = "points where no chunk starts";
+    }
+    if (!problem.empty()) {
+      index_problems_.push_back(where + ": entry " + std::to_string(e) + " (byte " + std::to_string(entry.offset) + ") " + problem);
+      if (index_problems_.size() >= kMostProblemsListed) return;
+    }
+  }
+}
+
+void Recording::check_chunk_order() {
+  // The writer numbers chunks 0, 1, 2, ... as it appends them; damage and `rec recover` leave gaps,
+  // never a number at or below an earlier one.
+  for (std::size_t c = 1; c < scan_.chunks.size() && index_problems_.size() < kMostProblemsListed; ++c) {
+    const ChunkLocation& previous = scan_.chunks[c - 1];
+    const ChunkLocation& chunk = scan_.chunks[c];
+    if (chunk.sequence <= previous.sequence) {
+      index_problems_.push_back(std::string(chunk_type_name(chunk.type)) + " chunk at byte " + std::to_string(chunk.offset) + " is numbered " +
+                                std::to_string(chunk.sequence) + ", not after the chunk before it (" + std::to_string(previous.sequence) +
+                                "): chunks reordered or renumbered");
+    }
+  }
 }
 
 void Recording::number_keyframes() {

@@ -19,6 +19,7 @@
 
 #include "recordings/chunk_format.h"
 #include "recordings/keyframe_codec.h"
+#include "recordings/recording_writer.h"
 #include "recordings/records.h"
 #include "recordings/session_header.h"
 #include "rtcore/base/result.h"
@@ -63,6 +64,11 @@ class Recording {
   /// Chunks whose CRCs held but whose content did not decode (should never happen; counted). Keyframe
   /// chunks are not among them: keyframe_problems() has those.
   std::span<const std::string> content_errors() const { return content_errors_; }
+  /// What is wrong with the file's bookkeeping though every chunk is intact: index entries that do
+  /// not name the chunks as they are, chunks numbered out of order. No reader needs either (replay
+  /// and score go by the chunks); `rec verify` counts them as problems. At most kMostProblemsListed.
+  std::span<const std::string> index_problems() const { return index_problems_; }
+  static constexpr std::size_t kMostProblemsListed = 20;
   /// Why each keyframe chunk whose CRC held is unusable: its record does not decode, claims more than
   /// the gland holds, or its Draco mesh does not decode (every keyframe is decoded: this takes a while).
   /// Keyframes are pictures: the ticks, commands and hashes replay and score without them.
@@ -115,6 +121,10 @@ class Recording {
  private:
   /// Where keyframe k's errors point: the file, the keyframe and its chunk's place in the file.
   std::string keyframe_place(std::size_t k) const;
+  /// Index entries that do not match the chunks (index_problems()).
+  void check_index(std::span<const IndexEntry> entries, const std::string& where);
+  /// Chunks whose numbers do not rise in file order (index_problems()).
+  void check_chunk_order();
   /// Sets every keyframe's number from its tick (after the keyframes are sorted).
   void number_keyframes();
   /// find_keyframe's error for a number the file lacks; `next` indexes the first keyframe numbered after it.
@@ -135,6 +145,7 @@ class Recording {
   nlohmann::ordered_json summary_;
   std::vector<std::string> content_errors_;
   std::vector<std::string> keyframe_record_errors_;  ///< keyframe chunks whose record did not decode
+  std::vector<std::string> index_problems_;
 };
 
 }  // namespace resecto::rec

@@ -138,6 +138,10 @@ void verify(const std::string& file) {
   // keyframes are decoded as export and the console's timeline would, and the first ticks must be the
   // header's start tick on, or nothing replays. (A later gap, where a recovery dropped a damaged
   // chunk, leaves what precedes it replayable: it is said, not failed.)
+  for (const std::string& e : r.index_problems()) {
+    std::fprintf(stderr, "%s: bookkeeping: %s\n", file.c_str(), e.c_str());
+    ++problems;
+  }
   for (const std::string& e : r.keyframe_problems()) {
     std::fprintf(stderr, "%s: undecodable: %s\n", file.c_str(), e.c_str());
     ++problems;

@@ -511,6 +511,49 @@ TEST(RecordingFile, AKeyframeThatDoesNotDecodeIsNamedByFileAndChunk) {
   EXPECT_TRUE(r->content_errors().empty()) << "a keyframe is not content the replay needs";
 }
 
+// An index whose entries do not name the chunks as they are, or chunks numbered out of order, said
+// "ok ... index present" (audit 30, F4): no reader needs them, but verify vouches for the file.
+TEST(RecordingFile, AnIndexOrNumberingThatDoesNotMatchTheChunksIsNamed) {
+  const std::vector<std::uint8_t>& file = testing::short_recording().file;
+  Result<Recording> intact = Recording::from_bytes(file, "session.rsrec");
+  ASSERT_TRUE(intact) << intact.error();
+  EXPECT_TRUE(intact->index_problems().empty()) << intact->index_problems().front();
+  const std::vector<std::uint8_t> misindexed = with_payloads_rewritten(file, [](const ChunkLocation& chunk, std::vector<std::uint8_t>& payload) {
+    if (chunk.type != static_cast<std::uint16_t>(ChunkType::kIndex)) return;
+    Result<std::vector<IndexEntry>> entries = decode_index(payload);
+    ASSERT_TRUE(entries) << entries.error();
+    ASSERT_GT(entries->size(), 3u);
+    (*entries)[2].offset += 1;
+    (*entries)[3].sequence += 7;
+    payload.clear();
+    encode_index(*entries, payload);
+  });
+  Result<Recording> r = Recording::from_bytes(misindexed, "misindexed.rsrec");
+  ASSERT_TRUE(r) << r.error();
+  EXPECT_TRUE(r->damaged().empty());
+  EXPECT_TRUE(r->content_errors().empty()) << "the chunks themselves are whole: replay and score go on";
+  ASSERT_EQ(r->index_problems().size(), 2u);
+  EXPECT_NE(r->index_problems()[0].find(": entry 2 (byte "), std::string::npos) << r->index_problems()[0];
+  EXPECT_NE(r->index_problems()[0].find(") points where no chunk starts"), std::string::npos) << r->index_problems()[0];
+  EXPECT_NE(r->index_problems()[1].find(": entry 3 (byte "), std::string::npos) << r->index_problems()[1];
+  EXPECT_NE(r->index_problems()[1].find(" the file has "), std::string::npos) << r->index_problems()[1];
+
+  // Every chunk numbered 0, framed afresh (CRCs hold); the index left out, as a killed run's file.
+  const ChunkScan scan = scan_chunks(file);
+  std::vector<std::uint8_t> renumbered(file.begin(), file.begin() + static_cast<std::ptrdiff_t>(scan.chunks.front().offset));
+  for (const ChunkLocation& chunk : scan.chunks) {
+    if (chunk.type == static_cast<std::uint16_t>(ChunkType::kIndex)) continue;
+    const auto from = file.begin() + static_cast<std::ptrdiff_t>(chunk.payload_offset());
+    append_chunk(renumbered, static_cast<ChunkType>(chunk.type), 0, std::span(&*from, chunk.payload_bytes));
+  }
+  Result<Recording> zeros = Recording::from_bytes(renumbered, "zeros.rsrec");
+  ASSERT_TRUE(zeros) << zeros.error();
+  ASSERT_FALSE(zeros->index_problems().empty());
+  EXPECT_NE(zeros->index_problems().back().find("is numbered 0, not after the chunk before it (0): chunks reordered or renumbered"), std::string::npos)
+      << zeros->index_problems().back();
+  EXPECT_LE(zeros->index_problems().size(), Recording::kMostProblemsListed);
+}
+
 // A recording whose header starts past tick 0 (the console's record button, mid-session) holds no
 // state to re-simulate from: replay refuses it by name and says what still works.
 TEST(RecordingFile, ReplayRefusesARecordingStartedMidSessionAndSaysWhy) {
