@@ -128,12 +128,14 @@ SimulationConfig config_from(const JsonFields& j) {
 
 std::size_t most_nodes(const SimulationConfig& config) {
   // The gland has about 0.86 nodes per surface triangle, and the core reserves room for three times
-  // its nodes (or 40,000): eight a triangle is ample.
-  return std::max<std::size_t>(40000, 8 * static_cast<std::size_t>(std::max(0, config.prostate_triangles)));
+  // its nodes (or TissueConfig::kMinNodeCapacity): eight a triangle is ample.
+  return std::max<std::size_t>(TissueConfig::kMinNodeCapacity, 8 * static_cast<std::size_t>(std::max(0, config.prostate_triangles)));
 }
 
 std::size_t most_surface_triangles(const SimulationConfig& config) {
-  return std::max<std::size_t>(160000, 16 * static_cast<std::size_t>(std::max(0, config.prostate_triangles)));
+  // A closed surface has about two triangles a vertex; four a node of the room's floor, sixteen a
+  // gland triangle, leave as much again for cut surfaces with handles.
+  return std::max<std::size_t>(4 * TissueConfig::kMinNodeCapacity, 16 * static_cast<std::size_t>(std::max(0, config.prostate_triangles)));
 }
 
 std::string build_identity() {

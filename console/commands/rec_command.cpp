@@ -153,21 +153,22 @@ void verify(const std::string& file) {
     ++problems;
   }
   if (problems > 0) throw std::runtime_error(file + ": " + std::to_string(problems) + " problem(s), " + std::to_string(r.chunks().size()) + " intact chunks");
-  // A gap a recovery left: the file is sound, but not the whole procedure replays (audit 25, F8: it
-  // said "ok" for a file whose last 39% of ticks cannot be replayed).
+  // Sound (every check above passed) but not the whole procedure: said with exit 0, not as "ok".
+  const std::string sound = file + ": sound, " + std::to_string(r.chunks().size()) +
+                            " chunks, every CRC matches, every keyframe decodes, index present; but ";
+  // A gap a recovery left: not the whole procedure replays (audit 25, F8: it said "ok" for a file
+  // whose last 39% of ticks cannot be replayed).
   if (r.replayable_ticks() < r.ticks().size()) {
-    std::printf("%s: sound, %zu chunks, every CRC matches, every keyframe decodes, index present; but only %llu of %zu recorded ticks replay: "
-                "the inputs break at tick %llu (%llu ticks missing), and the rest cannot be replayed\n",
-                file.c_str(), r.chunks().size(), static_cast<unsigned long long>(r.replayable_ticks()), r.ticks().size(),
+    std::printf("%sonly %llu of %zu recorded ticks replay: the inputs break at tick %llu (%llu ticks missing), and the rest cannot be replayed\n",
+                sound.c_str(), static_cast<unsigned long long>(r.replayable_ticks()), r.ticks().size(),
                 static_cast<unsigned long long>(start + r.replayable_ticks()), static_cast<unsigned long long>(r.missing_ticks()));
     return;
   }
   // A recovery that left out the last ticks chunks leaves no gap: only the recorder's summary says
   // how many it wrote (audit 30, F3: "ok" for a file that had lost its last quarter).
   if (const std::optional<std::uint64_t> written = r.summary_count("ticks"); written && *written > r.ticks().size()) {
-    std::printf("%s: sound, %zu chunks, every CRC matches, every keyframe decodes, index present; but it holds only %zu of the %llu ticks "
-                "its recorder wrote (%s): the procedure's last %llu ticks are lost\n",
-                file.c_str(), r.chunks().size(), r.ticks().size(), static_cast<unsigned long long>(*written),
+    std::printf("%sit holds only %zu of the %llu ticks its recorder wrote (%s): the procedure's last %llu ticks are lost\n", sound.c_str(),
+                r.ticks().size(), static_cast<unsigned long long>(*written),
                 r.recovered_damaged_ranges() > 0 ? "`rec recover` left out the damaged chunks that held the rest" : "chunks were removed",
                 static_cast<unsigned long long>(*written - r.ticks().size()));
     return;

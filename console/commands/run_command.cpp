@@ -179,7 +179,7 @@ void register_run(CLI::App& app) {
   cmd->add_option("--contact-margin-mm", o->contact_margin_mm,
                   "How far outside the tool a point may be and still become a contact candidate; it must exceed what tool and "
                   "tissue move between collision steps (default 1.5)")
-      ->check(finite_range(0.1, 10.0));
+      ->check(finite_range(units::m_to_mm(TissueConfig::kMinContactMarginM), units::m_to_mm(TissueConfig::kMaxContactMarginM)));
   cmd->add_option("--spin-us", o->spin_us, "Real time: spin this long before each tick instead of sleeping")
       ->transform(whole_in_range(0, 100000))
       ->capture_default_str();

@@ -60,9 +60,6 @@ bool is_count(const char* name) {
 /// Whether a metric has a value (only grams per cut can lack one).
 bool has_value(const ScoreMetrics& m, const char* name) { return has_grams_per_cut(m) || std::string(name) != "grams_per_cut"; }
 
-/// What a sound file (no damage left in it) lacks of the procedure it was recorded from, or empty: a
-/// recovery's left-out damaged ranges, unless the recorder's summary shows every tick and command it
-/// wrote still there (the ranges held only keyframes or hashes, which the score does not use).
 /// Whether the recorder's summary (written when it closed the file) counts exactly the ticks and
 /// commands the file holds: whatever else was lost (keyframes, hashes), the procedure is whole.
 bool holds_every_tick_and_command(const rec::Recording& recording) {
@@ -70,26 +67,28 @@ bool holds_every_tick_and_command(const rec::Recording& recording) {
   return ticks && commands && *ticks == recording.ticks().size() && *commands == recording.commands().size();
 }
 
+/// What a sound file (no damage left in it) lacks of the procedure it was recorded from, or empty:
+/// chunks a recovery left out or that were removed, unless the recorder's summary shows every tick
+/// and command it wrote still there (what went held only keyframes or hashes, which the score does
+/// not use); or all it cannot know, when the recorder never closed the file.
 std::string lost_part_of_procedure(const rec::Recording& recording) {
+  if (holds_every_tick_and_command(recording)) return {};
   const std::uint64_t dropped = recording.recovered_damaged_ranges();
   const std::optional<std::uint64_t> ticks = recording.summary_count("ticks"), commands = recording.summary_count("commands");
+  const auto held_of_written = [&] {
+    return std::to_string(recording.ticks().size()) + " of the " + std::to_string(*ticks) + " ticks and " + std::to_string(recording.commands().size()) +
+           " of the " + std::to_string(commands.value_or(0)) + " commands";
+  };
   // Cut between two chunks, a file looks whole up to its end; only the recorder's summary, written
   // when it closes the file, says the procedure ended there.
   if (dropped == 0) {
-    if (ticks && holds_every_tick_and_command(recording)) return {};
-    if (ticks) {  // closed, yet chunks are gone: removed by hand, or copied without them
-      return "it holds " + std::to_string(recording.ticks().size()) + " of the " + std::to_string(*ticks) + " ticks and " +
-             std::to_string(recording.commands().size()) + " of the " + std::to_string(commands.value_or(0)) + " commands its recorder wrote";
-    }
+    if (ticks) return "it holds " + held_of_written() + " its recorder wrote";  // closed, yet chunks are gone
     return "the recorder never closed it (the run was killed or the file cut after " + std::to_string(recording.ticks().size()) +
            " ticks), so how much of the procedure it lacks is unknown";
   }
-  if (holds_every_tick_and_command(recording)) return {};
   return "recovered (`rec recover`) from a damaged recording, " + std::to_string(dropped) + " damaged ranges left out" +
-         (ticks && commands
-              ? ": " + std::to_string(recording.ticks().size()) + " of the " + std::to_string(*ticks) + " ticks and " +
-                    std::to_string(recording.commands().size()) + " of the " + std::to_string(*commands) + " commands recorded remain"
-              : ", and the recording was never closed, so how much of the procedure they held is unknown");
+         (ticks && commands ? ": " + held_of_written() + " recorded remain"
+                            : ", and the recording was never closed, so how much of the procedure they held is unknown");
 }
 
 }  // namespace

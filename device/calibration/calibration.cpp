@@ -13,8 +13,9 @@
 #include "rtcore/base/atomic_file.h"
 #include "rtcore/base/checked_number.h"
 #include "rtcore/base/json_text.h"
-#include "rtcore/geometry/rigid_pose.h"
 #include "rtcore/base/text_file.h"
+#include "rtcore/base/units.h"
+#include "rtcore/geometry/rigid_pose.h"
 
 namespace resecto::device {
 namespace {
@@ -80,7 +81,7 @@ class FieldReader {
 };
 
 /// The largest registration translation read, in mm on each axis.
-constexpr double kMaxTranslationMm = 1000.0;
+constexpr double kMaxTranslationMm = units::m_to_mm(kRegistrationReachM);
 
 bool is_whole(double v, double lo, double hi) { return v == std::floor(v) && v >= lo && v <= hi; }
 

@@ -55,17 +55,12 @@ Vec3 loop_front_point(const TriangleMesh& loop) {
   return sum / static_cast<double>(std::max(count, 1));
 }
 
-}  // namespace
-
-namespace {
-
 // The registration places the device in the world: a rotation (orthonormal, not a reflection) and a
-// pivot and translation within a metre of the origin (the device sits beside the patient). A header
-// with a zero matrix or a pivot at 1e300 m would otherwise replay as a different run, or as NaN.
+// pivot and translation within reach (kRegistrationReachM, as the calibration file's). A header with
+// a zero matrix or a pivot at 1e300 m would otherwise replay as a different run, or as NaN.
 Status validate_gimbal(const GimbalGeometry& gimbal) {
   const RigidPose& pose = gimbal.device_to_world;
-  constexpr double kFarthestM = 1.0;
-  auto within_reach = [](const Vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && glm::length(p) <= kFarthestM; };
+  auto within_reach = [](const Vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && glm::length(p) <= kRegistrationReachM; };
   if (!within_reach(gimbal.pivot_m)) return Error{"gimbal pivot is not a finite point within 1 m of the device's origin"};
   if (!within_reach(pose.translation)) return Error{"device-to-world translation is not a finite offset within 1 m"};
   if (!is_proper_rotation(pose.rotation)) {
@@ -94,9 +89,10 @@ Status SimulationConfig::validate() const {
     return Error{text};
   }
   // The command line's range (--contact-margin-mm): a recording's header must not reach past it.
-  if (!(tissue.contact_margin_m >= 1e-4 && tissue.contact_margin_m <= 0.010)) {
+  if (!(tissue.contact_margin_m >= TissueConfig::kMinContactMarginM && tissue.contact_margin_m <= TissueConfig::kMaxContactMarginM)) {
     char text[128];
-    std::snprintf(text, sizeof text, "contact margin %g mm is outside [0.1, 10] mm", units::m_to_mm(tissue.contact_margin_m));
+    std::snprintf(text, sizeof text, "contact margin %g mm is outside [%g, %g] mm", units::m_to_mm(tissue.contact_margin_m),
+                  units::m_to_mm(TissueConfig::kMinContactMarginM), units::m_to_mm(TissueConfig::kMaxContactMarginM));
     return Error{text};
   }
   if (Status registration = validate_gimbal(gimbal); !registration) return registration;

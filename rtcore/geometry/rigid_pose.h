@@ -35,6 +35,11 @@ RigidPose compose(const RigidPose& outer, const RigidPose& inner);
 /// The inverse transform (rotation transposed).
 RigidPose inverse(const RigidPose& pose);
 
+/// How far a registration may place the device: each coordinate of its translation (and of the
+/// gimbal's pivot) within this many metres of the origin, a metre either way being generous beside a
+/// patient. Calibration files and recordings' headers are held to it.
+inline constexpr double kRegistrationReachM = 1.0;
+
 /// Whether `m` is a proper rotation: R^T R = I to `tolerance` in every entry, and det R > 0 (no
 /// scale, shear or mirror). Registrations from files and recordings are held to it.
 /// Inline, so the device's calibration reader (which links only rtcore's base) holds its files to it too.

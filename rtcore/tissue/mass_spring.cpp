@@ -18,12 +18,6 @@ std::size_t capacity_for(std::size_t count, double factor) {
   return static_cast<std::size_t>(std::ceil(static_cast<double>(count) * std::max(1.0, factor)));
 }
 
-// Floors of the reserved room, whatever the model's size: refinement near the loop turns a coarse
-// model's tetrahedra into many small ones (a 4 mm tetrahedron into ~20 of 1.5 mm), so a coarse
-// gland needs far more room than a multiple of its own counts. About 20 MB in all.
-constexpr std::size_t kMinTetrahedronCapacity = 160000;
-constexpr std::size_t kMinNodeCapacity = 40000;
-
 }  // namespace
 
 MassSpringTissue::OrderedMesh MassSpringTissue::ordered(const TetMesh& mesh, bool locality) {
@@ -49,8 +43,8 @@ MassSpringTissue::MassSpringTissue(OrderedMesh&& ordered_mesh, const TissueParam
       network_(build_spring_network(ordered_mesh.mesh)),
       springs_(network_),
       topology_(ordered_mesh.mesh.tetrahedra, ordered_mesh.mesh.regions, ordered_mesh.mesh.node_count(),
-                std::max(kMinTetrahedronCapacity, capacity_for(ordered_mesh.mesh.tetrahedron_count(), config.topology_capacity_factor)),
-                std::max(kMinNodeCapacity, capacity_for(ordered_mesh.mesh.node_count(), config.topology_capacity_factor))),
+                std::max(TissueConfig::kMinTetrahedronCapacity, capacity_for(ordered_mesh.mesh.tetrahedron_count(), config.topology_capacity_factor)),
+                std::max(TissueConfig::kMinNodeCapacity, capacity_for(ordered_mesh.mesh.node_count(), config.topology_capacity_factor))),
       tool_(config.contact_margin_m, config.contact_capacity) {
   const TetMesh& mesh = ordered_mesh.mesh;
   const std::size_t n = mesh.node_count();

@@ -41,6 +41,8 @@ struct TissueConfig {
   double cg_tolerance = 1e-4;          ///< relative residual at which CG stops
   int max_substeps = 4096;             ///< cap of kSubsteppedSymplectic; hitting it is flagged
   double contact_margin_m = 0.0015;
+  /// The contact margin's range: the command line's --contact-margin-mm and a recording's header.
+  static constexpr double kMinContactMarginM = 1e-4, kMaxContactMarginM = 0.010;
   /// Temporal coherence of the contact search: a collision step whose tool and tissue have moved at
   /// most this far together from where the published candidates were searched (the tool's vertices
   /// at most a third of it: contact_candidates_still_serve) keeps them instead of refitting and
@@ -57,6 +59,11 @@ struct TissueConfig {
   /// tetrahedron, spring and surface-face counts (local refinement adds all four). An edit that would
   /// pass a capacity is refused and counted (TissueFaults::topology_capacity_refusals).
   double topology_capacity_factor = 3.0;
+  /// Floors of that room, whatever the model's size: refinement near the loop turns a coarse model's
+  /// tetrahedra into many small ones (a 4 mm tetrahedron into ~20 of 1.5 mm), so a coarse gland
+  /// needs far more room than a multiple of its own counts. About 20 MB in all.
+  static constexpr std::size_t kMinTetrahedronCapacity = 160000;
+  static constexpr std::size_t kMinNodeCapacity = 40000;
 };
 
 /// Faults of the last step, counted rather than thrown (STYLE.md "Errors").

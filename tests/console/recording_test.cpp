@@ -49,6 +49,8 @@ OpenedRecording record_and_open(const std::string& name, const std::string& extr
   return {dir, file, rec::Recording::open(file)};
 }
 
+bool is(const rec::ChunkLocation& chunk, rec::ChunkType type) { return chunk.type == static_cast<std::uint16_t>(type); }
+
 /// `r` written again at `out` chunk by chunk, each with a fresh CRC, after `edit(chunk, payload)`
 /// (false: leave the chunk out), and closed with a new index.
 template <class Edit>
@@ -56,7 +58,7 @@ void rewrite(const rec::Recording& r, const std::filesystem::path& out, Edit edi
   rec::RecordingWriter writer;
   ASSERT_TRUE(writer.open(out));
   for (const rec::ChunkLocation& chunk : r.chunks()) {
-    if (chunk.type == static_cast<std::uint16_t>(rec::ChunkType::kIndex)) continue;
+    if (is(chunk, rec::ChunkType::kIndex)) continue;
     std::vector<std::uint8_t> payload(r.payload(chunk).begin(), r.payload(chunk).end());
     if (edit(chunk, payload)) writer.add_chunk(static_cast<rec::ChunkType>(chunk.type), payload);
   }
@@ -115,7 +117,7 @@ TEST(RecordingCommands, AnInputAlteredAtOneTickIsReportedAtThatTick) {
   const std::uint64_t altered_tick = 960;
   const auto altered = dir / "altered.rsrec";
   rewrite(*original, altered, [&](const rec::ChunkLocation& chunk, std::vector<std::uint8_t>& payload) {
-    if (chunk.type == static_cast<std::uint16_t>(rec::ChunkType::kTicks)) {
+    if (is(chunk, rec::ChunkType::kTicks)) {
       auto ticks = rec::decode_tick_block(payload);
       EXPECT_TRUE(ticks);
       for (rec::TickRecord& t : *ticks) {
@@ -293,7 +295,7 @@ TEST(RecordingCommands, ARecoveryWithoutSomeStepHashesDoesNotVerifyAsWhole) {
   const auto [dir, file, r] = record_and_open("recording_lost_steps", "--seconds 1");
   ASSERT_TRUE(r);
   const auto steps = std::find_if(r->chunks().begin(), r->chunks().end(),
-                                  [](const rec::ChunkLocation& c) { return c.type == static_cast<std::uint16_t>(rec::ChunkType::kSteps); });
+                                  [](const rec::ChunkLocation& c) { return is(c, rec::ChunkType::kSteps); });
   ASSERT_NE(steps, r->chunks().end());
   const auto damaged = dir / "damaged.rsrec";
   write_with_a_bit_flipped(*r, *steps, 0x10, damaged);
@@ -316,7 +318,6 @@ TEST(RecordingCommands, VerifyDecodesEveryKeyframeAndFindsTicksThatCannotReplay)
   // CRCs): verify said "ok" and export or replay failed after it.
   const auto [dir, file, r] = record_and_open("recording_verify_content", "--seconds 1");
   ASSERT_TRUE(r);
-  const auto is = [](const rec::ChunkLocation& chunk, rec::ChunkType type) { return chunk.type == static_cast<std::uint16_t>(type); };
   const auto garbled = dir / "garbled_keyframe.rsrec";
   bool first_keyframe = true;
   rewrite(*r, garbled, [&](const rec::ChunkLocation& chunk, std::vector<std::uint8_t>& payload) {
@@ -357,7 +358,6 @@ TEST(RecordingCommands, VerifyDecodesEveryKeyframeAndFindsTicksThatCannotReplay)
 TEST(RecordingCommands, TicksLostFromTheEndOrAnEditedHeaderAreNamed) {
   const auto [dir, file, r] = record_and_open("recording_lost_end", "--seconds 1");
   ASSERT_TRUE(r);
-  const auto is = [](const rec::ChunkLocation& chunk, rec::ChunkType type) { return chunk.type == static_cast<std::uint16_t>(type); };
   std::size_t last_ticks = 0;
   for (std::size_t c = 0; c < r->chunks().size(); ++c) last_ticks = is(r->chunks()[c], rec::ChunkType::kTicks) ? c : last_ticks;
   const auto shorter = dir / "shorter.rsrec";
