@@ -60,9 +60,11 @@ Vec3 loop_front_point(const TriangleMesh& loop) {
 // a zero matrix or a pivot at 1e300 m would otherwise replay as a different run, or as NaN.
 Status validate_gimbal(const GimbalGeometry& gimbal) {
   const RigidPose& pose = gimbal.device_to_world;
-  auto within_reach = [](const Vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && glm::length(p) <= kRegistrationReachM; };
-  if (!within_reach(gimbal.pivot_m)) return Error{"gimbal pivot is not a finite point within 1 m of the device's origin"};
-  if (!within_reach(pose.translation)) return Error{"device-to-world translation is not a finite offset within 1 m"};
+  auto within_reach = [](const Vec3& p) {
+    return std::abs(p.x) <= kRegistrationReachM && std::abs(p.y) <= kRegistrationReachM && std::abs(p.z) <= kRegistrationReachM;  // NaN fails
+  };
+  if (!within_reach(gimbal.pivot_m)) return Error{"gimbal pivot is not a finite point within 1 m of the device's origin on each axis"};
+  if (!within_reach(pose.translation)) return Error{"device-to-world translation is not a finite offset within 1 m on each axis"};
   if (!is_proper_rotation(pose.rotation)) {
     return Error{"device-to-world rotation is not a rotation (orthonormal, determinant +1)"};
   }

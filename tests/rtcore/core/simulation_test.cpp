@@ -351,6 +351,20 @@ TEST(Simulation, ContactRoomGrowsWithTheGland) {
   EXPECT_TRUE(config.validate());
 }
 
+// The registration's reach is the calibration file's, axis by axis: a translation of (900, 900, 0) mm,
+// which a calibration file may hold, was refused as 1.27 m away by a length check.
+TEST(SimulationConfig, RegistrationReachIsTheCalibrationFilesOnEachAxis) {
+  SimulationConfig config;
+  config.gimbal.device_to_world.translation = Vec3(0.9, 0.9, 0.0);
+  config.gimbal.pivot_m = Vec3(-0.9, 0.9, 0.9);
+  EXPECT_TRUE(config.validate()) << config.validate().error();
+  config.gimbal.device_to_world.translation = Vec3(0.0, 1.2, 0.0);
+  EXPECT_NE(config.validate().error().find("device-to-world translation is not a finite offset within 1 m"), std::string::npos);
+  config.gimbal.device_to_world.translation = Vec3(0.0);
+  config.gimbal.pivot_m = Vec3(0.0, 0.0, std::nan(""));
+  EXPECT_NE(config.validate().error().find("gimbal pivot is not a finite point within 1 m"), std::string::npos);
+}
+
 TEST(Simulation, RejectsImpossibleRates) {
   SimulationConfig config = small_config();
   config.physics_per_collision = 0;
