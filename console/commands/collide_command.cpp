@@ -215,7 +215,7 @@ void register_collide(CLI::App& app) {
                 "(same pairs; without it every pose is independent)");
   cmd->add_option("--threads", options->threads,
                   "1: every query on one thread (the default); 2: each query shared with a helper thread (same pairs; "
-                  "with --sequence the threads claim four fixed shares of the tissue tree, each keeping its front)")
+                  "with --sequence each thread keeps the front of its own half of the tissue tree)")
       ->transform(whole_in_range(1, 2))
       ->capture_default_str();
   cmd->add_option("--method", options->method,

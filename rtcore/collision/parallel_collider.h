@@ -3,9 +3,6 @@
 // counter, whole (walk and exact tests), until none is left; their sorted pairs are merged. A rigid
 // tool's pairs are spread over the gland along the whole sheath, so the claims even out the work
 // without a schedule worked out in advance. Which thread ran which subtree changes no pair.
-// A sequence keeps fronts from call to call, so its subtrees are dealt once into a few fixed shares,
-// each with a Collider (and its front) of its own, and the threads claim whole shares: a helper that
-// wakes late takes fewer of them rather than leaving the caller waiting on a fixed half.
 // The helper is a LoopHelper: called in for each query, it spins between queries that come less
 // than a few milliseconds apart, so a query of a few hundred microseconds does not wait tens of them
 // for a sleeping thread to wake, and a helper that comes late finds its share already taken.
@@ -40,9 +37,8 @@ class ParallelCollider {
   /// Collider::collide's pairs: sorted by (tissue, tool), each once. False on overflow.
   bool collide(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree, const TriangleMesh& tool,
                const RigidPose& tool_pose);
-  /// Collider::collide_sequence's pairs for consecutive poses, each share of the subtrees (every
-  /// kSequenceShares-th one, so each share spans the gland) keeping its own front whichever thread
-  /// runs it. False on overflow.
+  /// Collider::collide_sequence's pairs for consecutive poses, each thread keeping the front of its
+  /// own fixed half of the subtrees (alternate ones, so both halves span the gland). False on overflow.
   bool collide_sequence(const SphereTree& tissue_tree, const TriangleMesh& tissue, const SphereTree& tool_tree, const TriangleMesh& tool,
                         const RigidPose& tool_pose, double tissue_travel_m = 0.0);
   /// Lets the helper sleep now rather than spin for the next query (it goes by itself a few
@@ -50,28 +46,24 @@ class ParallelCollider {
   void release_helper() {
     if (helper_) helper_->send_home();
   }
-  /// Forgets every share's front (Collider::reset_sequence).
+  /// Forgets both threads' fronts (Collider::reset_sequence).
   void reset_sequence();
   std::span<const TrianglePair> pairs() const { return {pairs_.data(), pair_count_}; }
-  /// The work counters of every Collider that ran, summed.
+  /// Both threads' work counters, summed.
   const CollisionStats& stats() const { return stats_; }
 
  private:
   /// The nodes kSplitDepth below the root (or leaves above it), depth first: the claims.
   void split(const SphereTree& tissue_tree);
   void run_share(std::uint32_t share);
-  /// Runs the shares (claimed by this thread and the helper, or all here should it not come in time)
-  /// and merges their pairs.
+  /// Runs both shares (the helper's on its thread, or both here should it not come in time) and
+  /// merges their pairs.
   bool run_shares();
 
   static constexpr int kSplitDepth = 6;  // up to 64 subtrees: far more than two threads need to even out
-  // Four: a helper woken from sleep (tens of microseconds in a VM) still takes a fair part of a
-  // sequence step of ~200 us; each share costs a Collider's buffers and a front of its own.
-  static constexpr std::uint32_t kSequenceShares = 4;
-  Collider colliders_[kSequenceShares];  // a query's: 0 and 1, one a thread; a sequence's: one a share
+  Collider colliders_[2];
   std::vector<std::int32_t> starts_;
-  std::vector<std::int32_t> sequence_shares_[kSequenceShares];  // each share's fixed subtrees
-  std::uint32_t share_count_ = 0;  // shares the last query ran
+  std::vector<std::int32_t> halves_[2];  // a sequence's: each thread's fixed subtrees
   struct Pending {
     std::int32_t node, depth;
   };
@@ -87,8 +79,8 @@ class ParallelCollider {
     bool sequence = false;
     double tissue_travel_m = 0.0;
   } query_;
-  bool share_ok_[kSequenceShares] = {};
-  std::vector<TrianglePair> pairs_, merged_;  // the shares' pairs merged, and the merge's other buffer
+  bool share_ok_[2] = {true, true};
+  std::vector<TrianglePair> pairs_;
   std::size_t pair_count_ = 0;
   CollisionStats stats_;
   std::unique_ptr<LoopHelper> helper_;  // last: its thread starts once the rest exists
