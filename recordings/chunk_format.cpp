@@ -18,6 +18,12 @@ std::uint32_t load_u32(const std::uint8_t* p) {
   return v;
 }
 
+std::uint16_t load_u16(const std::uint8_t* p) {
+  std::uint16_t v;
+  std::memcpy(&v, p, 2);
+  return v;
+}
+
 /// The chunk whose marker is at `pos`, if its frame is intact (CRC, plausible length, inside the
 /// file); `payload_ok` tells whether the payload's CRC holds too.
 bool parse_chunk_at(std::span<const std::uint8_t> file, std::uint64_t limit, std::uint64_t pos, ChunkLocation& chunk,
@@ -69,6 +75,24 @@ void append_chunk(std::vector<std::uint8_t>& out, ChunkType type, std::uint32_t 
   w.put(crc32_of(std::span<const std::uint8_t>(out.data() + frame_at, 16)));
   w.put_bytes(payload);
   w.put(crc32_of(payload));
+}
+
+std::string describe_chunk_at(std::span<const std::uint8_t> file, std::uint64_t pos) {
+  if (pos >= file.size()) return "the end of the file";
+  if (file.size() - pos < kChunkFrameBytes || load_u32(file.data() + pos) != kChunkMarker) return "no chunk marker";
+  const std::uint8_t* frame = file.data() + pos;
+  if (crc32_of(std::span<const std::uint8_t>(frame, 16)) != load_u32(frame + 16)) return "a chunk frame whose own CRC fails";
+  const std::string type(chunk_type_name(load_u16(frame + 4)));
+  const std::uint32_t payload = load_u32(frame + 12);
+  const std::uint64_t end = pos + kChunkFrameBytes + std::uint64_t{payload} + kChunkTrailerBytes;
+  if (payload > kMaxChunkPayloadBytes) return "a " + type + " chunk whose frame claims " + std::to_string(payload) + " bytes, past any real chunk";
+  if (end > file.size()) {
+    return "a " + type + " chunk whose frame claims " + std::to_string(payload) + " bytes, but the file ends at byte " + std::to_string(file.size()) +
+           " (cut short)";
+  }
+  const std::span<const std::uint8_t> body(frame + kChunkFrameBytes, payload);
+  if (crc32_of(body) != load_u32(frame + kChunkFrameBytes + payload)) return "a " + type + " chunk whose payload CRC fails";
+  return "a " + type + " chunk (" + std::to_string(payload) + " bytes)";
 }
 
 std::string describe(const DamagedRange& range) {

@@ -71,6 +71,12 @@ struct DamagedRange {
   bool frame_intact = false;
 };
 
+/// What the bytes at `pos` of `file` hold, for a reader that expected a chunk there: "a ticks chunk
+/// (3601 bytes)", "a header chunk whose frame claims 2335 bytes, but the file ends at byte 1000 (cut
+/// short)", "a header chunk whose payload CRC fails", "a chunk frame whose own CRC fails", "no chunk
+/// marker", or "the end of the file".
+std::string describe_chunk_at(std::span<const std::uint8_t> file, std::uint64_t pos);
+
 /// One line saying what a damaged range is and where ("keyframe chunk 80 at byte 223687 (3601 bytes):
 /// payload CRC mismatch"), as `rec info`, `rec verify` and the keyframe lookup print it.
 std::string describe(const DamagedRange& range);

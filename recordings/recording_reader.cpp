@@ -107,7 +107,11 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
         break;
     }
   }
-  if (!have_header) return Error{name + ": no intact header chunk (nothing to replay from)"};
+  if (!have_header) {
+    // Where it should be and what is there instead (audit 31, F6: every reader said only "no intact header").
+    return Error{name + ": no intact header chunk (nothing to replay from): at byte " + std::to_string(sizeof kFileSignature) + ", where the recorder " +
+                 "writes it, the file holds " + describe_chunk_at(r.bytes_, sizeof kFileSignature)};
+  }
   r.check_chunk_order();
 
   // Sorted by tick; a record seen twice (never written so, but a copied chunk could be) is kept once.
@@ -342,6 +346,37 @@ std::uint64_t tick_span(const std::vector<TickRecord>& ticks) {
 double Recording::duration_s() const { return static_cast<double>(tick_span(ticks_)) * header_.simulation.tick_s(); }
 
 std::uint64_t Recording::missing_ticks() const { return tick_span(ticks_) - ticks_.size(); }
+
+std::vector<std::pair<std::uint64_t, std::uint64_t>> Recording::tick_gaps() const {
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> gaps;
+  std::uint64_t next = static_cast<std::uint64_t>(header_.start_tick);
+  for (const TickRecord& t : ticks_) {
+    if (t.tick < next) continue;  // a tick held twice
+    if (t.tick > next) gaps.emplace_back(next, t.tick - 1);
+    next = t.tick + 1;
+  }
+  if (const std::optional<std::uint64_t> written = summary_count("ticks")) {
+    const std::uint64_t end = static_cast<std::uint64_t>(header_.start_tick) + *written;
+    if (end > next) gaps.emplace_back(next, end - 1);
+  }
+  return gaps;
+}
+
+std::string Recording::describe_tick_gaps() const {
+  const auto gaps = tick_gaps();
+  if (gaps.empty()) return {};
+  std::string text = "ticks ";
+  std::uint64_t count = 0;
+  constexpr std::size_t kMostNamed = 5;
+  for (std::size_t i = 0; i < gaps.size() && i < kMostNamed; ++i) {
+    const auto [first, last] = gaps[i];
+    if (i > 0) text += i + 1 == gaps.size() ? " and " : ", ";
+    text += std::to_string(first) + (last > first ? "-" + std::to_string(last) : "");
+  }
+  if (gaps.size() > kMostNamed) text += " and " + std::to_string(gaps.size() - kMostNamed) + " more runs";
+  for (const auto& [first, last] : gaps) count += last - first + 1;
+  return text + " (" + std::to_string(count) + " ticks)";
+}
 
 std::array<std::uint64_t, kChunkTypeCount> Recording::bytes_by_type() const {
   std::array<std::uint64_t, kChunkTypeCount> bytes{};

@@ -110,6 +110,12 @@ class Recording {
   double duration_s() const;
   /// Ticks between the first and the last recorded one that are not in the file (a gap a recovery left).
   std::uint64_t missing_ticks() const;
+  /// The runs of tick numbers (first, last) the procedure had that the file lacks: from the header's
+  /// start tick to the last recorded one, and past it up to the count in the recorder's summary (ticks
+  /// whose chunk is damaged, was removed, or was left out by a recovery).
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> tick_gaps() const;
+  /// tick_gaps() in words ("ticks 720-1439 and 2000 (721 ticks)"), empty when there are none.
+  std::string describe_tick_gaps() const;
   /// Bytes of intact chunks (frames included) by chunk type (index = ChunkType value).
   std::array<std::uint64_t, kChunkTypeCount> bytes_by_type() const;
   std::array<std::uint64_t, kChunkTypeCount> chunks_by_type() const;

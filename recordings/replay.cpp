@@ -105,12 +105,16 @@ std::string unverified_hashes(const Recording& recording, const Replayer& replay
   if (why.empty()) return why;
   const std::uint64_t in_file = recording.steps().size();
   const std::uint64_t verified = replayer.verified_hashes();
+  const std::uint64_t compared_count = verified + replayer.mismatches();
   // Said as it is: when every hash in the file was compared and matched, what fails is the file's
-  // word for the rest ("only 600 could be compared" of 600 read as a failed comparison; audit 25, F5).
+  // word for the rest ("only 600 could be compared" of 600 read as a failed comparison; audit 25, F5),
+  // and a hash that differed was compared ("only 0 of 180 could be compared" beside 180 mismatches;
+  // audit 31, F4).
   const std::string compared =
-      verified == in_file && replayer.mismatches() == 0
+      compared_count == in_file && replayer.mismatches() == 0
           ? "all " + std::to_string(in_file) + " collision steps' hashes in the file matched, which vouches for those alone"
-          : "only " + std::to_string(verified) + " of the " + std::to_string(in_file) + " collision steps' hashes in the file could be compared";
+          : std::to_string(compared_count) + " of the " + std::to_string(in_file) + " collision steps' hashes in the file could be compared (" +
+                std::to_string(verified) + " matched, " + std::to_string(replayer.mismatches()) + " differed)";
   const std::string remedy = recording.damaged().empty() ? "" : "; `resecto rec recover` keeps what is intact";
   return recording.name() + ": " + why + ": " + compared + remedy;
 }

@@ -116,6 +116,12 @@ void info(const InfoOptions& o) {
     if (name != "file" && count.get<std::uint64_t>() > 0) std::printf(" %s %llu", name.c_str(), static_cast<unsigned long long>(count.get<std::uint64_t>()));
   }
   std::printf("\n  index      %s; %zu damaged ranges\n", index_state(r).c_str(), r.damaged().size());
+  if (const std::string lost = r.describe_tick_gaps(); !lost.empty()) std::printf("  lost       %s of the procedure\n", lost.c_str());
+  const ordered_json& summary = r.summary();
+  if (summary.is_object() && summary.contains("run") && summary["run"].is_object() && summary["run"].contains("interrupted") &&
+      summary["run"]["interrupted"].is_string()) {
+    std::printf("  run        interrupted by %s: the procedure was cut short\n", summary["run"]["interrupted"].get<std::string>().c_str());
+  }
   for (const rec::DamagedRange& d : r.damaged()) std::printf("  damaged    %s\n", rec::describe(d).c_str());
 }
 
@@ -152,7 +158,14 @@ void verify(const std::string& file) {
                  static_cast<unsigned long long>(start), static_cast<unsigned long long>(r.ticks().front().tick));
     ++problems;
   }
-  if (problems > 0) throw std::runtime_error(file + ": " + std::to_string(problems) + " problem(s), " + std::to_string(r.chunks().size()) + " intact chunks");
+  if (problems > 0) {
+    // What the damage cost the procedure, in ticks (audit 31, F5: a removed ticks chunk showed only as
+    // bookkeeping lines).
+    if (const std::string lost = r.describe_tick_gaps(); !lost.empty()) {
+      std::fprintf(stderr, "%s: lost: %s of the procedure are not in the file; replay stops at the first\n", file.c_str(), lost.c_str());
+    }
+    throw std::runtime_error(file + ": " + std::to_string(problems) + " problem(s), " + std::to_string(r.chunks().size()) + " intact chunks");
+  }
   // Sound (every check above passed) but not the whole procedure: said with exit 0, not as "ok".
   const std::string sound = file + ": sound, " + std::to_string(r.chunks().size()) +
                             " chunks, every CRC matches, every keyframe decodes, index present; but ";
@@ -212,6 +225,12 @@ void export_recording(const ExportOptions& o) {
   if (o.inputs) {
     if (Status written = rec::export_inputs_csv(r, o.out); !written) throw std::runtime_error(written.error());
     std::printf("%s: %zu ticks' inputs\n", o.out.c_str(), r.ticks().size());
+    // Written, since what the file holds is the user's, but not passed off as the whole procedure
+    // (audit 31, F1: a CSV jumping from tick 719 to 1440, exit 0).
+    if (const std::string lost = r.describe_tick_gaps(); !lost.empty()) {
+      throw std::runtime_error(o.out + ": the CSV lacks " + lost + ": they are not in " + o.file +
+                               " (damaged or removed chunks; `resecto rec verify` names them)");
+    }
     return;
   }
   std::size_t k = 0;

@@ -68,10 +68,15 @@ void replay(const ReplayOptions& o) {
     if (!recording->closed()) {
       std::printf("  the recording was never closed (no index): it ends where its run stopped writing, not necessarily at the run's end\n");
     }
-    if (o.verify) {
-      std::printf("  %llu of %llu recorded hashes verified, %llu mismatches\n", static_cast<unsigned long long>(r.verified_hashes()),
-                  static_cast<unsigned long long>(written_steps), static_cast<unsigned long long>(r.mismatches()));
+    // Said with or without --verify: a replay that does not reproduce its recording is news either way
+    // (audit 31, F4: two different final hashes and not a word about 105 mismatches).
+    std::printf("  %llu of %llu recorded hashes verified, %llu mismatches", static_cast<unsigned long long>(r.verified_hashes()),
+                static_cast<unsigned long long>(written_steps), static_cast<unsigned long long>(r.mismatches()));
+    if (r.mismatches() > 0) {
+      std::printf(", the first at tick %llu: this replay does not reproduce the recording%s", static_cast<unsigned long long>(*r.first_mismatch_tick()),
+                  o.verify ? "" : " (`--verify` fails on it)");
     }
+    std::printf("\n");
   }
   if (o.verify && r.mismatches() > 0) {
     const std::uint64_t tick = *r.first_mismatch_tick();

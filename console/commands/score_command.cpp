@@ -106,7 +106,12 @@ void score(const ScoreOptions& o) {
   if (o.json) {
     nlohmann::ordered_json out = nlohmann::ordered_json::array();
     for (const RecordingScore& s : scored) {
-      out.push_back({{"file", s.file}, {"procedure", s.procedure}, {"ticks", s.ticks}, {"verified_hashes", s.verified_hashes},
+      out.push_back({{"file", s.file},
+                     {"procedure", s.procedure},
+                     {"ticks", s.ticks},
+                     {"verified_hashes", s.verified_hashes},
+                     {"surface_triangles", s.surface_triangles},
+                     {"interrupted", s.interrupted.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(s.interrupted)},
                      {"metrics", score_metrics_json(s.score.metrics)}});
     }
     nlohmann::ordered_json doc = {{"scored", out}, {"skipped", skipped}};
@@ -114,9 +119,10 @@ void score(const ScoreOptions& o) {
   } else {
     for (const RecordingScore& s : scored) {
       const ScoreMetrics& m = s.score.metrics;
-      std::printf("%s (%s, %.1f s): %.2f g resected (%.2f g adenoma, %.1f%% of it left), %.2f g/min, cuts %llu, perforations %llu, "
+      std::printf("%s (%s, %.1f s%s): %.2f g resected (%.2f g adenoma, %.1f%% of it left), %.2f g/min, cuts %llu, perforations %llu, "
                   "sphincter-zone violations %llu, pedal down with nothing cut %.2f s, tool path %.0f mm\n",
-                  s.file.c_str(), s.procedure.c_str(), m.procedure_time_s, m.resected_total_g, m.resected_adenoma_g,
+                  s.file.c_str(), s.procedure.c_str(), m.procedure_time_s, s.interrupted.empty() ? "" : (", interrupted by " + s.interrupted).c_str(),
+                  m.resected_total_g, m.resected_adenoma_g,
                   100.0 * m.remaining_adenoma_fraction, m.grams_per_minute, static_cast<unsigned long long>(m.cuts),
                   static_cast<unsigned long long>(m.perforations), static_cast<unsigned long long>(m.sphincter_zone_violations), m.loop_on_idle_s,
                   m.tool_path_mm);

@@ -117,8 +117,15 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
                   options.seconds > 0.0 ? "--seconds" : "the procedure's length", tick_s * simulation.physics_per_collision);
     return Error{text};
   }
-  Result<std::unique_ptr<Simulation>> created = Simulation::create(simulation);
+  Result<std::unique_ptr<Simulation>> created = [&] {
+    const EndAtOnceOnInterrupt nothing_written_yet;
+    return Simulation::create(simulation);
+  }();
   if (!created) return Error{created.error()};
+  // A signal noted before the build: the run never starts, so no file is made or replaced.
+  if (const int signal_number = interrupt_signal(); signal_number != 0) {
+    throw InterruptedRun(signal_number, "interrupted by " + signal_name(signal_number) + " before the first tick; nothing was run or written");
+  }
   Simulation& sim = **created;
   const SimulationConfig& config = sim.config();
   const auto period_ns = static_cast<std::int64_t>(std::llround(tick_s * 1e9));
@@ -296,7 +303,10 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   r["metrics"] = metrics_json(sim.metrics());
   r["score"] = score_metrics_json(score.finish(sim).metrics);
   if (recorder) {
-    Result<rec::RecorderCounters> recorded = recorder->finish({{"ticks", result.ticks}, {"state_hash", hex_hash(result.final_hash)}});
+    ordered_json run = {{"ticks", result.ticks}, {"state_hash", hex_hash(result.final_hash)}};
+    // So that a score of the file says the procedure was cut short, not finished (audit 31, F3).
+    if (result.interrupted_by != 0) run["interrupted"] = signal_name(result.interrupted_by);
+    Result<rec::RecorderCounters> recorded = recorder->finish(run);
     if (!recorded) return Error{"recording " + options.record_path + ": " + recorded.error()};
     r["recording"] = {{"path", options.record_path},
                       {"bytes", recorded->bytes},

@@ -19,6 +19,18 @@ int interrupt_signal();
 /// "SIGINT" or "SIGTERM".
 std::string signal_name(int signal_number);
 
+/// While one exists, a signal ends the process at once (exit 128 + its number, after a line on
+/// standard error) instead of being noted: for work that writes nothing and cannot poll, such as
+/// building a large model, where a noted Ctrl-C would wait minutes for the build to end only to stop
+/// the run before its first tick (audit 31, F3).
+class EndAtOnceOnInterrupt {
+ public:
+  EndAtOnceOnInterrupt();
+  ~EndAtOnceOnInterrupt();
+  EndAtOnceOnInterrupt(const EndAtOnceOnInterrupt&) = delete;
+  EndAtOnceOnInterrupt& operator=(const EndAtOnceOnInterrupt&) = delete;
+};
+
 /// Thrown after a run that a signal ended has written its outputs: main() prints the message and
 /// exits with 128 + the signal's number, the code a shell gives a process the signal killed.
 class InterruptedRun : public std::runtime_error {

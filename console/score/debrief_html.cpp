@@ -135,9 +135,12 @@ std::string plot_svg(const std::vector<ScoreSample>& series, const char* title, 
 }
 
 std::string section_for(const RecordingScore& s) {
-  std::string html = "<section><h2>" + escape(s.file) + "</h2><p>procedure <b>" + escape(s.procedure) + "</b>, " +
-                     number(s.score.metrics.procedure_time_s, 1) + " s simulated, " + std::to_string(s.verified_hashes) +
-                     " collision steps re-simulated and verified against the recording</p>";
+  std::string html = "<section><h2>" + escape(s.file) + "</h2><p>procedure <b>" + escape(s.procedure) + "</b> on a gland of " +
+                     std::to_string(s.surface_triangles) + " surface triangles, " + number(s.score.metrics.procedure_time_s, 1) + " s simulated, " +
+                     std::to_string(s.verified_hashes) + " collision steps re-simulated and verified against the recording</p>";
+  if (!s.interrupted.empty()) {
+    html += "<p class=\"warn\">The run was interrupted by " + escape(s.interrupted) + ": scored as far as it went, not as a finished procedure.</p>";
+  }
   html += "<h3>Plots over time</h3>";
   const std::vector<ScoreSample>& series = s.score.series;
   html += plot_svg(series, "Reaction force, largest of each step", "N", "#1d3557", [](const ScoreSample& x) { return x.force_n; });
@@ -194,7 +197,7 @@ std::string debrief_html(std::span<const RecordingScore> scores) {
       "td,th{border:1px solid #bbb;padding:3px 8px;font-size:13px;text-align:left}th{background:#eee}"
       ".cols{display:flex;gap:24px}.cols section{flex:1}.plot{display:block;margin:4px 0}.title{font-size:12px;font-weight:bold}"
       ".axis{font-size:10px;fill:#555}.legend span{display:inline-block;width:12px;height:12px;margin:0 4px 0 12px;vertical-align:middle}"
-      ".ref{color:#555;font-size:12px}</style></head><body><h1>Resecto debrief</h1>";
+      ".ref{color:#555;font-size:12px}.warn{color:#9d0208;font-weight:bold}</style></head><body><h1>Resecto debrief</h1>";
   html += "<h2>Metrics</h2><table><tr><th>Metric</th><th>Unit</th>";
   for (const RecordingScore& s : scores) html += "<th>" + escape(s.file) + "</th>";
   html += "<th>Reference (literature figures and targets)</th></tr>";

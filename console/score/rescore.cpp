@@ -115,7 +115,7 @@ ordered_json score_metrics_json(const ScoreMetrics& m) {
 }
 
 std::string score_csv_header() {
-  std::string line = "file,procedure,ticks";
+  std::string line = "file,procedure,ticks,surface_triangles,interrupted";
   for_each_scalar(ScoreMetrics{}, [&](const char* name, double) { line += std::string(",") + name; });
   return line + ",lobe_order,blood_loss_ml_per_g,irrigant_l_per_g\n";
 }
@@ -127,7 +127,8 @@ std::string score_csv_row(const RecordingScore& s) {
     for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
     return out + "\"";
   };
-  std::string line = quoted(s.file) + "," + quoted(s.procedure) + "," + std::to_string(s.ticks);
+  std::string line = quoted(s.file) + "," + quoted(s.procedure) + "," + std::to_string(s.ticks) + "," + std::to_string(s.surface_triangles) + "," +
+                     s.interrupted;
   for_each_scalar(s.score.metrics, [&](const char* name, double v) {
     char number[64];
     if (!has_value(s.score.metrics, name)) {
@@ -168,6 +169,20 @@ Result<RecordingScore> score_recording(const std::filesystem::path& path, const 
   if (std::string lost = lost_part_of_procedure(*recording); !lost.empty())
     return Error{name + ": " + lost + "; a score from part of a procedure would mislead"};
   if (recording->replayable_ticks() == 0) return Error{name + ": no recorded input to replay"};
+  const auto period = static_cast<std::uint64_t>(recording->header().simulation.physics_per_collision);
+  if (recording->replayable_ticks() < period) {
+    return Error{name + ": it holds " + std::to_string(recording->replayable_ticks()) + " ticks, less than one collision step (" + std::to_string(period) +
+                 "): no procedure to score"};
+  }
+  // A run a signal ended is scored as far as it went, and said to be cut short (audit 31, F3: it
+  // scored as a finished procedure in a cohort).
+  const nlohmann::ordered_json& run = recording->summary().is_object() ? recording->summary().value("run", nlohmann::ordered_json::object())
+                                                                      : nlohmann::ordered_json::object();
+  const std::string interrupted = run.is_object() && run.contains("interrupted") && run["interrupted"].is_string() ? run["interrupted"].get<std::string>() : "";
+  if (!interrupted.empty()) {
+    const std::string cut = "the run was interrupted by " + interrupted + ": scored as far as it went, not as a finished procedure";
+    note = note.empty() ? name + ": " + cut : note + "; " + cut;
+  }
   if (recording->replayable_ticks() != recording->ticks().size()) {
     return Error{name + ": recorded input breaks at tick " + std::to_string(recording->replayable_ticks())};
   }
@@ -177,7 +192,6 @@ Result<RecordingScore> score_recording(const std::filesystem::path& path, const 
   const Simulation& sim = replayer.simulation();
   ScoreTracker tracker(sim);
   const std::uint64_t end = replayer.end_tick();
-  const std::uint64_t period = static_cast<std::uint64_t>(sim.config().physics_per_collision);
   const std::uint64_t report_every = std::max<std::uint64_t>(period, end / 50);
   std::uint64_t next_report = report_every;
   // Collision ticks are the multiples of the period; observe after each has run.
@@ -201,6 +215,8 @@ Result<RecordingScore> score_recording(const std::filesystem::path& path, const 
   out.procedure = recording->header().procedure;
   out.ticks = sim.tick();
   out.verified_hashes = replayer.verified_hashes();
+  out.surface_triangles = recording->header().surface_triangles;
+  out.interrupted = interrupted;
   out.note = note;
   out.score = tracker.finish(sim);
   return out;

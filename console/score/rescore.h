@@ -21,7 +21,11 @@ struct RecordingScore {
   std::string procedure;       ///< as the recording's header names it
   std::uint64_t ticks = 0;
   std::uint64_t verified_hashes = 0;
-  /// Why a damaged file was scored anyway (its damage lost no tick or command), or empty.
+  /// The gland's surface triangles (the model's resolution: scores of different ones differ).
+  std::uint32_t surface_triangles = 0;
+  /// The signal that ended the run before its procedure did ("SIGINT"), or empty when it ran to its end.
+  std::string interrupted;
+  /// Why a damaged or interrupted file was scored anyway, or empty.
   std::string note;
   ProcedureScore score;
 };

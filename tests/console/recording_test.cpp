@@ -131,6 +131,10 @@ TEST(RecordingCommands, AnInputAlteredAtOneTickIsReportedAtThatTick) {
   EXPECT_NE(replay.exit_code, 0);
   EXPECT_EQ(json_of(replay)["first_mismatch_tick"], altered_tick);
   EXPECT_NE(replay.err.find("first at tick 960"), std::string::npos) << replay.err;
+  // Without --verify the replay still says that it does not reproduce the recording, and where.
+  const testing::CommandOutput plain = run_resecto("replay " + altered.string());
+  EXPECT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_NE(plain.out.find("mismatches, the first at tick 960: this replay does not reproduce the recording"), std::string::npos) << plain.out;
   // The unaltered file still verifies.
   EXPECT_EQ(run_resecto("replay " + file.string() + " --verify").exit_code, 0);
 }
@@ -387,6 +391,60 @@ TEST(RecordingCommands, TicksLostFromTheEndOrAnEditedHeaderAreNamed) {
   EXPECT_NE(replayed.err.find("'s header says " + std::to_string(r->header().nodes + 1) + " nodes"), std::string::npos) << replayed.err;
 }
 
+TEST(RecordingCommands, TicksLostInTheMiddleAreNamedAndNoExportPassesOverThem) {
+  const auto [dir, file, r] = record_and_open("recording_lost_middle", "--seconds 2");
+  ASSERT_TRUE(r);
+  // The second ticks chunk left out, the rest (with a new index) intact.
+  const auto gapped = dir / "gapped.rsrec";
+  int ticks_chunks = 0;
+  std::uint64_t lost_first = 0, lost_last = 0;
+  rewrite(*r, gapped, [&](const rec::ChunkLocation& chunk, std::vector<std::uint8_t>& payload) {
+    if (!is(chunk, rec::ChunkType::kTicks) || ++ticks_chunks != 2) return true;
+    const auto ticks = rec::decode_tick_block(payload);
+    EXPECT_TRUE(ticks && !ticks->empty());
+    lost_first = ticks->front().tick;
+    lost_last = ticks->back().tick;
+    return false;
+  });
+  const std::string lost = "ticks " + std::to_string(lost_first) + "-" + std::to_string(lost_last);
+  const Result<rec::Recording> opened = rec::Recording::open(gapped);
+  ASSERT_TRUE(opened);
+  ASSERT_EQ(opened->tick_gaps().size(), 1u);
+  EXPECT_EQ(opened->tick_gaps().front(), std::make_pair(lost_first, lost_last));
+  const testing::CommandOutput verify = run_resecto("rec verify " + gapped.string());
+  EXPECT_NE(verify.out.find("only "), std::string::npos) << verify.out;
+  const testing::CommandOutput info = run_resecto("rec info " + gapped.string());
+  EXPECT_NE(info.out.find("lost       " + lost), std::string::npos) << info.out;
+  // The inputs that are there are written, but the command fails, naming what the CSV lacks.
+  const testing::CommandOutput exported = run_resecto("rec export " + gapped.string() + " --inputs -o " + (dir / "inputs.csv").string());
+  EXPECT_EQ(exported.exit_code, 1);
+  EXPECT_NE(exported.err.find("the CSV lacks " + lost), std::string::npos) << exported.err;
+  EXPECT_TRUE(std::filesystem::exists(dir / "inputs.csv"));
+  // Damage in a ticks chunk of the original file: verify names the ticks it cost.
+  const auto damaged = dir / "damaged.rsrec";
+  ticks_chunks = 0;
+  for (const rec::ChunkLocation& chunk : r->chunks()) {
+    if (is(chunk, rec::ChunkType::kTicks) && ++ticks_chunks == 2) write_with_a_bit_flipped(*r, chunk, 0x10, damaged);
+  }
+  const testing::CommandOutput failed = run_resecto("rec verify " + damaged.string());
+  EXPECT_EQ(failed.exit_code, 1);
+  EXPECT_NE(failed.err.find("lost: " + lost), std::string::npos) << failed.err;
+}
+
+TEST(RecordingCommands, AFileCutInsideItsHeaderSaysWhereAndWhat) {
+  const auto [dir, file, r] = record_and_open("recording_cut_header", "--seconds 1");
+  ASSERT_TRUE(r);
+  const auto cut = dir / "cut.rsrec";
+  std::ofstream(cut, std::ios::binary).write(reinterpret_cast<const char*>(r->bytes().data()), 200);
+  for (const std::string command : {"rec verify ", "replay ", "score "}) {
+    const testing::CommandOutput out = run_resecto(command + cut.string());
+    EXPECT_NE(out.exit_code, 0) << command;
+    EXPECT_NE(out.err.find("at byte 8, where the recorder writes it, the file holds a header chunk whose frame claims "), std::string::npos)
+        << command << out.err;
+    EXPECT_NE(out.err.find("but the file ends at byte 200 (cut short)"), std::string::npos) << command << out.err;
+  }
+}
+
 TEST(RecordingCommands, ADeviceOrPipeIsNeverReadAsARecording) {
   // /dev/zero read as a recording filled the memory; a pipe with no writer hung.
   const auto dir = scratch_directory("recording_not_a_file");
@@ -608,7 +666,43 @@ TEST(RecordingCommands, CtrlCOrSigtermEndsARunWithEveryOutputWholeAndTheShellsEx
     EXPECT_EQ(run_resecto("mesh check " + surface.string()).exit_code, 0) << name;
     // No temporary is left beside the outputs.
     for (const auto& entry : std::filesystem::directory_iterator(dir)) EXPECT_NE(entry.path().extension(), ".tmp") << entry.path();
+    // The file says it was cut short: its score is of the procedure as far as it went, and says so.
+    const testing::CommandOutput scored = run_resecto("score " + file.string() + " --json --quiet");
+    ASSERT_EQ(scored.exit_code, 0) << scored.err;
+    EXPECT_EQ(json_of(scored)["scored"][0]["interrupted"], name);
+    EXPECT_NE(scored.err.find("the run was interrupted by " + name + ": scored as far as it went"), std::string::npos) << scored.err;
+    EXPECT_NE(run_resecto("rec info " + file.string()).out.find("interrupted by " + name), std::string::npos) << name;
   }
+}
+
+TEST(RecordingCommands, ASignalWhileTheModelIsBuiltEndsTheRunAtOnceAndTouchesNoFile) {
+  const auto dir = scratch_directory("recording_interrupted_build");
+  const auto file = dir / "kept.rsrec";
+  std::ofstream(file) << "a file of the user's\n";
+  const auto err = dir / "err.txt";
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::freopen(err.c_str(), "w", stderr);
+    std::vector<std::string> words{RESECTO_EXE, "run", "--headless", "--procedure", "demo", "--triangles", "138240", "--record", file.string()};
+    std::vector<char*> argv;
+    for (std::string& word : words) argv.push_back(word.data());
+    argv.push_back(nullptr);
+    ::execv(RESECTO_EXE, argv.data());
+    ::_exit(127);
+  }
+  // The 138,240-triangle model takes seconds to build (far longer under the sanitizers); 1 s in, the build is under way.
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  const auto signalled = std::chrono::steady_clock::now();
+  ::kill(child, SIGINT);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  const double waited_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - signalled).count();
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  EXPECT_LT(waited_s, 2.0) << "the run waited for the build to end";
+  EXPECT_EQ(testing::read_text(file), "a file of the user's\n");
+  EXPECT_NE(testing::read_text(err).find("interrupted while the model was being built; nothing was run or written"), std::string::npos);
 }
 
 }  // namespace

@@ -156,7 +156,9 @@ TEST(ScoreCommand, CohortCsvSkipsTheDamagedRecording) {
   std::vector<std::string> rows;
   while (std::getline(csv, line)) rows.push_back(line);
   ASSERT_EQ(rows.size(), 1u + kCohort);
-  EXPECT_EQ(rows[0].rfind("file,procedure,ticks,procedure_time_s,", 0), 0u) << rows[0];
+  // Each row says its gland's resolution and whether its run was interrupted (empty: it ran to its end).
+  EXPECT_EQ(rows[0].rfind("file,procedure,ticks,surface_triangles,interrupted,procedure_time_s,", 0), 0u) << rows[0];
+  EXPECT_NE(rows[1].find(",1302,,"), std::string::npos) << rows[1];
   const auto columns = std::count(rows[0].begin(), rows[0].end(), ',');
   for (int i = 1; i <= kCohort; ++i) {
     EXPECT_EQ(std::count(rows[static_cast<std::size_t>(i)].begin(), rows[static_cast<std::size_t>(i)].end(), ','), columns) << rows[static_cast<std::size_t>(i)];
