@@ -9,6 +9,7 @@
 
 #include "console/commands/checked_options.h"
 #include "console/commands/command_registry.h"
+#include "console/commands/large_model_notice.h"
 #include "console/commands/parameter_options.h"
 #include "console/gui/console_app.h"
 #include "console/gui/tissue_presets.h"
@@ -118,6 +119,7 @@ void open_console(const ConsoleCliOptions& o) {
   options.vsync = !o.no_vsync;
   options.view_scale = o.view_scale;
   catch_interrupts();
+  note_large_model(static_cast<std::size_t>(options.core.simulation.prostate_triangles), "a gland of");
   Result<nlohmann::ordered_json> report = gui::run_console(options);
   if (!report) throw std::runtime_error(report.error());
   std::fputs(gui::summarize_console_report(*report).c_str(), stdout);

@@ -12,6 +12,7 @@
 
 #include "console/commands/checked_options.h"
 #include "console/commands/command_registry.h"
+#include "console/commands/large_model_notice.h"
 #include "rtcore/anatomy/landmarks_file.h"
 #include "rtcore/anatomy/prostate.h"
 #include "rtcore/anatomy/resectoscope.h"
@@ -190,6 +191,7 @@ void register_tetra(CLI::App& mesh) {
       if (!axis) fail(axis.error());
       tet.channel_axis = *axis;
     }
+    note_large_model(surface->triangle_count(), "TetGen's tetrahedra for");
     const auto start = std::chrono::steady_clock::now();
     Result<TetMesh> tetra = tetrahedralize(*surface, tet);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

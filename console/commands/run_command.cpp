@@ -13,6 +13,7 @@
 
 #include "console/commands/checked_options.h"
 #include "console/commands/command_registry.h"
+#include "console/commands/large_model_notice.h"
 #include "console/commands/console_command.h"
 #include "console/commands/parameter_options.h"
 #include "console/headless/headless_run.h"
@@ -128,6 +129,7 @@ void run(const RunOptions& o) {
   }
 
   catch_interrupts();
+  note_large_model(static_cast<std::size_t>(options.simulation.prostate_triangles), "a gland of");
   Result<HeadlessResult> result = run_headless(options);
   if (!result) throw std::runtime_error(result.error());
   if (!o.report.empty()) {

@@ -504,7 +504,11 @@ Result<ordered_json> run_console(const ConsoleOptions& options) {
 
   CoreSessionOptions core = options.core;
   core.simulation.parameters = options.settings.parameters;
-  Result<std::unique_ptr<CoreSession>> created = CoreSession::create(core);
+  Result<std::unique_ptr<CoreSession>> created = [&] {
+    // Nothing is written yet: a Ctrl-C during a large model's build ends the console at once.
+    const EndAtOnceOnInterrupt nothing_written_yet;
+    return CoreSession::create(core);
+  }();
   if (!created) {
     glfwDestroyWindow(window);
     return Error{created.error()};

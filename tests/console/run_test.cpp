@@ -9,12 +9,25 @@
 
 #include <nlohmann/json.hpp>
 
+#include "console/commands/large_model_notice.h"
 #include "tests/console/run_resecto.h"
 
 namespace resecto::testing {
 namespace {
 
 const char* kShortRun = "run --headless --triangles 1296 --seconds 2.5";
+
+// A build of minutes and gigabytes is announced before it starts; a model of seconds is not.
+TEST(RunCommand, ALargeModelIsAnnouncedBeforeItsBuild) {
+  ::testing::internal::CaptureStderr();
+  cli::note_large_model(cli::kLargeModelTriangles, "a gland of");
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+  ::testing::internal::CaptureStderr();
+  cli::note_large_model(1'000'000, "a gland of");
+  const std::string note = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(note.find("note: building a gland of 1000000 surface triangles takes a while"), std::string::npos) << note;
+  EXPECT_NE(note.find("Ctrl-C ends it at once"), std::string::npos) << note;
+}
 
 TEST(RunCommand, ReportFollowsTheContractAndTheTraceMatchesIt) {
   const auto dir = scratch_directory("run_report");
