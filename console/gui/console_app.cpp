@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <thread>
+#include <vector>
 
 #include "console/gui/console_controller.h"
 #include "console/gui/console_panels.h"
@@ -78,6 +79,8 @@ class ConsoleWindow {
   void layout_and_draw();
   void draw_endoscope_window(const ImVec2& pos, const ImVec2& size);
   void draw_outside_window(const ImVec2& pos, const ImVec2& size);
+  /// The landmarks' names beside their markers in the outside view, none over another.
+  void draw_landmark_labels(ImDrawList* draw, const ImVec2& origin, const CameraView& camera, float w, float h) const;
   int scaled(int pixels) const { return std::max(16, static_cast<int>(std::lround(pixels * options_.view_scale))); }
   bool slowed(std::uint64_t frame) const { return options_.slow_frame_ms > 0.0 && (frame + 1) % options_.slow_frame_every == 0; }
 
@@ -229,6 +232,46 @@ void ConsoleWindow::draw_endoscope_window(const ImVec2& pos, const ImVec2& size)
   ImGui::PopStyleVar();
 }
 
+void ConsoleWindow::draw_landmark_labels(ImDrawList* draw, const ImVec2& origin, const CameraView& camera, float w, float h) const {
+  // Landmarks a few millimetres apart (the apex and the external sphincter) project onto one spot from
+  // most orbits: each label, top to bottom, is moved down below any placed one it would overlap, with
+  // a line back to its marker, so every name stays readable.
+  struct Label {
+    ImVec2 marker, at, size;
+    const char* text;
+  };
+  std::vector<Label> labels;
+  for (const Landmark& l : scene_->landmarks()) {
+    const ProjectedPoint p = SceneRenderer::project(camera, l.position, w, h);
+    if (!p.visible) continue;
+    const ImVec2 marker(origin.x + p.x, origin.y + p.y);
+    const ImVec2 size = ImGui::CalcTextSize(l.name.c_str());
+    // Right of the marker, or left of it where the view's edge would cut the name.
+    const float x = marker.x + 8 + size.x <= origin.x + w ? marker.x + 8 : marker.x - 8 - size.x;
+    labels.push_back({marker, ImVec2(x, marker.y - 7), size, l.name.c_str()});
+  }
+  std::stable_sort(labels.begin(), labels.end(), [](const Label& a, const Label& b) { return a.at.y < b.at.y; });
+  const auto overlap = [](const Label& a, const Label& b) {
+    return a.at.x < b.at.x + b.size.x && b.at.x < a.at.x + a.size.x && a.at.y < b.at.y + b.size.y && b.at.y < a.at.y + a.size.y;
+  };
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (std::size_t j = 0; j < i; ++j) {
+        if (!overlap(labels[i], labels[j])) continue;
+        labels[i].at.y = labels[j].at.y + labels[j].size.y + 1.0f;
+        moved = true;
+      }
+    }
+    const Label& l = labels[i];
+    if (l.at.y > l.marker.y) {
+      const float edge = l.at.x > l.marker.x ? l.at.x : l.at.x + l.size.x;
+      draw->AddLine(l.marker, ImVec2(edge, l.at.y + 0.5f * l.size.y), IM_COL32(255, 255, 255, 120));
+    }
+    draw->AddText(l.at, IM_COL32(255, 255, 255, 230), l.text);
+  }
+}
+
 void ConsoleWindow::draw_outside_window(const ImVec2& pos, const ImVec2& size) {
   ImGui::SetNextWindowPos(pos);
   ImGui::SetNextWindowSize(size);
@@ -249,12 +292,7 @@ void ConsoleWindow::draw_outside_window(const ImVec2& pos, const ImVec2& size) {
     if (ImGui::IsMouseDragging(ImGuiMouseButton_Left)) ui_.orbit.drag(io.MouseDelta.x, io.MouseDelta.y);
     if (io.MouseWheel != 0.0f) ui_.orbit.zoom(io.MouseWheel);
   }
-  ImDrawList* draw = ImGui::GetWindowDrawList();
-  for (const Landmark& l : scene_->landmarks()) {
-    const ProjectedPoint p = SceneRenderer::project(camera, l.position, float(w), float(h));
-    if (!p.visible) continue;
-    draw->AddText(ImVec2(origin.x + p.x + 8, origin.y + p.y - 7), IM_COL32(255, 255, 255, 230), l.name.c_str());
-  }
+  draw_landmark_labels(ImGui::GetWindowDrawList(), origin, camera, float(w), float(h));
   ImGui::End();
   ImGui::PopStyleVar();
 }
