@@ -347,6 +347,12 @@ double Recording::duration_s() const { return static_cast<double>(tick_span(tick
 
 std::uint64_t Recording::missing_ticks() const { return tick_span(ticks_) - ticks_.size(); }
 
+std::string Recording::interrupted_by() const {
+  if (!summary_.is_object() || !summary_.contains("run") || !summary_["run"].is_object()) return {};
+  const nlohmann::ordered_json& run = summary_["run"];
+  return run.contains("interrupted") && run["interrupted"].is_string() ? run["interrupted"].get<std::string>() : std::string();
+}
+
 std::vector<std::pair<std::uint64_t, std::uint64_t>> Recording::tick_gaps() const {
   std::vector<std::pair<std::uint64_t, std::uint64_t>> gaps;
   std::uint64_t next = static_cast<std::uint64_t>(header_.start_tick);

@@ -101,6 +101,9 @@ class Recording {
   /// `lost.<kind>`): what it wrote, which the file may no longer hold. None when the file was never
   /// closed (a cut or killed run, or a recovery of one) or its summary is lost.
   std::optional<std::uint64_t> summary_count(std::string_view key) const;
+  /// The signal that ended the recorded run before its procedure did ("SIGINT", from the summary),
+  /// or empty: it ran to its end, or the file was never closed (nothing says).
+  std::string interrupted_by() const;
   /// The damaged ranges `rec recover` left out when it made this file, over every recovery of it; 0
   /// for a file no recovery made. What they held is lost, though the file itself is sound.
   std::uint64_t recovered_damaged_ranges() const;

@@ -117,10 +117,8 @@ void info(const InfoOptions& o) {
   }
   std::printf("\n  index      %s; %zu damaged ranges\n", index_state(r).c_str(), r.damaged().size());
   if (const std::string lost = r.describe_tick_gaps(); !lost.empty()) std::printf("  lost       %s of the procedure\n", lost.c_str());
-  const ordered_json& summary = r.summary();
-  if (summary.is_object() && summary.contains("run") && summary["run"].is_object() && summary["run"].contains("interrupted") &&
-      summary["run"]["interrupted"].is_string()) {
-    std::printf("  run        interrupted by %s: the procedure was cut short\n", summary["run"]["interrupted"].get<std::string>().c_str());
+  if (const std::string signal = r.interrupted_by(); !signal.empty()) {
+    std::printf("  run        interrupted by %s: the procedure was cut short\n", signal.c_str());
   }
   for (const rec::DamagedRange& d : r.damaged()) std::printf("  damaged    %s\n", rec::describe(d).c_str());
 }

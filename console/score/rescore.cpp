@@ -176,9 +176,7 @@ Result<RecordingScore> score_recording(const std::filesystem::path& path, const 
   }
   // A run a signal ended is scored as far as it went, and said to be cut short (audit 31, F3: it
   // scored as a finished procedure in a cohort).
-  const nlohmann::ordered_json& run = recording->summary().is_object() ? recording->summary().value("run", nlohmann::ordered_json::object())
-                                                                      : nlohmann::ordered_json::object();
-  const std::string interrupted = run.is_object() && run.contains("interrupted") && run["interrupted"].is_string() ? run["interrupted"].get<std::string>() : "";
+  const std::string interrupted = recording->interrupted_by();
   if (!interrupted.empty()) {
     const std::string cut = "the run was interrupted by " + interrupted + ": scored as far as it went, not as a finished procedure";
     note = note.empty() ? name + ": " + cut : note + "; " + cut;
