@@ -29,7 +29,7 @@ inline CLI::Validator finite_range(double lo, double hi) {
   return CLI::Validator(
       [lo, hi](std::string& text) -> std::string {
         const std::optional<double> value = parse_finite(text);
-        if (!value) return "'" + text + "' is not a finite number";
+        if (!value) return "'" + text + "' is " + not_finite_kind(text);
         if (!in_closed_range(*value, lo, hi)) {
           return exact_number(*value) + " is outside [" + exact_number(lo) + ", " + exact_number(hi) + "]";
         }
@@ -44,7 +44,7 @@ inline CLI::Validator finite_at_least(double lo) {
   return CLI::Validator(
       [lo](std::string& text) -> std::string {
         const std::optional<double> value = parse_finite(text);
-        if (!value) return "'" + text + "' is not a finite number";
+        if (!value) return "'" + text + "' is " + not_finite_kind(text);
         if (!(*value >= lo)) return exact_number(*value) + " is below " + exact_number(lo);
         return std::string();
       },
@@ -56,7 +56,7 @@ inline CLI::Validator positive_up_to(double hi) {
   return CLI::Validator(
       [hi](std::string& text) -> std::string {
         const std::optional<double> value = parse_finite(text);
-        if (!value) return "'" + text + "' is not a finite number";
+        if (!value) return "'" + text + "' is " + not_finite_kind(text);
         if (!(*value > 0.0 && *value <= hi)) return exact_number(*value) + " is outside (0, " + exact_number(hi) + "]";
         return std::string();
       },

@@ -56,4 +56,15 @@ inline std::optional<double> parse_finite(std::string_view text) {
   return value;
 }
 
+/// What `text`, refused by parse_finite, is not: "not a finite number" when it reads as a number that
+/// is not finite ("nan", "-inf", "1e999"), "not a number" when it reads as no number at all ("0x1p3",
+/// "1.0mm", "1,5"): calling those "not finite" sent readers looking for an overflow.
+inline const char* not_finite_kind(std::string_view text) {
+  double value = 0.0;
+  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  const bool whole = !text.empty() && end == text.data() + text.size() && (error == std::errc{} || error == std::errc::result_out_of_range);
+  return whole ? "not a finite number" : "not a number";
+}
+
 }  // namespace resecto

@@ -110,7 +110,7 @@ std::optional<std::int64_t> parse_integer(std::string_view word) {
 
 Result<double> coordinate(const TextLines& lines, std::string_view word) {
   const std::optional<double> value = parse_finite(word);
-  if (!value) return lines.error_at(word, quoted_word(word) + " is not a finite number");
+  if (!value) return lines.error_at(word, quoted_word(word) + " is " + not_finite_kind(word));
   return *value;
 }
 
@@ -380,6 +380,7 @@ struct PlyProperty {
   PlyType type = PlyType::float32;
   bool is_list = false;
   PlyType count_type = PlyType::uint8;
+  int line = 0;  // of the header, for naming a property declared twice
 };
 
 struct PlyElement {
@@ -405,7 +406,10 @@ class PlyBody {
       if (start == offset_) return Error{name_ + ": the file ends inside " + what + " (truncated?)"};
       const std::string_view word = body_.substr(start, offset_ - start);
       const std::optional<double> value = ply_integral(type) ? to_double(parse_integer(word)) : parse_finite(word);
-      if (!value) return Error{name_ + ": byte " + std::to_string(body_offset_ + start) + ": " + what + " " + quoted_word(word) + " is not a " + (ply_integral(type) ? "whole number" : "finite number")};
+      if (!value) {
+        return Error{name_ + ": byte " + std::to_string(body_offset_ + start) + ": " + what + " " + quoted_word(word) + " is " +
+                     (ply_integral(type) ? "not a whole number" : not_finite_kind(word))};
+      }
       return *value;
     }
     const std::size_t size = ply_size(type);
@@ -513,6 +517,16 @@ Result<RawMesh> parse_ply(std::string_view text, const std::string& name) {
       } else {
         return lines.error("expected 'property <type> <name>' or 'property list <count type> <item type> <name>'");
       }
+      // Two columns of one name: which one the reader took was arbitrary (the later one, silently), and a
+      // wrong one showed only as some face's degenerate triangle far from the header line at fault.
+      for (const PlyProperty& earlier : elements.back().properties) {
+        if (earlier.name == property.name) {
+          return lines.error_at(property.name, "element '" + std::string(elements.back().name) + "' declares property " +
+                                                   quoted_word(property.name) + " twice (first on line " + std::to_string(earlier.line) +
+                                                   ")");
+        }
+      }
+      property.line = lines.number();
       elements.back().properties.push_back(property);
     } else {
       return lines.error_at(keyword, "unknown header line " + quoted_word(keyword));

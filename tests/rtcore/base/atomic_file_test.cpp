@@ -183,6 +183,11 @@ TEST(CheckedNumber, NanIsNeverInRangeAndValuesPrintExactly) {
   EXPECT_EQ(parse_finite("-1e-400").value(), 0.0);
   EXPECT_GT(parse_finite("4e-320").value(), 0.0);  // subnormal
   EXPECT_FALSE(parse_finite("-1e309"));
+  // Audit 6, B: what a refused word is not, for the message.
+  for (const char* word : {"0x1p3", "1.0mm", "1,5", "", "+", "--1", "1e", "\xEF\xBC\x91"})
+    EXPECT_STREQ(not_finite_kind(word), "not a number") << word;
+  for (const char* word : {"nan", "-inf", "+inf", "infinity", "1e999", "-1e309"})
+    EXPECT_STREQ(not_finite_kind(word), "not a finite number") << word;
 }
 
 }  // namespace

@@ -288,7 +288,8 @@ TEST(MeshFiles, MalformedWordsAreNamedForWhatTheyAre) {
   const std::string cube = cube_off();
   std::string with_nul = cube;
   with_nul.insert(with_nul.find("1 1 1\n") + 5, std::string(1, '\0'));
-  EXPECT_NE(validation_error(write_file("nul.off", with_nul)).find("'1\\x00' is not a finite number"), std::string::npos) << "the NUL printed, not cutting the message";
+  EXPECT_NE(validation_error(write_file("nul.off", with_nul)).find("'1\\x00' is not a number"), std::string::npos)
+      << "the NUL printed, not cutting the message";
   std::string fractional = cube;
   fractional.replace(fractional.find("3 1 6 5"), 7, "3 1 6.0 5");
   EXPECT_NE(validation_error(write_file("fraction.off", fractional)).find("vertex index '6.0' is not a whole number"), std::string::npos);
@@ -311,6 +312,41 @@ TEST(MeshFiles, MalformedWordsAreNamedForWhatTheyAre) {
   for (const char* v : {"0 0 0", "1 0 0", "1 1 0", "0 1 0", "0 0 1", "1 0 1", "1 1 1", "0 1 1"}) ply += std::string(v) + " 7\n";
   for (const auto& t : kCubeFaces) ply += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + "\n";
   EXPECT_NE(validation_error(write_file("extra.ply", ply)).find("vertex 0 has a value past its 3 properties: '7'"), std::string::npos);
+}
+
+// Audit 6, B: "0x1p3", "1.0mm" and "1,5" were each called "not a finite number", which reads as an
+// overflow; they are no number at all. NaN, infinity and overflow stay "not a finite number".
+TEST(MeshFiles, WordsThatAreNoNumberAreToldFromNonFiniteOnes) {
+  const std::string cube = cube_off();
+  const std::pair<const char*, const char*> words[] = {{"0x1p3", "is not a number"},       {"1.0mm", "is not a number"},
+                                                       {"1,5", "is not a number"},         {"nan", "is not a finite number"},
+                                                       {"-inf", "is not a finite number"}, {"1e999", "is not a finite number"}};
+  for (const auto& [word, says] : words) {
+    std::string bad = cube;
+    bad.replace(bad.find("1 1 1\n"), 1, word);
+    EXPECT_EQ(validation_error(write_file("word.off", bad)), scratch("word.off").string() + ":9:1: '" + word + "' " + says) << word;
+  }
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nelement face 0\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  EXPECT_NE(validation_error(write_file("word.ply", ply + "1.0mm 0 0\n")).find("vertex 0 x '1.0mm' is not a number"), std::string::npos);
+  EXPECT_NE(validation_error(write_file("word.ply", ply + "inf 0 0\n")).find("vertex 0 x 'inf' is not a finite number"), std::string::npos);
+}
+
+// Audit 6, B: a second `property float x` silently replaced the first column, and the file failed
+// later as a degenerate triangle on some face.
+TEST(MeshFiles, APlyPropertyDeclaredTwiceInAnElementIsRefused) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\nproperty float x\n"
+      "element face 12\nproperty list uchar int vertex_indices\nend_header\n";
+  EXPECT_EQ(validation_error(write_file("twice.ply", header)),
+            scratch("twice.ply").string() + ":7:16: element 'vertex' declares property 'x' twice (first on line 4)");
+  // The same name in two elements is two properties.
+  const std::string apart =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nproperty float x\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 5\n";
+  const Result<TriangleMesh> read = read_surface_mesh(write_file("apart.ply", apart));
+  EXPECT_TRUE(read) << read.error();
 }
 
 TEST(MeshFiles, AsciiStlMayStartWithAByteOrderMark) {
