@@ -3,8 +3,10 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -13,6 +15,7 @@
 #include "rtcore/base/atomic_file.h"
 #include "rtcore/base/checked_number.h"
 #include "rtcore/base/json_text.h"
+#include "rtcore/base/quoted_word.h"
 #include "rtcore/base/text_file.h"
 #include "rtcore/base/units.h"
 #include "rtcore/geometry/rigid_pose.h"
@@ -68,6 +71,21 @@ class FieldReader {
     return values;
   }
 
+  /// Refuses a key of the object at `path` ("" for the document) that is none of `known`: a misspelt
+  /// key is otherwise ignored, and the field it meant keeps the value it had.
+  void only_keys(const std::string& path, std::initializer_list<const char*> known) {
+    const json* node = path.empty() ? &root_ : at(path);
+    if (!node || !node->is_object()) return;
+    std::string names;
+    for (const char* name : known) names += std::string(names.empty() ? "" : ", ") + name;
+    for (const auto& [key, value] : node->items()) {
+      const bool found = std::any_of(known.begin(), known.end(), [&](const char* name) { return key == name; });
+      const std::string field = printable_text(key);
+      if (!found)
+        fail(path.empty() ? field : path + "." + field, "unknown key (" + (path.empty() ? "the file" : path) + " holds " + names + ")");
+    }
+  }
+
   void fail(const std::string& path, const std::string& why) {
     if (error_.empty()) error_ = source_ + ": " + path + ": " + why;
   }
@@ -84,6 +102,48 @@ class FieldReader {
 constexpr double kMaxTranslationMm = units::m_to_mm(kRegistrationReachM);
 
 bool is_whole(double v, double lo, double hi) { return v == std::floor(v) && v >= lo && v <= hi; }
+
+/// The keys a calibration file holds, object by object.
+void refuse_unknown_keys(FieldReader& in) {
+  in.only_keys("", {"format", "version", "sheath", "hall_table", "encoders", "registration"});
+  in.only_keys("sheath", {"gain_mm_per_count", "offset_mm", "min_mm", "max_mm"});
+  in.only_keys("hall_table", {"hall_sum_counts", "loop_mm"});
+  in.only_keys("encoders", {"counts_per_revolution"});
+  in.only_keys("registration", {"rotation", "translation_mm"});
+}
+
+/// Why the sensor models cannot describe the device, or nothing. The board clamps the sheath's reading
+/// to [min_mm, max_mm], so a model mapping every potentiometer count outside that range reads one end
+/// whatever the sheath does; a Hall table point is a loop position measured, so it lies on the loop's
+/// travel. For a calibration the board takes (to_board): its gain is non-zero and min_mm below max_mm.
+std::optional<std::string> sensor_model_problem(const Calibration& c) {
+  const double at_zero = c.sheath_offset_mm, at_max = c.sheath_gain_mm_per_count * kAdcMaxCounts + c.sheath_offset_mm;
+  const double lo = std::min(at_zero, at_max), hi = std::max(at_zero, at_max);
+  if (!(hi >= c.sheath_min_mm && lo <= c.sheath_max_mm)) {
+    return "sheath: potentiometer counts 0-" + exact_number(kAdcMaxCounts) + " map to " + rounded_number(lo, 9) + " .. " +
+           rounded_number(hi, 9) + " mm, all outside the sheath's travel (min_mm " + exact_number(c.sheath_min_mm) + " to max_mm " +
+           exact_number(c.sheath_max_mm) + "): gain_mm_per_count or offset_mm is wrong";
+  }
+  for (unsigned i = 0; i < LP3500_HALL_TABLE_POINTS; ++i) {
+    if (!in_closed_range(c.loop_mm[i], 0.0, kLoopTravelMm)) {
+      return "hall_table.loop_mm[" + std::to_string(i) + "]: " + exact_number(c.loop_mm[i]) + " mm is outside the loop's 0-" +
+             exact_number(kLoopTravelMm) + " mm travel";
+    }
+  }
+  return std::nullopt;
+}
+
+/// Which of the board's sheath rules `b` (from `c`) breaks: the board answers only that one is.
+std::string sheath_rule_broken(const Calibration& c, const lp3500_calibration& b) {
+  if (b.sheath_gain_nm_per_count == 0) {
+    return "sheath.gain_mm_per_count: " + exact_number(c.sheath_gain_mm_per_count) +
+           " is zero to the board's 0.000001 mm per count, and a zero gain reads every count as offset_mm";
+  }
+  if (b.sheath_min_um >= b.sheath_max_um) {
+    return "sheath: min_mm " + exact_number(c.sheath_min_mm) + " must be below max_mm " + exact_number(c.sheath_max_mm);
+  }
+  return "sheath.gain_mm_per_count: " + exact_number(c.sheath_gain_mm_per_count) + " is outside +-0.5 mm per count";
+}
 
 }  // namespace
 
@@ -128,7 +188,7 @@ Result<lp3500_calibration> to_board(const Calibration& c) {
   switch (lp3500_validate_calibration(&b, &bad)) {
     case LP3500_OK: return b;
     case LP3500_ERROR_SHEATH_RANGE:
-      return Error{"sheath: gain must be non-zero and within +-0.5 mm per count, and min_mm below max_mm"};
+      return Error{sheath_rule_broken(c, b)};
     case LP3500_ERROR_NOT_MONOTONE:
       return Error{"hall_table[" + std::to_string(bad) + "]: hall_sum_counts must be strictly monotone and loop_mm "
                    "strictly increasing (points " + std::to_string(bad - 1) + " and " + std::to_string(bad) + ")"};
@@ -137,7 +197,7 @@ Result<lp3500_calibration> to_board(const Calibration& c) {
 }
 
 Result<Calibration> parse_calibration(const std::string& text, const std::string& source) {
-  Result<json> parsed = parse_json_text(text, source);
+  Result<json> parsed = parse_json_text(text, source, true);
   if (!parsed) return Error{parsed.error()};
   const json& root = *parsed;
   FieldReader in(root, source);
@@ -157,6 +217,7 @@ Result<Calibration> parse_calibration(const std::string& text, const std::string
   const auto cpr = in.numbers("encoders.counts_per_revolution", LP3500_ENCODER_COUNT);
   const json* rotation = in.at("registration.rotation");
   const auto translation = in.numbers("registration.translation_mm", 3);
+  refuse_unknown_keys(in);
   if (!in.ok()) return Error{in.error()};
   for (unsigned i = 0; i < LP3500_HALL_TABLE_POINTS; ++i) {
     if (!is_whole(sums[i], 0, 8190)) in.fail("hall_table.hall_sum_counts[" + std::to_string(i) + "]", "not a whole number in 0-8190");
@@ -197,6 +258,7 @@ Result<Calibration> parse_calibration(const std::string& text, const std::string
   if (!is_proper_rotation(matrix)) return Error{source + ": registration.rotation: not a proper rotation (orthonormal, det +1)"};
   const auto board = to_board(c);
   if (!board) return Error{source + ": " + board.error()};
+  if (auto problem = sensor_model_problem(c)) return Error{source + ": " + *problem};
   return c;
 }
 

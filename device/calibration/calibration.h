@@ -13,6 +13,11 @@
 
 namespace resecto::device {
 
+/// What the device can measure: the potentiometer and each Hall channel read 12-bit codes, and the loop
+/// travels over the Hall table's 74 points, 0.5 mm apart.
+inline constexpr double kAdcMaxCounts = 4095.0;
+inline constexpr double kLoopTravelMm = (LP3500_HALL_TABLE_POINTS - 1) * LP3500_HALL_TABLE_STEP_UM * 1e-3;
+
 /// One device's calibration. Defaults: the firmware's compiled-in calibration, 4096 counts/rev on
 /// every axis, and the registration that puts the gimbal pivot (the device frame's origin) at world
 /// (0, 0, -150) mm with the device axes along the world's, so zero yaw/pitch aims the sheath down the
@@ -38,7 +43,8 @@ Result<lp3500_calibration> to_board(const Calibration& calibration);
 /// `base` with its sensor part replaced by the board's calibration.
 Calibration from_board(const lp3500_calibration& board, const Calibration& base = default_calibration());
 
-/// Parses calibration JSON; errors name `source` and the field at fault.
+/// Parses calibration JSON; errors name `source` and the field at fault. Unknown and repeated keys are
+/// refused, and so are sensor models that map the sensor's whole range outside the travel.
 Result<Calibration> parse_calibration(const std::string& text, const std::string& source);
 
 /// Reads and validates a calibration file.

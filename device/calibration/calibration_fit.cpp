@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <optional>
 
+#include "device/calibration/calibration.h"
 #include "resecto/lp3500_sensors.h"
 #include "rtcore/base/checked_number.h"
 
@@ -40,11 +41,8 @@ Result<std::vector<int>> require_columns(const NumericCsv& csv, const std::strin
   return indices;
 }
 
-// What the device can measure: the sheath travels 0-230 mm on a 12-bit potentiometer, the loop
-// over the Hall table's 74 points 0.5 mm apart, each Hall channel a 12-bit reading.
+// The sheath travels 0-230 mm (the loop's travel and the ADC's codes are the calibration's, calibration.h).
 constexpr double kSheathTravelMm = 230.0;
-constexpr double kLoopTravelMm = (LP3500_HALL_TABLE_POINTS - 1) * LP3500_HALL_TABLE_STEP_UM * 1e-3;
-constexpr double kAdcMaxCounts = 4095.0;
 
 /// "<source>:<line>: <problem>" when `value` is outside [lo, hi] (NaN always is), else nothing.
 std::optional<Error> row_problem(const std::string& source, int line, const char* what, double value, double lo, double hi) {

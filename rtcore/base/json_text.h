@@ -3,10 +3,14 @@
 // modules that read JSON (anatomy, device, console) link nlohmann_json themselves.
 #pragma once
 
+#include <functional>
+#include <set>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "rtcore/base/quoted_word.h"
 #include "rtcore/base/result.h"
 #include "rtcore/base/text_file.h"
 
@@ -20,8 +24,77 @@ inline std::string library_free(const std::string& what) {
   return what;
 }
 
-inline Result<nlohmann::json> parse_json_text(const std::string& text, const std::string& source) {
+namespace detail {
+
+/// Follows the parser through a document (nlohmann's parse callback) and keeps the path of the first
+/// key an object names twice, "sheath.offset_mm" or "points[2].x", or nothing.
+class RepeatedKeyFinder {
+ public:
+  bool operator()(int /*depth*/, nlohmann::json::parse_event_t event, const nlohmann::json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    switch (event) {
+      case Event::object_start:
+        levels_.push_back({true, {}, {}, 0});
+        break;
+      case Event::array_start:
+        levels_.push_back({false, {}, {}, 0});
+        break;
+      case Event::key: {
+        Level& object = levels_.back();
+        object.key = parsed.get<std::string>();
+        if (!object.keys.insert(object.key).second && repeated_.empty()) repeated_ = path();
+        break;
+      }
+      case Event::object_end:
+      case Event::array_end:
+        levels_.pop_back();
+        element_done();
+        break;
+      case Event::value:
+        element_done();
+        break;
+    }
+    return true;  // keep everything: the document is still built whole
+  }
+  const std::string& repeated() const { return repeated_; }
+
+ private:
+  struct Level {
+    bool object;
+    std::set<std::string> keys;  // an object's keys so far
+    std::string key;             // an object's current key
+    std::size_t index;           // an array's current element
+  };
+  void element_done() {
+    if (!levels_.empty() && !levels_.back().object) ++levels_.back().index;
+  }
+  std::string path() const {
+    std::string out;
+    for (const Level& level : levels_) {
+      if (!level.object) out += "[" + std::to_string(level.index) + "]";
+      else out += (out.empty() ? "" : ".") + printable_text(level.key);
+    }
+    return out;
+  }
+
+  std::vector<Level> levels_;
+  std::string repeated_;
+};
+
+}  // namespace detail
+
+/// The document in `text`, or an error naming `source` and where the syntax fails. With
+/// `refuse_repeated_keys`, an object that names a key twice is an error naming the key's path: the
+/// library keeps the last silently, so a hand-edited file could be read with a value its author
+/// thought was replaced.
+inline Result<nlohmann::json> parse_json_text(const std::string& text, const std::string& source, bool refuse_repeated_keys = false) {
   try {
+    if (refuse_repeated_keys) {
+      detail::RepeatedKeyFinder finder;
+      nlohmann::json document = nlohmann::json::parse(text, std::ref(finder));
+      if (!finder.repeated().empty()) return Error{source + ": " + finder.repeated() + ": the key appears twice in its object"};
+      return document;
+    }
     return nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     // e.byte counts the bytes read, the offending one included; what() is

@@ -313,6 +313,22 @@ TEST_F(HostileInput, CalibrationInputsOutsideTheDeviceAreRefused) {
   write_bytes(path("far.json"), far.dump());
   expect_clean_failure(run_resecto_bounded("run --headless --seconds 0.1 --calibration " + arg("far.json")),
                        "registration.translation_mm[1]: 1e+308 is outside [-1000, 1000] mm", "translation");
+  // Audit 6, A: a sheath model reading every count off the travel, a misspelt key and a repeated one
+  // were all run as if nothing were wrong.
+  nlohmann::json off_travel = nlohmann::json::parse(read_text(path("good.json")));
+  off_travel["sheath"]["offset_mm"] = -1e6;
+  write_bytes(path("off_travel.json"), off_travel.dump());
+  expect_clean_failure(run_resecto_bounded("device monitor --device emulator --seconds 0.1 --calibration " + arg("off_travel.json")),
+                       "off_travel.json: sheath: potentiometer counts 0-4095 map to ", "offset -1e6");
+  nlohmann::json misspelt = nlohmann::json::parse(read_text(path("good.json")));
+  misspelt["sheath"]["gain"] = -0.25;
+  write_bytes(path("misspelt.json"), misspelt.dump());
+  expect_clean_failure(run_resecto_bounded("run --headless --seconds 0.1 --calibration " + arg("misspelt.json")),
+                       "misspelt.json: sheath.gain: unknown key (sheath holds gain_mm_per_count, offset_mm, min_mm, max_mm)", "misspelt");
+  const std::string good_text = read_text(path("good.json"));
+  write_bytes(path("twice.json"), good_text.substr(0, good_text.rfind('}')) + ", \"version\": 1}");
+  expect_clean_failure(run_resecto_bounded("run --headless --seconds 0.1 --calibration " + arg("twice.json")),
+                       "twice.json: version: the key appears twice in its object", "repeated key");
 
   const std::pair<std::string, std::string> sheaths[] = {
       {"position_mm,potentiometer_counts\n0,100\n10,5000\n", "potentiometer_counts 5000 is outside [0, 4095]"},
@@ -321,6 +337,9 @@ TEST_F(HostileInput, CalibrationInputsOutsideTheDeviceAreRefused) {
       // Audit 24: a mistyped row (rms residual 64 mm) and two rows 1 mm apart were fitted and written.
       {"position_mm,potentiometer_counts\n0,3686\n230,2646\n115,4000\n", "by 86.187 mm, more than 2.000: a row is misread or mistyped"},
       {"position_mm,potentiometer_counts\n10,3640\n11,3636\n", "the measurements cover only 10.000 to 11.000 mm"},
+      // Audit 6, A: a ';'-separated export was "column position_mm;potentiometer_counts: not a number".
+      {"position_mm;potentiometer_counts\n0;3686\n230;2646\n",
+       "bad_sheath.csv:1: the header has no columns 'position_mm', 'potentiometer_counts'"},
   };
   for (const auto& [csv, expected] : sheaths) {
     write_bytes(path("bad_sheath.csv"), csv);

@@ -83,6 +83,63 @@ TEST(Calibration, ReaderErrorsNameTheFileAndField) {
   EXPECT_FALSE(read_calibration(scratch("absent.json")).ok());
 }
 
+// Audit 6, A: a misspelt key was ignored (the field it meant kept its value) and a repeated key read
+// its last value; both are refused by path, as presets refuse unknown keys.
+TEST(Calibration, ReaderRefusesUnknownAndRepeatedKeysByPath) {
+  const std::string good = calibration_to_json(default_calibration());
+  const auto error_of = [](const std::string& text) {
+    const auto result = parse_calibration(text, "cal.json");
+    return result.ok() ? std::string("accepted") : result.error();
+  };
+  std::string extra = good;
+  extra.insert(extra.find("\"min_mm\""), "\"minimum_mm\": 0, ");
+  EXPECT_EQ(error_of(extra), "cal.json: sheath.minimum_mm: unknown key (sheath holds gain_mm_per_count, offset_mm, min_mm, max_mm)");
+  EXPECT_EQ(error_of("{\"comment\": \"x\", " + good.substr(1)),
+            "cal.json: comment: unknown key (the file holds format, version, sheath, hall_table, encoders, registration)");
+  std::string twice = good;
+  twice.insert(twice.find("\"min_mm\""), "\"offset_mm\": -1000000, ");
+  EXPECT_EQ(error_of(twice), "cal.json: sheath.offset_mm: the key appears twice in its object");
+  EXPECT_EQ(error_of(good.substr(0, good.rfind('}')) + ", \"version\": 1}"), "cal.json: version: the key appears twice in its object");
+}
+
+// Audit 6, A: the emulated board encodes with the calibration it decodes with, so a nonsense sensor
+// model ran unnoticed; one that maps the whole sensor range off the travel is refused, saying why.
+TEST(Calibration, ReaderRefusesSensorModelsThatMapOffTheTravel) {
+  const auto error_of = [](const Calibration& c) {
+    const auto result = parse_calibration(calibration_to_json(c), "cal.json");
+    return result.ok() ? std::string("accepted") : result.error();
+  };
+  Calibration far = default_calibration();
+  far.sheath_offset_mm = -1e6;
+  EXPECT_EQ(error_of(far),
+            "cal.json: sheath: potentiometer counts 0-4095 map to -1000905.29 .. -1000000 mm, all outside the sheath's travel "
+            "(min_mm 0 to max_mm 230): gain_mm_per_count or offset_mm is wrong");
+  Calibration still = default_calibration();
+  still.sheath_gain_mm_per_count = 0.0;
+  EXPECT_EQ(
+      error_of(still),
+      "cal.json: sheath.gain_mm_per_count: 0 is zero to the board's 0.000001 mm per count, and a zero gain reads every count as offset_mm");
+  Calibration swapped = default_calibration();
+  swapped.sheath_min_mm = 230.0;
+  swapped.sheath_max_mm = 0.0;
+  EXPECT_EQ(error_of(swapped), "cal.json: sheath: min_mm 230 must be below max_mm 0");
+  Calibration beyond = default_calibration();
+  for (double& mm : beyond.loop_mm) mm += 20.0;
+  EXPECT_EQ(error_of(beyond), "cal.json: hall_table.loop_mm[34]: 37 mm is outside the loop's 0-36.5 mm travel");
+
+  // Partly on the travel is a real potentiometer's case (the default maps counts to -90 .. 815 mm), and
+  // a steeper gain or a table over half the travel still describe some device.
+  Calibration steeper = default_calibration();
+  steeper.sheath_gain_mm_per_count = -0.25;
+  EXPECT_EQ(error_of(steeper), "accepted");
+  Calibration edge = default_calibration();
+  edge.sheath_offset_mm = -kAdcMaxCounts * edge.sheath_gain_mm_per_count;  // count 4095 reads 0 mm, the travel's end
+  EXPECT_EQ(error_of(edge), "accepted");
+  Calibration half = default_calibration();
+  for (double& mm : half.loop_mm) mm *= 0.5;
+  EXPECT_EQ(error_of(half), "accepted");
+}
+
 TEST(CalibrationFit, SheathLeastSquaresRecoversTheLineAndReportsResiduals) {
   std::vector<SheathSample> samples;
   for (int i = 0; i <= 23; ++i) {
