@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <charconv>
 #include <cmath>
 
 #include "rtcore/base/checked_number.h"
@@ -13,10 +12,11 @@
 namespace resecto::gui {
 namespace {
 
+/// A finite number as the command line reads one (parse_finite: "+40" too, as `--set stiffness=+40`).
 bool parse_number(const std::string& text, double& out) {
-  const char* end = text.data() + text.size();
-  const auto [ptr, error] = std::from_chars(text.data(), end, out);
-  return error == std::errc{} && ptr == end && std::isfinite(out);
+  const std::optional<double> value = parse_finite(text);
+  if (value) out = *value;
+  return value.has_value();
 }
 
 /// The largest frame number a script may name (--frames' bound) and the largest drag, in pixels.

@@ -2,7 +2,6 @@
 // comment says where, and the edge-spring conversion rule lives in springs.cpp.
 #include "rtcore/tissue/tissue_parameters.h"
 
-#include <charconv>
 #include <cmath>
 #include <string>
 
@@ -82,12 +81,10 @@ Status TissueParameters::set_from_assignment(std::string_view assignment) {
   const std::string_view text = assignment.substr(equals + 1);
   const std::optional<TissueParameter> id = find_tissue_parameter(key);
   if (!id) return Error{"--set " + std::string(assignment) + ": unknown parameter '" + std::string(key) + "' (see resecto params)"};
-  double value = 0.0;
-  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (text.empty() || error != std::errc{} || end != text.data() + text.size()) {
-    return Error{"--set " + std::string(assignment) + ": '" + std::string(text) + "' is not a number"};
-  }
-  if (Status status = set(*id, value); !status) return Error{"--set " + std::string(assignment) + ": " + status.error()};
+  // parse_finite, as every other number on the command line is read: from_chars alone refused "+40".
+  const std::optional<double> value = parse_finite(text);
+  if (!value) return Error{"--set " + std::string(assignment) + ": '" + std::string(text) + "' is " + not_finite_kind(text)};
+  if (Status status = set(*id, *value); !status) return Error{"--set " + std::string(assignment) + ": " + status.error()};
   return Ok{};
 }
 

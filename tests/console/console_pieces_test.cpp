@@ -61,6 +61,14 @@ TEST(ActionScript, LineEndingsAndHashesInPaths) {
   }
 }
 
+// Audit 6, D: numbers are read as on the command line, where `--set stiffness=+40` now is.
+TEST(ActionScript, NumbersMayCarryALeadingPlus) {
+  Result<std::vector<Action>> parsed = parse_actions("frame +2 set stiffness +45\n", "t");
+  ASSERT_TRUE(parsed) << parsed.error();
+  EXPECT_EQ((*parsed)[0].frame, 2u);
+  EXPECT_EQ((*parsed)[0].value, 45.0);
+}
+
 TEST(ActionScript, ErrorsNameTheLineAndTheProblem) {
   const std::pair<const char*, const char*> cases[] = {
       {"frame 1 pause\nframe x quit\n", "t:2:7: expected 'frame N VERB"},

@@ -45,5 +45,11 @@ TEST(ParamsCommand, SetRefusesUnknownKeysAndOutOfRangeValues) {
   EXPECT_NE(malformed.err.find("expected KEY=VALUE"), std::string::npos) << malformed.err;
 }
 
+// Audit 6, D: "--set stiffness=+40" was "'+40' is not a number", while `--seconds +2` was read.
+TEST(ParamsCommand, SetTakesALeadingPlus) {
+  const CommandOutput plus = run_resecto("run --headless --triangles 1296 --seconds 0.05 --set stiffness=+40");
+  EXPECT_EQ(plus.exit_code, 0) << plus.err;
+}
+
 }  // namespace
 }  // namespace resecto::testing

@@ -58,6 +58,12 @@ TEST(TissueParameters, RefusesUnknownKeysAndOutOfRangeValuesNamingThem) {
   EXPECT_FALSE(p.set_from_assignment("stiffness=abc"));
   EXPECT_FALSE(p.set_from_assignment("stiffness"));
   EXPECT_FALSE(p.set_from_assignment("stiffness=nan"));
+  // Audit 6, D: a leading '+' was refused here while `--seconds +2` and a procedure's "+2.0" were read.
+  ASSERT_TRUE(p.set_from_assignment("stiffness=+41"));
+  EXPECT_DOUBLE_EQ(p.get(TissueParameter::kStiffness), 41.0);
+  EXPECT_EQ(p.set_from_assignment("stiffness=4O").error(), "--set stiffness=4O: '4O' is not a number");
+  EXPECT_EQ(p.set_from_assignment("stiffness=inf").error(), "--set stiffness=inf: 'inf' is not a finite number");
+  EXPECT_FALSE(p.set_from_assignment("stiffness=++40"));
   ASSERT_TRUE(p.set_from_assignment("stiffness=80"));
   EXPECT_DOUBLE_EQ(p.si(TissueParameter::kStiffness), 80e3);
   for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
