@@ -49,9 +49,8 @@ TriangleMesh read_mesh_or_fail(const std::string& path) {
 }
 
 std::vector<RigidPose> read_poses_or_fail(const std::string& path) {
-  Result<std::string> text = read_text_file(path, " the poses file");
+  Result<std::string> text = read_utf8_text_file(path, " the poses file");
   if (!text) fail(text.error());
-  strip_utf8_bom(*text);
   Result<std::vector<RigidPose>> poses = parse_poses(*text, path);
   if (!poses) fail(poses.error());
   return std::move(poses).value();

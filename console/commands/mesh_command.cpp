@@ -185,7 +185,7 @@ void register_tetra(CLI::App& mesh) {
     // The generator's landmarks, when present, say where the urethral channel runs.
     const auto landmarks = landmarks_path_for(options->input);
     if (std::filesystem::exists(landmarks)) {
-      Result<std::string> text = read_text_file(landmarks);
+      Result<std::string> text = read_utf8_text_file(landmarks);
       if (!text) fail(text.error());
       Result<std::pair<Vec3, Vec3>> axis = parse_channel_axis(*text, landmarks.string());
       if (!axis) fail(axis.error());

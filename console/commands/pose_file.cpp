@@ -34,29 +34,21 @@ Result<std::vector<RigidPose>> parse_poses(const std::string& text, const std::s
   // Lines end in LF, CR LF or a lone CR (text_lines).
   for (const std::string_view text_line : text_lines(text)) {
     ++number;
-    const std::string line(text_line);
-    const std::size_t start = line.find_first_not_of(" \t\r");
-    if (start == std::string::npos || line[start] == '#') continue;
+    const std::vector<TextWord> words = text_words(text_line, ",");
+    if (words.empty() || words.front().text.front() == '#') continue;
     const std::string where = source + ":" + std::to_string(number) + ": ";
     double values[12];
-    const char* cursor = line.c_str();
     int count = 0;
-    for (;;) {
-      while (*cursor == ' ' || *cursor == '\t' || *cursor == ',' || *cursor == '\r') ++cursor;
-      if (*cursor == '\0') break;
+    for (const TextWord& word : words) {
       // Decimal numbers only, as the mesh readers and the procedure files take them: strtod also took
       // hexadecimal ("0x3") and read the number at the front of a word ("1.5abc").
-      const char* end = cursor;
-      while (*end != '\0' && *end != ' ' && *end != '\t' && *end != ',' && *end != '\r') ++end;
-      const std::string_view word(cursor, static_cast<std::size_t>(end - cursor));
-      const std::optional<double> v = parse_finite(word);
-      if (!v && names_a_non_finite_number(word)) {
-        return Error{where + "number " + std::to_string(count + 1) + " of 12, '" + std::string(word) + "', is not finite"};
+      const std::optional<double> v = parse_finite(word.text);
+      if (!v && names_a_non_finite_number(word.text)) {
+        return Error{where + "number " + std::to_string(count + 1) + " of 12, '" + std::string(word.text) + "', is not finite"};
       }
-      if (!v) return Error{where + "'" + std::string(word.substr(0, 20)) + "' is not a number"};
+      if (!v) return Error{where + "'" + std::string(word.text.substr(0, 20)) + "' is not a number"};
       if (count == 12) return Error{where + "more than 12 numbers (expected r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz)"};
       values[count++] = *v;
-      cursor = end;
     }
     if (count != 12) {
       return Error{where + "expected 12 numbers (r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz), found " + std::to_string(count)};

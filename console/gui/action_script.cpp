@@ -177,9 +177,8 @@ Result<std::vector<Action>> parse_actions(const std::string& text, const std::st
 }
 
 Result<std::vector<Action>> load_actions(const std::filesystem::path& path) {
-  Result<std::string> text = read_text_file(path, " the actions file");
+  Result<std::string> text = read_utf8_text_file(path, " the actions file");
   if (!text) return Error{text.error()};
-  strip_utf8_bom(*text);
   return parse_actions(*text, path.string());
 }
 

@@ -21,9 +21,8 @@ Status save_preset(const std::filesystem::path& path, const TissueParameters& pa
 }
 
 Result<TissueParameters> load_preset(const std::filesystem::path& path, const TissueParameters& base) {
-  Result<std::string> text = read_text_file(path, " the preset");
+  Result<std::string> text = read_utf8_text_file(path, " the preset");
   if (!text) return Error{text.error()};
-  strip_utf8_bom(*text);
   Result<nlohmann::json> parsed = parse_json_text(*text, path.string());
   if (!parsed) return Error{parsed.error()};
   const nlohmann::json& preset = *parsed;

@@ -263,7 +263,7 @@ Result<Calibration> parse_calibration(const std::string& text, const std::string
 }
 
 Result<Calibration> read_calibration(const std::filesystem::path& path) {
-  Result<std::string> text = read_text_file(path);
+  Result<std::string> text = read_utf8_text_file(path);
   if (!text) return Error{text.error()};
   return parse_calibration(*text, path.string());
 }

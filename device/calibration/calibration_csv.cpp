@@ -114,9 +114,8 @@ Result<NumericCsv> parse_numeric_csv(const std::string& text, const std::string&
 }
 
 Result<NumericCsv> read_numeric_csv(const std::filesystem::path& path) {
-  Result<std::string> text = read_text_file(path);
+  Result<std::string> text = read_utf8_text_file(path);
   if (!text) return Error{text.error()};
-  strip_utf8_bom(*text);
   return parse_numeric_csv(*text, path.string());
 }
 

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -60,15 +61,27 @@ inline Result<std::string> read_text_file(const std::filesystem::path& path, con
   return read_regular_file<std::string>(path, what, max_bytes);
 }
 
-/// "line L, column C" (from 1) of the byte at `offset` (from 0) of `text`, for a parser that reports
-/// where it stopped as a byte count (nlohmann::json's parse_error::byte is the count read, from 1).
-inline std::string text_position(std::string_view text, std::size_t offset) {
+/// A place in a text: its line and its column, counting bytes, both from 1.
+struct TextPlace {
+  std::size_t line = 1;
+  std::size_t column = 1;
+};
+
+/// The place of the byte at `offset` (from 0) of `text`.
+inline TextPlace text_place(std::string_view text, std::size_t offset) {
   offset = std::min(offset, text.size());
   std::size_t line = 1, line_start = 0;
   for (std::size_t i = 0; i < offset; ++i) {
     if (text[i] == '\n') ++line, line_start = i + 1;
   }
-  return "line " + std::to_string(line) + ", column " + std::to_string(offset - line_start + 1);
+  return {line, offset - line_start + 1};
+}
+
+/// "line L, column C" (from 1) of the byte at `offset` (from 0) of `text`, for a parser that reports
+/// where it stopped as a byte count (nlohmann::json's parse_error::byte is the count read, from 1).
+inline std::string text_position(std::string_view text, std::size_t offset) {
+  const TextPlace place = text_place(text, offset);
+  return "line " + std::to_string(place.line) + ", column " + std::to_string(place.column);
 }
 
 /// The lines of `text`, ended by "\n", "\r\n" or a lone "\r" (classic Mac OS files, and some
@@ -93,9 +106,12 @@ struct TextWord {
   std::size_t column = 1;
 };
 
-/// The words of `line`, split on spaces, tabs, vertical tabs and form feeds.
-inline std::vector<TextWord> text_words(std::string_view line) {
-  const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f' || c == '\r' || c == '\n'; };
+/// The words of `line`, split on spaces, tabs, vertical tabs and form feeds, and on any of `separators`
+/// (",": the procedure and pose files take commas between numbers, as a spreadsheet exports them).
+inline std::vector<TextWord> text_words(std::string_view line, std::string_view separators = "") {
+  const auto blank = [separators](char c) {
+    return c == ' ' || c == '\t' || c == '\v' || c == '\f' || c == '\r' || c == '\n' || separators.find(c) != std::string_view::npos;
+  };
   std::vector<TextWord> words;
   std::size_t i = 0;
   while (i < line.size()) {
@@ -114,6 +130,41 @@ inline std::vector<TextWord> text_words(std::string_view line) {
 /// files; it carries nothing, and left in it made the first word unreadable ("'\xEF\xBB\xBFOFF'").
 inline void strip_utf8_bom(std::string& text) {
   if (text.size() >= 3 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);
+}
+
+/// Whether `text` is UTF-16: its byte-order mark (FF FE or FE FF), or, without one, the NUL byte UTF-16
+/// puts beside each ASCII character, on the same side of the first four.
+inline bool is_utf16(std::string_view text) {
+  if (text.starts_with("\xFF\xFE") || text.starts_with("\xFE\xFF")) return true;
+  if (text.size() < 8) return false;
+  const bool low_first = text[0] != '\0' && text[1] == '\0';  // little-endian: 'A' 00
+  for (std::size_t i = 0; i < 8; i += 2) {
+    const char ascii = low_first ? text[i] : text[i + 1], nul = low_first ? text[i + 1] : text[i];
+    if (ascii == '\0' || nul != '\0') return false;
+  }
+  return true;
+}
+
+/// Why `text` (from `name`) is not UTF-8 text, or nothing. Windows editors save "Unicode" text as
+/// UTF-16, which parsers read as a NUL after every character and reported as mojibake; a NUL byte
+/// elsewhere is no text either.
+inline std::optional<std::string> utf8_text_problem(std::string_view text, const std::string& name) {
+  if (is_utf16(text)) return name + ": is UTF-16, not UTF-8 text; save it as UTF-8";
+  if (const std::size_t nul = text.find('\0'); nul != std::string_view::npos) {
+    const TextPlace place = text_place(text, nul);
+    return name + ":" + std::to_string(place.line) + ":" + std::to_string(place.column) + ": a NUL byte, which UTF-8 text never holds";
+  }
+  return std::nullopt;
+}
+
+/// A text input (procedure, poses, actions, preset, calibration, CSV, landmarks) read whole and
+/// checked to be UTF-8 (utf8_text_problem), its byte-order mark dropped (strip_utf8_bom).
+inline Result<std::string> read_utf8_text_file(const std::filesystem::path& path, const std::string& what = "") {
+  Result<std::string> text = read_text_file(path, what);
+  if (!text) return text;
+  if (auto problem = utf8_text_problem(*text, path.string())) return Error{*problem};
+  strip_utf8_bom(*text);
+  return text;
 }
 
 }  // namespace resecto

@@ -141,7 +141,7 @@ Result<Procedure> parse_procedure(const std::string& text, const std::string& so
     ++number;
     // A comment may also end a line ("2.0  0 0 0  80 0  1 0   # first stroke").
     if (const std::size_t comment = line.find('#'); comment != std::string_view::npos) line = line.substr(0, comment);
-    const std::vector<TextWord> words = text_words(line);
+    const std::vector<TextWord> words = text_words(line, ",");
     if (words.empty()) continue;
     const auto error_at = [&](std::size_t word, const std::string& what) {
       return position_error(source_name, number, words[word].column, what);
@@ -183,9 +183,8 @@ Result<Procedure> parse_procedure(const std::string& text, const std::string& so
 }
 
 Result<Procedure> load_procedure(const std::filesystem::path& path) {
-  Result<std::string> text = read_text_file(path, " the procedure file");
+  Result<std::string> text = read_utf8_text_file(path, " the procedure file");
   if (!text) return Error{text.error()};
-  strip_utf8_bom(*text);
   return parse_procedure(*text, path.string());
 }
 

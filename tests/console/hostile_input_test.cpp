@@ -407,6 +407,22 @@ TEST_F(HostileInput, AByteOrderMarkBeforeTextIsIgnored) {
   EXPECT_EQ(run.exit_code, 0) << run.err;
 }
 
+// Audit 6, C: a UTF-16 procedure or pose file ("Unicode" in Windows editors) was reported as mojibake;
+// procedure columns separated by commas were "found 1", while pose files took commas.
+TEST_F(HostileInput, Utf16TextIsNamedAndProcedureColumnsTakeCommas) {
+  std::string utf16 = "\xFF\xFE";
+  for (const char c : std::string("0 0 0 0 125 0 0 0\n1 0 0 0 140 0 0 0\n")) utf16 += std::string{c, '\0'};
+  write_bytes(path("utf16.proc"), utf16);
+  expect_clean_failure(run_resecto_bounded("run --headless --procedure " + arg("utf16.proc")),
+                       "utf16.proc: is UTF-16, not UTF-8 text; save it as UTF-8", "UTF-16 procedure");
+  write_bytes(path("utf16_pose.txt"), "\xFE\xFF" + std::string(1, '\0') + "1");
+  expect_clean_failure(run_resecto_bounded(collide_args(arg("p.off"), "utf16_pose.txt")), "utf16_pose.txt: is UTF-16, not UTF-8 text",
+                       "UTF-16 poses");
+  write_bytes(path("commas.proc"), "0.0, 0, 0, 0, 125, 0, 0, 0\n1.0,0,0,0,140,0,0,0\n");
+  const CommandOutput commas = run_resecto_bounded("run --headless --triangles 1296 --procedure " + arg("commas.proc"), 60.0);
+  EXPECT_EQ(commas.exit_code, 0) << commas.err;
+}
+
 /// A 256 KiB tmpfs, mounted for one test and filled to the last byte after the good files are in.
 class FullDisk : public HostileInput {
  protected:

@@ -84,6 +84,37 @@ TEST(Procedure, ErrorsNameTheLineAndColumn) {
       << error_of("0 0 0 0 100 0 0 0\n1\t0 0 0 100 0 0 0 7\n");
 }
 
+// Audit 6, C: "0.0, 0, 0, ..." was "expected 8 columns ..., found 1"; the pose files took commas, so
+// the procedures take them by the same rule (text_words with ","): spaces, tabs and commas separate.
+TEST(Procedure, CommasSeparateColumnsAsInPoseFiles) {
+  const Result<Procedure> p = parse_procedure("0.0, 0, 0, 0, 125, 0, 0, 0\n1.5,0,0,0,158,2.5,1,0  # a stroke\n", "mine.txt");
+  ASSERT_TRUE(p) << p.error();
+  ASSERT_EQ(p->keyframes.size(), 2u);
+  EXPECT_EQ(p->keyframes[1].loop_mm, 2.5);
+  EXPECT_TRUE(p->keyframes[1].cut);
+  const Result<Procedure> bad = parse_procedure("0,0,0,0,300,0,0,0\n", "mine.txt");
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error(), "mine.txt:1:9: insertion_mm 300 is outside [0, 230]");  // columns still count bytes
+}
+
+// Audit 6, C: a procedure saved as "Unicode" (UTF-16) was reported as a first word of mojibake.
+TEST(Procedure, AUtf16FileIsNamedAsOne) {
+  const auto path = std::filesystem::temp_directory_path() / "resecto_procedure_utf16.txt";
+  for (const std::string bom : {"\xFF\xFE", "\xFE\xFF", ""}) {
+    std::string text = bom;
+    for (const char c : std::string("0 0 0 0 125 0 0 0\n")) text += bom == "\xFE\xFF" ? std::string{'\0', c} : std::string{c, '\0'};
+    std::ofstream(path, std::ios::binary) << text;
+    const Result<Procedure> p = load_procedure(path);
+    ASSERT_FALSE(p);
+    EXPECT_EQ(p.error(), path.string() + ": is UTF-16, not UTF-8 text; save it as UTF-8");
+  }
+  std::ofstream(path, std::ios::binary) << "0 0 0 0 125 0 0 0\n1 0 0 0 15" + std::string(1, '\0') + "8 0 0 0\n";
+  const Result<Procedure> nul = load_procedure(path);
+  std::filesystem::remove(path);
+  ASSERT_FALSE(nul);
+  EXPECT_EQ(nul.error(), path.string() + ":2:11: a NUL byte, which UTF-8 text never holds");
+}
+
 // Lines may end in LF, CR LF or a lone CR (classic Mac OS, some spreadsheets' exports): a CR-only file
 // used to read as one line of 8 x N words, "more than 8 columns" (audit 24, F11).
 TEST(Procedure, LinesEndInLfCrLfOrCr) {
