@@ -23,7 +23,8 @@ Status save_preset(const std::filesystem::path& path, const TissueParameters& pa
 Result<TissueParameters> load_preset(const std::filesystem::path& path, const TissueParameters& base) {
   Result<std::string> text = read_utf8_text_file(path, " the preset");
   if (!text) return Error{text.error()};
-  Result<nlohmann::json> parsed = parse_json_text(*text, path.string());
+  // A key written twice (a hand edit) is refused as in calibration files: the library would keep the last silently.
+  Result<nlohmann::json> parsed = parse_json_text(*text, path.string(), true);
   if (!parsed) return Error{parsed.error()};
   const nlohmann::json& preset = *parsed;
   if (!preset.is_object()) return Error{path.string() + ": not a JSON object (a preset is {\"resecto_preset\": 1, \"parameters\": {...}})"};

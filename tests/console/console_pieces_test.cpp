@@ -130,6 +130,7 @@ TEST(TissuePresets, RoundTripAndClearErrors) {
       {R"([1, 2])", "not a JSON object"},
       {R"({"resecto_preset": 2, "parameters": {}})", "preset format 2 is not one this build reads"},
       {R"({"resecto_preset": 1, "parameters": {}, "stiffnes": 40})", "unknown key 'stiffnes'"},
+      {R"({"resecto_preset": 1, "parameters": {"stiffness": 40, "stiffness": 60}})", "parameters.stiffness: the key appears twice in its object"},
   };
   for (const auto& [text, expected] : bad) {
     std::ofstream(dir / "bad.json") << text;

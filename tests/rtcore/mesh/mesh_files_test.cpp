@@ -349,6 +349,15 @@ TEST(MeshFiles, APlyPropertyDeclaredTwiceInAnElementIsRefused) {
   EXPECT_TRUE(read) << read.error();
 }
 
+// A Windows "Unicode" save is UTF-16: named as such rather than read as a NUL after every character.
+TEST(MeshFiles, AUtf16TextMeshIsNamedAsOne) {
+  for (const char* name : {"wide.obj", "wide.off"}) {
+    std::string wide = "\xFF\xFE";
+    for (const char c : std::string("v 0 0 0\n")) wide += std::string(1, c) + std::string(1, '\0');
+    EXPECT_EQ(validation_error(write_file(name, wide)), scratch(name).string() + ": is UTF-16, not UTF-8 text; save it as UTF-8");
+  }
+}
+
 TEST(MeshFiles, AsciiStlMayStartWithAByteOrderMark) {
   std::string stl = "solid cube\n";
   const Vec3 corners[8] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
