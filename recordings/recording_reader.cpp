@@ -376,12 +376,14 @@ std::string Recording::describe_tick_gaps() const {
   constexpr std::size_t kMostNamed = 5;
   for (std::size_t i = 0; i < gaps.size() && i < kMostNamed; ++i) {
     const auto [first, last] = gaps[i];
-    if (i > 0) text += i + 1 == gaps.size() ? " and " : ", ";
-    text += std::to_string(first) + (last > first ? "-" + std::to_string(last) : "");
+    // Appended piece by piece: `"-" + std::to_string(...)` trips GCC 12's false -Wrestrict at -O3.
+    if (i > 0) text.append(i + 1 == gaps.size() ? " and " : ", ");
+    text.append(std::to_string(first));
+    if (last > first) text.append("-").append(std::to_string(last));
   }
-  if (gaps.size() > kMostNamed) text += " and " + std::to_string(gaps.size() - kMostNamed) + " more runs";
+  if (gaps.size() > kMostNamed) text.append(" and ").append(std::to_string(gaps.size() - kMostNamed)).append(" more runs");
   for (const auto& [first, last] : gaps) count += last - first + 1;
-  return text + " (" + std::to_string(count) + " ticks)";
+  return text.append(" (").append(std::to_string(count)).append(" ticks)");
 }
 
 std::array<std::uint64_t, kChunkTypeCount> Recording::bytes_by_type() const {

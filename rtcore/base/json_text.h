@@ -70,9 +70,14 @@ class RepeatedKeyFinder {
   }
   std::string path() const {
     std::string out;
+    // Appended piece by piece: `"[" + std::to_string(...)` trips GCC 12's false -Wrestrict at -O3.
     for (const Level& level : levels_) {
-      if (!level.object) out += "[" + std::to_string(level.index) + "]";
-      else out += (out.empty() ? "" : ".") + printable_text(level.key);
+      if (!level.object) {
+        out.append("[").append(std::to_string(level.index)).append("]");
+      } else {
+        if (!out.empty()) out.push_back('.');
+        out.append(printable_text(level.key));
+      }
     }
     return out;
   }
