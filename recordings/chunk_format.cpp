@@ -18,31 +18,36 @@ std::uint32_t load_u32(const std::uint8_t* p) {
   return v;
 }
 
-std::uint16_t load_u16(const std::uint8_t* p) {
-  std::uint16_t v;
-  std::memcpy(&v, p, 2);
-  return v;
-}
+/// What the bytes at `pos` hold, checked in the order a reader trusts them: the marker, the frame's
+/// CRC (so a damaged length is never used), a plausible length inside `limit`, the payload's CRC.
+enum class ChunkCheck { kNoMarker, kFrameCrcFails, kTooLong, kCutShort, kPayloadCrcFails, kIntact };
 
-/// The chunk whose marker is at `pos`, if its frame is intact (CRC, plausible length, inside the
-/// file); `payload_ok` tells whether the payload's CRC holds too.
-bool parse_chunk_at(std::span<const std::uint8_t> file, std::uint64_t limit, std::uint64_t pos, ChunkLocation& chunk,
-                    bool& payload_ok) {
-  if (limit - pos < kChunkFrameBytes + kChunkTrailerBytes) return false;
+/// Checks the chunk whose marker may be at `pos`; `chunk` is filled from kTooLong on.
+ChunkCheck check_chunk_at(std::span<const std::uint8_t> file, std::uint64_t limit, std::uint64_t pos, ChunkLocation& chunk) {
+  if (pos >= limit || limit - pos < kChunkFrameBytes) return ChunkCheck::kNoMarker;
   const std::uint8_t* frame = file.data() + pos;
-  if (load_u32(frame) != kChunkMarker) return false;
-  if (crc32_of(std::span<const std::uint8_t>(frame, 16)) != load_u32(frame + 16)) return false;
+  if (load_u32(frame) != kChunkMarker) return ChunkCheck::kNoMarker;
+  if (crc32_of(std::span<const std::uint8_t>(frame, 16)) != load_u32(frame + 16)) return ChunkCheck::kFrameCrcFails;
   ByteReader reader(std::span<const std::uint8_t>(frame + 4, 12));
   chunk.offset = pos;
   chunk.type = reader.get<std::uint16_t>();
   reader.get<std::uint16_t>();  // flags: none defined yet
   chunk.sequence = reader.get<std::uint32_t>();
   chunk.payload_bytes = reader.get<std::uint32_t>();
-  if (chunk.payload_bytes > kMaxChunkPayloadBytes) return false;
-  if (limit - pos < kChunkFrameBytes + std::uint64_t{chunk.payload_bytes} + kChunkTrailerBytes) return false;  // cut off
+  if (chunk.payload_bytes > kMaxChunkPayloadBytes) return ChunkCheck::kTooLong;
+  if (limit - pos < kChunkFrameBytes + std::uint64_t{chunk.payload_bytes} + kChunkTrailerBytes) return ChunkCheck::kCutShort;
   const std::span<const std::uint8_t> payload(file.data() + chunk.payload_offset(), chunk.payload_bytes);
-  payload_ok = crc32_of(payload) == load_u32(file.data() + chunk.payload_offset() + chunk.payload_bytes);
-  return true;
+  return crc32_of(payload) == load_u32(file.data() + chunk.payload_offset() + chunk.payload_bytes) ? ChunkCheck::kIntact
+                                                                                                  : ChunkCheck::kPayloadCrcFails;
+}
+
+/// The chunk whose marker is at `pos`, if its frame is intact (CRC, plausible length, inside the
+/// file); `payload_ok` tells whether the payload's CRC holds too.
+bool parse_chunk_at(std::span<const std::uint8_t> file, std::uint64_t limit, std::uint64_t pos, ChunkLocation& chunk,
+                    bool& payload_ok) {
+  const ChunkCheck check = check_chunk_at(file, limit, pos, chunk);
+  payload_ok = check == ChunkCheck::kIntact;
+  return check == ChunkCheck::kIntact || check == ChunkCheck::kPayloadCrcFails;
 }
 
 }  // namespace
@@ -79,20 +84,19 @@ void append_chunk(std::vector<std::uint8_t>& out, ChunkType type, std::uint32_t 
 
 std::string describe_chunk_at(std::span<const std::uint8_t> file, std::uint64_t pos) {
   if (pos >= file.size()) return "the end of the file";
-  if (file.size() - pos < kChunkFrameBytes || load_u32(file.data() + pos) != kChunkMarker) return "no chunk marker";
-  const std::uint8_t* frame = file.data() + pos;
-  if (crc32_of(std::span<const std::uint8_t>(frame, 16)) != load_u32(frame + 16)) return "a chunk frame whose own CRC fails";
-  const std::string type(chunk_type_name(load_u16(frame + 4)));
-  const std::uint32_t payload = load_u32(frame + 12);
-  const std::uint64_t end = pos + kChunkFrameBytes + std::uint64_t{payload} + kChunkTrailerBytes;
-  if (payload > kMaxChunkPayloadBytes) return "a " + type + " chunk whose frame claims " + std::to_string(payload) + " bytes, past any real chunk";
-  if (end > file.size()) {
-    return "a " + type + " chunk whose frame claims " + std::to_string(payload) + " bytes, but the file ends at byte " + std::to_string(file.size()) +
-           " (cut short)";
+  ChunkLocation chunk;
+  const ChunkCheck check = check_chunk_at(file, file.size(), pos, chunk);
+  const std::string a_chunk = "a " + std::string(chunk_type_name(chunk.type)) + " chunk";
+  const std::string claims = a_chunk + " whose frame claims " + std::to_string(chunk.payload_bytes) + " bytes";
+  switch (check) {
+    case ChunkCheck::kNoMarker: return "no chunk marker";
+    case ChunkCheck::kFrameCrcFails: return "a chunk frame whose own CRC fails";
+    case ChunkCheck::kTooLong: return claims + ", past any real chunk";
+    case ChunkCheck::kCutShort: return claims + ", but the file ends at byte " + std::to_string(file.size()) + " (cut short)";
+    case ChunkCheck::kPayloadCrcFails: return a_chunk + " whose payload CRC fails";
+    case ChunkCheck::kIntact: break;
   }
-  const std::span<const std::uint8_t> body(frame + kChunkFrameBytes, payload);
-  if (crc32_of(body) != load_u32(frame + kChunkFrameBytes + payload)) return "a " + type + " chunk whose payload CRC fails";
-  return "a " + type + " chunk (" + std::to_string(payload) + " bytes)";
+  return a_chunk + " (" + std::to_string(chunk.payload_bytes) + " bytes)";
 }
 
 std::string describe(const DamagedRange& range) {
