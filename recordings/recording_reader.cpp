@@ -157,6 +157,13 @@ void Recording::check_index(std::span<const IndexEntry> entries, const std::stri
                 std::to_string(chunk->sequence) + " of " + std::to_string(chunk->payload_bytes);
     } else if (!at_chunk && !in_damage) {
       problem = "points where no chunk starts";
+    } else if (at_chunk) {
+      // The first tick is what a reader seeking by time trusts the index for.
+      const std::uint64_t first_tick = first_tick_of(chunk->type, payload(*chunk));
+      if (first_tick != entry.first_tick) {
+        problem = "gives the " + std::string(chunk_type_name(entry.type)) + " chunk's first tick as " + std::to_string(entry.first_tick) +
+                  ", the chunk starts at tick " + std::to_string(first_tick);
+      }
     }
     if (!problem.empty()) {
       index_problems_.push_back(where + ": entry " + std::to_string(e) + " (byte " + std::to_string(entry.offset) + ") " + problem);

@@ -1,6 +1,7 @@
 // Packing of tick, step, command and keyframe payloads (layouts in recordings/README.md).
 #include "recordings/records.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -11,6 +12,7 @@
 #include <zlib.h>
 
 #include "recordings/byte_io.h"
+#include "recordings/chunk_format.h"
 
 namespace resecto::rec {
 namespace {
@@ -250,6 +252,26 @@ Result<KeyframeRecord> decode_keyframe_payload(std::span<const std::uint8_t> pay
   k.has_node_ids = (changed & 2) != 0;
   k.draco = r.get_bytes(r.remaining());
   return k;
+}
+
+std::uint64_t first_tick_of(std::uint16_t type, std::span<const std::uint8_t> payload) {
+  switch (static_cast<ChunkType>(type)) {
+    case ChunkType::kTicks:
+    case ChunkType::kKeyframe: {
+      ByteReader r(payload);
+      return r.get<std::uint64_t>();
+    }
+    case ChunkType::kSteps: {
+      Result<std::vector<StepRecord>> steps = decode_step_block(payload);
+      return steps && !steps->empty() ? steps->front().tick : 0;
+    }
+    case ChunkType::kCommands: {
+      Result<std::vector<ParameterCommand>> commands = decode_command_block(payload);
+      return commands && !commands->empty() ? static_cast<std::uint64_t>(std::max<std::int64_t>(0, commands->front().apply_tick)) : 0;
+    }
+    default:
+      return 0;
+  }
 }
 
 }  // namespace resecto::rec

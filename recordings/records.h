@@ -34,6 +34,10 @@ struct StepRecord {
 inline constexpr std::uint32_t kMetricWords = static_cast<std::uint32_t>(metric_field_count());
 
 /// Payload of a kTicks chunk: consecutive ticks (`ticks[i].tick == ticks[0].tick + i`).
+/// The first tick a chunk's payload covers (ticks, steps, keyframes, commands), 0 for others: what the
+/// recorder's index gives for it.
+std::uint64_t first_tick_of(std::uint16_t type, std::span<const std::uint8_t> payload);
+
 void encode_tick_block(std::span<const TickRecord> ticks, std::vector<std::uint8_t>& payload);
 Result<std::vector<TickRecord>> decode_tick_block(std::span<const std::uint8_t> payload);
 

@@ -22,26 +22,6 @@ Status write_bytes_atomically(const std::filesystem::path& out, std::span<const 
 
 }  // namespace
 
-std::uint64_t first_tick_of(std::uint16_t type, std::span<const std::uint8_t> payload) {
-  switch (static_cast<ChunkType>(type)) {
-    case ChunkType::kTicks:
-    case ChunkType::kKeyframe: {
-      ByteReader r(payload);
-      return r.get<std::uint64_t>();
-    }
-    case ChunkType::kSteps: {
-      Result<std::vector<StepRecord>> steps = decode_step_block(payload);
-      return steps && !steps->empty() ? steps->front().tick : 0;
-    }
-    case ChunkType::kCommands: {
-      Result<std::vector<ParameterCommand>> commands = decode_command_block(payload);
-      return commands && !commands->empty() ? static_cast<std::uint64_t>(std::max<std::int64_t>(0, commands->front().apply_tick)) : 0;
-    }
-    default:
-      return 0;
-  }
-}
-
 std::vector<std::uint8_t> recovered_bytes(const Recording& recording, RecoverReport& report) {
   report = {};
   std::vector<std::uint8_t> out(std::begin(kFileSignature), std::end(kFileSignature));

@@ -33,7 +33,4 @@ Status export_keyframe(const Recording& recording, std::size_t k, const std::fil
 /// loop_travel_m,cut,coagulate,tool_present (17 significant digits: the values read back exactly).
 Status export_inputs_csv(const Recording& recording, const std::filesystem::path& out);
 
-/// The first tick a chunk's payload covers (ticks, steps, keyframes, commands), 0 for others.
-std::uint64_t first_tick_of(std::uint16_t type, std::span<const std::uint8_t> payload);
-
 }  // namespace resecto::rec

@@ -538,6 +538,23 @@ TEST(RecordingFile, AnIndexOrNumberingThatDoesNotMatchTheChunksIsNamed) {
   EXPECT_NE(r->index_problems()[1].find(": entry 3 (byte "), std::string::npos) << r->index_problems()[1];
   EXPECT_NE(r->index_problems()[1].find(" the file has "), std::string::npos) << r->index_problems()[1];
 
+  // An entry that names its chunk rightly but gives it another first tick, the field a reader seeking by time uses.
+  const std::vector<std::uint8_t> mistimed = with_payloads_rewritten(file, [](const ChunkLocation& chunk, std::vector<std::uint8_t>& payload) {
+    if (chunk.type != static_cast<std::uint16_t>(ChunkType::kIndex)) return;
+    Result<std::vector<IndexEntry>> entries = decode_index(payload);
+    ASSERT_TRUE(entries) << entries.error();
+    const auto ticks = std::find_if(entries->begin(), entries->end(), [](const IndexEntry& e) { return e.type == static_cast<std::uint16_t>(ChunkType::kTicks); });
+    ASSERT_NE(ticks, entries->end());
+    ticks->first_tick += 5;
+    payload.clear();
+    encode_index(*entries, payload);
+  });
+  Result<Recording> shifted = Recording::from_bytes(mistimed, "mistimed.rsrec");
+  ASSERT_TRUE(shifted) << shifted.error();
+  ASSERT_EQ(shifted->index_problems().size(), 1u);
+  EXPECT_NE(shifted->index_problems()[0].find("gives the ticks chunk's first tick as 5, the chunk starts at tick 0"), std::string::npos)
+      << shifted->index_problems()[0];
+
   // Every chunk numbered 0, framed afresh (CRCs hold); the index left out, as a killed run's file.
   const ChunkScan scan = scan_chunks(file);
   std::vector<std::uint8_t> renumbered(file.begin(), file.begin() + static_cast<std::ptrdiff_t>(scan.chunks.front().offset));
