@@ -59,11 +59,12 @@ Result<TriangleMesh> read_surface_mesh(const std::filesystem::path& path, double
   Result<std::string> bytes = read_text_file(path, " the mesh", kMaxMeshFileBytes);
   if (!bytes) return Error{bytes.error()};
   const MeshFormat format = ext == ".off" ? MeshFormat::off : ext == ".obj" ? MeshFormat::obj : ext == ".ply" ? MeshFormat::ply : MeshFormat::stl;
-  // A binary STL's 80-byte header is free bytes, so only the formats that open with text lose a mark,
-  // and only the text-only ones (OFF, OBJ) can be told to be UTF-16 (a Windows "Unicode" save): a
-  // binary PLY or STL holds NUL bytes of its own.
+  // A binary STL's 80-byte header is free bytes, so only the formats that open with text lose a mark.
+  // A Windows "Unicode" save is UTF-16: a PLY always opens with its text header (any binary data comes
+  // after it), so its start tells as an OFF's or OBJ's does; an STL is judged by parse_stl, which
+  // knows a binary one by its size.
   if (format != MeshFormat::stl) strip_utf8_bom(*bytes);
-  if ((format == MeshFormat::off || format == MeshFormat::obj) && is_utf16(*bytes)) {
+  if (format != MeshFormat::stl && is_utf16(*bytes)) {
     return Error{name + ": is UTF-16, not UTF-8 text; save it as UTF-8"};
   }
   return parse_surface_mesh(*bytes, format, name, metres_per_unit);

@@ -17,6 +17,7 @@
 
 #include "rtcore/base/checked_number.h"
 #include "rtcore/base/quoted_word.h"
+#include "rtcore/base/text_file.h"
 
 namespace resecto {
 namespace {
@@ -757,6 +758,8 @@ Result<RawMesh> parse_stl(std::string_view bytes, const std::string& name) {
     const std::uint32_t declared = little_endian_u32(bytes, 80);
     if (84 + 50 * std::uint64_t{declared} == bytes.size()) return parse_binary_stl(bytes, name);
   }
+  // Not a binary one's size: an ASCII STL saved as UTF-16 ("Unicode") would read as neither.
+  if (is_utf16(bytes)) return Error{name + ": is UTF-16, not UTF-8 text; save it as UTF-8"};
   // An editor may put a UTF-8 byte-order mark before "solid" (the other formats' readers drop it
   // earlier; a binary STL's header may begin with those bytes, so here only ahead of the text).
   const std::string_view text = bytes.starts_with("\xEF\xBB\xBF") ? bytes.substr(3) : bytes;

@@ -350,11 +350,20 @@ TEST(MeshFiles, APlyPropertyDeclaredTwiceInAnElementIsRefused) {
 }
 
 // A Windows "Unicode" save is UTF-16: named as such rather than read as a NUL after every character.
+// PLY and ASCII STL too (an STL's binary layout, whose header is free bytes, is known by its size).
 TEST(MeshFiles, AUtf16TextMeshIsNamedAsOne) {
-  for (const char* name : {"wide.obj", "wide.off"}) {
-    std::string wide = "\xFF\xFE";
-    for (const char c : std::string("v 0 0 0\n")) wide += std::string(1, c) + std::string(1, '\0');
-    EXPECT_EQ(validation_error(write_file(name, wide)), scratch(name).string() + ": is UTF-16, not UTF-8 text; save it as UTF-8");
+  const std::pair<const char*, std::string> files[] = {
+      {"wide.obj", "v 0 0 0\n"},
+      {"wide.off", "OFF\n3 1 0\n"},
+      {"wide.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"},
+      {"wide.stl", "solid part\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid part\n"}};
+  for (const auto& [name, text] : files) {
+    for (const bool marked : {true, false}) {
+      std::string wide = marked ? "\xFF\xFE" : "";
+      for (const char c : text) wide += std::string(1, c) + std::string(1, '\0');
+      EXPECT_EQ(validation_error(write_file(name, wide)), scratch(name).string() + ": is UTF-16, not UTF-8 text; save it as UTF-8")
+          << name << (marked ? " with" : " without") << " a byte-order mark";
+    }
   }
 }
 
