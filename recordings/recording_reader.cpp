@@ -92,6 +92,10 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
         break;
       }
       case ChunkType::kSummary:
+        if (std::optional<std::string> deep = json_nesting_error(std::string_view(reinterpret_cast<const char*>(payload.data()), payload.size()), where)) {
+          r.content_errors_.push_back(*deep);
+          break;
+        }
         try {
           r.summary_ = nlohmann::ordered_json::parse(payload.begin(), payload.end());
         } catch (const std::exception& e) {

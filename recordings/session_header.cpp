@@ -170,6 +170,7 @@ nlohmann::ordered_json header_to_json(const SessionHeader& h) {
 }
 
 Result<SessionHeader> header_from_json(std::string_view text) {
+  if (std::optional<std::string> deep = json_nesting_error(text, "header")) return Error{*deep};
   try {
     const ordered_json document = ordered_json::parse(text);
     const JsonFields j(document, "");

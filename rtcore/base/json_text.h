@@ -4,8 +4,10 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -22,6 +24,40 @@ inline std::string library_free(const std::string& what) {
     if (const std::size_t end = what.find("] "); end != std::string::npos) return what.substr(end + 2);
   }
   return what;
+}
+
+/// The most levels of arrays and objects a JSON input may nest. Every file this program reads nests a
+/// handful; the library parses any depth, but copying or walking a document 50,000 levels deep
+/// recurses that deep and overflows the stack (audit 32, F1: a crafted recording header).
+inline constexpr std::size_t kMostJsonNesting = 256;
+
+/// Where `text` first opens a level of arrays and objects past kMostJsonNesting (brackets inside
+/// strings do not count), or std::string::npos.
+inline std::size_t json_nesting_overflow(std::string_view text) {
+  std::size_t depth = 0;
+  bool in_string = false, escaped = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (escaped) escaped = false;
+      else if (c == '\\') escaped = true;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMostJsonNesting) return i;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return std::string::npos;
+}
+
+/// The error for JSON `text` from `source` that nests too deep, or nothing.
+inline std::optional<std::string> json_nesting_error(std::string_view text, const std::string& source) {
+  const std::size_t at = json_nesting_overflow(text);
+  if (at == std::string::npos) return std::nullopt;
+  return source + ": nests arrays and objects more than " + std::to_string(kMostJsonNesting) + " levels deep at " + text_position(text, at);
 }
 
 namespace detail {
@@ -93,6 +129,7 @@ class RepeatedKeyFinder {
 /// library keeps the last silently, so a hand-edited file could be read with a value its author
 /// thought was replaced.
 inline Result<nlohmann::json> parse_json_text(const std::string& text, const std::string& source, bool refuse_repeated_keys = false) {
+  if (std::optional<std::string> deep = json_nesting_error(text, source)) return Error{*deep};
   try {
     if (refuse_repeated_keys) {
       detail::RepeatedKeyFinder finder;

@@ -387,6 +387,20 @@ TEST(SessionHeaderJson, ANegativeStartTickIsRefusedByName) {
   EXPECT_EQ(broken.error().find("[json.exception"), std::string::npos) << broken.error();
 }
 
+// Audit 32, F1: a header whose calibration nested 50,000 levels deep (valid JSON, valid CRCs) overflowed
+// the stack of every command that read it, as the document was copied; refused by where it goes deep.
+TEST(SessionHeaderJson, AHeaderNestedThousandsDeepIsRefusedNotACrash) {
+  nlohmann::ordered_json json = header_to_json(sound_header());
+  json["calibration"] = "@";
+  std::string text = json.dump();
+  const std::size_t at = text.find("\"@\"");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 3, std::string(50000, '[') + std::string(50000, ']'));
+  const Result<SessionHeader> parsed = header_from_json(text);
+  ASSERT_FALSE(parsed);
+  EXPECT_NE(parsed.error().find("header: nests arrays and objects more than 256 levels deep at line 1, column "), std::string::npos) << parsed.error();
+}
+
 TEST(SessionHeaderJson, AHeaderWithoutContactReuseReplaysSearchingEveryStep) {
   const SessionHeader header = sound_header();
   nlohmann::ordered_json json = header_to_json(header);

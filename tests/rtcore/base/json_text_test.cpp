@@ -31,4 +31,17 @@ TEST(JsonText, RepeatedKeysAreRefusedByPathWhenAsked) {
 }
 
 }  // namespace
+// Audit 32, F1: any depth parses, but a document thousands of levels deep overflows the stack when it
+// is copied or walked; brackets inside strings are text, not nesting.
+TEST(JsonText, NestingPastTheLimitIsRefusedByWhereItGoesDeep) {
+  const std::string deep = "{\"a\": " + std::string(300, '[') + std::string(300, ']') + "}";
+  const Result<nlohmann::json> refused = parse_json_text(deep, "deep.json");
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error(), "deep.json: nests arrays and objects more than 256 levels deep at line 1, column 262");
+  const std::string quoted = "{\"a\": \"" + std::string(300, '[') + "\\\"{\"}";
+  EXPECT_TRUE(parse_json_text(quoted, "quoted.json")) << "brackets in a string";
+  const std::string at_limit = std::string(255, '[') + std::string(255, ']');
+  EXPECT_TRUE(parse_json_text("{\"a\": " + at_limit + "}", "limit.json"));
+}
+
 }  // namespace resecto
