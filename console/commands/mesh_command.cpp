@@ -90,10 +90,14 @@ void register_prostate(CLI::App& mesh) {
   cmd->add_option("-o,--output", options->output, "Mesh file (.off, .obj, .ply, .stl), millimetres")->required();
   cmd->callback([options] {
     require_output_extension(options->output, true);
+    // Both outputs checked before either is written: a landmarks path with a folder in the way
+    // failed after the mesh was written (audit 32, F8).
+    const auto landmarks = landmarks_path_for(options->output);
+    const std::filesystem::path outputs[] = {options->output, landmarks};
+    if (Status writable = check_output_paths(outputs); !writable) fail(writable.error());
     const ProstateModel model = generate_prostate(options->triangles);
     const SurfaceReport report = validated(model.surface, "generated prostate");
     write_or_fail(options->output, model.surface);
-    const auto landmarks = landmarks_path_for(options->output);
     if (Status written = write_file_atomically(landmarks, landmarks_to_json(model)); !written) fail(written.error());
     const ProstateShape& s = model.shape;
     std::printf("prostate %s (landmarks %s)\n", options->output.c_str(), landmarks.string().c_str());

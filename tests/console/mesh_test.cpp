@@ -29,6 +29,16 @@ TEST(MeshCommand, ProstateWritesMeshAndLandmarksDeterministically) {
   EXPECT_EQ(mesh->triangle_count(), 2816u);
 }
 
+// Audit 32, F8: a folder where the landmarks go failed the command after the mesh was written.
+TEST(MeshCommand, ProstateChecksBothOutputsBeforeWritingEither) {
+  const auto dir = scratch_directory("mesh_prostate_outputs");
+  std::filesystem::create_directories(dir / "p.landmarks.json");
+  const CommandOutput run = run_resecto("mesh prostate --triangles 1296 -o " + (dir / "p.off").string());
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("p.landmarks.json"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "p.off")) << "nothing written when one output cannot be";
+}
+
 TEST(MeshCommand, ResectoscopeHas488FacesSheathFirst) {
   const auto dir = scratch_directory("mesh_resectoscope");
   const CommandOutput run = run_resecto("mesh resectoscope --loop-travel 12 -o " + (dir / "tool.stl").string());
