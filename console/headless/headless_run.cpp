@@ -365,6 +365,15 @@ std::string summarize_report(const ordered_json& r) {
                 m.at("contact_time_s").get<double>(), m.at("peak_reaction_force_n").get<double>(), m.at("cut_pedal_time_s").get<double>(),
                 m.at("cut_in_contact_time_s").get<double>(), m.at("max_tissue_displacement_mm").get<double>());
   std::string summary = text;
+  // Only the JSON said so (audit 32, F11): a procedure that moves the tool further between two contact
+  // searches than their margin covers may pass through tissue without a contact being found.
+  if (const auto outran = m.at("contact_margin_exceeded_ticks").get<std::uint64_t>(); outran > 0) {
+    std::snprintf(text, sizeof text,
+                  "  warning    on %llu ticks the tool had moved past the contact search's margin since the last search (up to %.2f mm): "
+                  "contacts there may have been missed; the procedure moves faster than a hand can\n",
+                  static_cast<unsigned long long>(outran), m.at("max_tool_travel_since_search_mm").get<double>());
+    summary += text;
+  }
   if (r.contains("recording")) {
     const auto& recording = r.at("recording");
     const auto& lost = recording.at("lost");

@@ -121,6 +121,20 @@ TEST(RunCommand, ReportsTheCollisionStepsThatKeptTheirContactCandidates) {
   EXPECT_NE(refused.err.find("contact reuse shift 1.5 mm is outside [0, the contact margin 1.5 mm)"), std::string::npos) << refused.err;
 }
 
+// Audit 32, F11: a procedure that jumps the tool 50 mm between two samples looked normal in the
+// summary; only the JSON counted the ticks past the contact margin.
+TEST(RunCommand, AToolThatOutrunsTheContactSearchIsWarnedOf) {
+  const auto dir = scratch_directory("run_outrun");
+  std::ofstream(dir / "jump.txt") << "0 0 0 0 125 0 0 0\n0.3 0 0 0 125 0 0 0\n0.3001 0 0 0 175 20 1 0\n0.6 0 0 0 175 20 1 0\n";
+  const CommandOutput jump = run_resecto("run --headless --triangles 1296 --procedure " + (dir / "jump.txt").string());
+  ASSERT_EQ(jump.exit_code, 0) << jump.err;
+  EXPECT_NE(jump.out.find("  warning    on "), std::string::npos) << jump.out;
+  EXPECT_NE(jump.out.find("contacts there may have been missed"), std::string::npos) << jump.out;
+  const CommandOutput calm = run_resecto(kShortRun);
+  ASSERT_EQ(calm.exit_code, 0) << calm.err;
+  EXPECT_EQ(calm.out.find("warning"), std::string::npos) << calm.out;
+}
+
 TEST(RunCommand, TheContactMarginIsTheUsersToChooseWithinItsRange) {
   const auto dir = scratch_directory("run_contact_margin");
   // A wider margin keeps every pair the default keeps and more: the short run's state is the same.
