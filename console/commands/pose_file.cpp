@@ -32,14 +32,18 @@ Result<std::vector<RigidPose>> parse_poses(const std::string& text, const std::s
   std::vector<RigidPose> poses;
   int number = 0;
   // Lines end in LF, CR LF or a lone CR (text_lines).
-  for (const std::string_view text_line : text_lines(text)) {
+  for (std::string_view text_line : text_lines(text)) {
     ++number;
+    // A comment runs from '#' to the end of the line, as in procedure files (audit 32, F12: one after
+    // the numbers was read as a thirteenth).
+    if (const std::size_t comment = text_line.find('#'); comment != std::string_view::npos) text_line = text_line.substr(0, comment);
     const std::vector<TextWord> words = text_words(text_line, ",");
-    if (words.empty() || words.front().text.front() == '#') continue;
-    const std::string where = source + ":" + std::to_string(number) + ": ";
+    if (words.empty()) continue;
+    const std::string line_place = source + ":" + std::to_string(number) + ": ";
     double values[12];
     int count = 0;
     for (const TextWord& word : words) {
+      const std::string where = source + ":" + std::to_string(number) + ":" + std::to_string(word.column) + ": ";
       // Decimal numbers only, as the mesh readers and the procedure files take them: strtod also took
       // hexadecimal ("0x3") and read the number at the front of a word ("1.5abc").
       const std::optional<double> v = parse_finite(word.text);
@@ -50,6 +54,7 @@ Result<std::vector<RigidPose>> parse_poses(const std::string& text, const std::s
       if (count == 12) return Error{where + "more than 12 numbers (expected r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz)"};
       values[count++] = *v;
     }
+    const std::string& where = line_place;
     if (count != 12) {
       return Error{where + "expected 12 numbers (r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz), found " + std::to_string(count)};
     }

@@ -193,17 +193,21 @@ TEST(CollideCommand, MalformedPosesLineIsNamed) {
   std::ofstream(f.poses) << "1 0 0 0 0 1 0 0 0 0 1 nan\n";
   result = run_resecto(common_args(f));
   EXPECT_NE(result.exit_code, 0);
-  EXPECT_NE(result.err.find("poses.txt:1: number 12 of 12, 'nan', is not finite"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("poses.txt:1:23: number 12 of 12, 'nan', is not finite"), std::string::npos) << result.err;
 
   // Decimal numbers only, whole words: strtod took "0x3" as 3 and "1.5abc" as 1.5 then "abc".
   for (const char* word : {"0x3", "1.5abc"}) {
     std::ofstream(f.poses) << "1 0 0 0 0 1 0 0 0 0 1 " << word << "\n";
     result = run_resecto(common_args(f));
     EXPECT_NE(result.exit_code, 0);
-    EXPECT_NE(result.err.find(std::string("poses.txt:1: '") + word + "' is not a number"), std::string::npos) << result.err;
+    EXPECT_NE(result.err.find(std::string("poses.txt:1:23: '") + word + "' is not a number"), std::string::npos) << result.err;
   }
   std::ofstream(f.poses) << "1,0,0,0, 0,1,0,0, 0,0,1,0.5\n";  // commas still separate
   EXPECT_EQ(run_resecto(common_args(f)).exit_code, 0);
+  // A comment may follow the numbers, as in procedure files (audit 32, F12).
+  std::ofstream(f.poses) << "# rest\n1 0 0 0 0 1 0 0 0 0 1 0.5  # on the wall\n1 0 0 0 0 1 0 0 0 0 1 0.6#\n";
+  result = run_resecto(common_args(f));
+  EXPECT_EQ(result.exit_code, 0) << result.err;
 
   std::ofstream(f.poses) << "2 0 0 0 0 1 0 0 0 0 1 0\n";
   result = run_resecto(common_args(f));
