@@ -18,6 +18,7 @@
 #include "console/commands/command_registry.h"
 #include "console/commands/pose_file.h"
 #include "rtcore/base/atomic_file.h"
+#include "rtcore/base/checked_number.h"
 #include "rtcore/base/quantile.h"
 #include "rtcore/base/text_file.h"
 #include "rtcore/collision/collide.h"
@@ -45,6 +46,17 @@ constexpr double kFileUnits = 1.0;
 TriangleMesh read_mesh_or_fail(const std::string& path) {
   Result<TriangleMesh> mesh = read_surface_mesh(path, kFileUnits);
   if (!mesh) fail(mesh.error());
+  // Scale-free, but within a double's range: the exact triangle tests multiply up to four coordinate
+  // differences, which underflowed at spans of 1e-148 and missed or invented pairs (audit 32, F7).
+  if (!mesh->positions.empty()) {
+    const Aabb box = bounding_box(*mesh);
+    const Vec3 extent = box.max - box.min;
+    const double span = std::max({extent.x, extent.y, extent.z});
+    constexpr double kSmallestSpan = 1e-60, kLargestSpan = 1e60;
+    if (!(span >= kSmallestSpan && span <= kLargestSpan)) {
+      fail(path + ": spans " + exact_number(span) + " units; the exact triangle tests need a span from 1e-60 to 1e+60 (rescale the mesh)");
+    }
+  }
   return std::move(mesh).value();
 }
 

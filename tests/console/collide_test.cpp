@@ -204,6 +204,12 @@ TEST(CollideCommand, MalformedPosesLineIsNamed) {
   }
   std::ofstream(f.poses) << "1,0,0,0, 0,1,0,0, 0,0,1,0.5\n";  // commas still separate
   EXPECT_EQ(run_resecto(common_args(f)).exit_code, 0);
+  // A mesh too small (or large) for a double's products is refused, not answered wrongly (audit 32, F7).
+  std::ofstream(f.dir / "tiny.off") << "OFF\n4 4 0\n0 0 0\n1e-150 0 0\n0 1e-150 0\n0 0 1e-150\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  std::ofstream(f.poses) << "1 0 0 0 0 1 0 0 0 0 1 0\n";
+  result = run_resecto("collide --tissue " + f.tissue.string() + " --tool " + (f.dir / "tiny.off").string() + " --poses " + f.poses.string());
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("spans 1e-150 units; the exact triangle tests need a span from 1e-60 to 1e+60"), std::string::npos) << result.err;
   // A comment may follow the numbers, as in procedure files (audit 32, F12).
   std::ofstream(f.poses) << "# rest\n1 0 0 0 0 1 0 0 0 0 1 0.5  # on the wall\n1 0 0 0 0 1 0 0 0 0 1 0.6#\n";
   result = run_resecto(common_args(f));
