@@ -2,6 +2,7 @@
 #include "console/commands/console_command.h"
 
 #include <cstdio>
+#include <optional>
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
@@ -80,6 +81,7 @@ void open_console(const ConsoleCliOptions& o) {
   options.input_paths = inputs;
   Result<Procedure> procedure = find_procedure(o.procedure);
   if (!procedure) throw std::runtime_error(procedure.error());
+  if (const std::optional<std::string> note = shadowed_file_note(o.procedure)) std::fprintf(stderr, "%s\n", note->c_str());
   options.core.device.procedure = std::move(*procedure);
   options.core.device.source = o.device == "keyboard" ? DeviceSource::kEmulatorManual
                                : o.device == "hid"    ? DeviceSource::kHid

@@ -71,6 +71,7 @@ void run(const RunOptions& o) {
   HeadlessOptions options;
   Result<Procedure> procedure = find_procedure(o.procedure);
   if (!procedure) throw std::runtime_error(procedure.error());
+  if (const std::optional<std::string> note = shadowed_file_note(o.procedure)) std::fprintf(stderr, "%s\n", note->c_str());
   options.procedure = std::move(*procedure);
   options.seconds = o.seconds;
   options.realtime = o.realtime;

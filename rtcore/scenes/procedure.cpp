@@ -207,4 +207,11 @@ Result<Procedure> find_procedure(const std::string& name_or_path) {
   return names_a_builtin_procedure(name_or_path) ? builtin_procedure(name_or_path) : load_procedure(name_or_path);
 }
 
+std::optional<std::string> shadowed_file_note(const std::string& name_or_path) {
+  // A file named demo beside the user was passed over without a word (audit 32, F13).
+  std::error_code error;
+  if (!names_a_builtin_procedure(name_or_path) || !builtin_procedure(name_or_path) || !std::filesystem::exists(name_or_path, error)) return std::nullopt;
+  return "note: --procedure " + name_or_path + " is the built-in procedure; to read the file " + name_or_path + " here, write ./" + name_or_path;
+}
+
 }  // namespace resecto

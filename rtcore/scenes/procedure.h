@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,5 +50,8 @@ Result<Procedure> builtin_procedure(const std::string& name);
 bool names_a_builtin_procedure(const std::string& name_or_path);
 /// A built-in name or a file path.
 Result<Procedure> find_procedure(const std::string& name_or_path);
+/// When `name_or_path` is a built-in procedure's name and a file of that name is also in the current
+/// folder, the note that says which was taken and how to read the file; otherwise nothing.
+std::optional<std::string> shadowed_file_note(const std::string& name_or_path);
 
 }  // namespace resecto

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "rtcore/scenes/procedure.h"
@@ -95,6 +97,22 @@ TEST(Procedure, CommasSeparateColumnsAsInPoseFiles) {
   const Result<Procedure> bad = parse_procedure("0,0,0,0,300,0,0,0\n", "mine.txt");
   ASSERT_FALSE(bad);
   EXPECT_EQ(bad.error(), "mine.txt:1:9: insertion_mm 300 is outside [0, 230]");  // columns still count bytes
+}
+
+// Audit 32, F13: a file named demo in the current folder was passed over for the built-in demo silently.
+TEST(Procedure, ABuiltInNameThatAFileHereAlsoHasIsNoted) {
+  const auto dir = std::filesystem::temp_directory_path() / "resecto_procedure_shadowed";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "demo") << "0 0 0 0 125 0 0 0\n";
+  const auto before = std::filesystem::current_path();
+  std::filesystem::current_path(dir);
+  const std::optional<std::string> demo = shadowed_file_note("demo"), turp = shadowed_file_note("turp"), file = shadowed_file_note("./demo");
+  std::filesystem::current_path(before);
+  std::filesystem::remove_all(dir);
+  ASSERT_TRUE(demo);
+  EXPECT_EQ(*demo, "note: --procedure demo is the built-in procedure; to read the file demo here, write ./demo");
+  EXPECT_FALSE(turp) << "no file named turp here";
+  EXPECT_FALSE(file) << "a path is read as the file it names";
 }
 
 // Audit 6, C: a procedure saved as "Unicode" (UTF-16) was reported as a first word of mojibake.
