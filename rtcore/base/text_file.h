@@ -4,8 +4,10 @@
 #pragma once
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -31,7 +33,12 @@ Result<Bytes> read_regular_file(const std::filesystem::path& path, const std::st
   const std::string name = path.string();
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(path, ec);
-  if (status.type() == std::filesystem::file_type::not_found) return Error{name + ": cannot open" + what + ": no such file"};
+  if (status.type() == std::filesystem::file_type::not_found) {
+    // A link that leads nowhere is there, and "no such file" sent users looking for a typo.
+    std::error_code link_error;
+    const bool dangling = std::filesystem::is_symlink(std::filesystem::symlink_status(path, link_error));
+    return Error{name + ": cannot open" + what + (dangling ? ": a symbolic link whose target is missing" : ": no such file")};
+  }
   if (ec) return Error{name + ": cannot open" + what + ": " + ec.message()};
   if (status.type() == std::filesystem::file_type::directory) return Error{name + ": is a folder, not a file"};
   if (status.type() != std::filesystem::file_type::regular) {
@@ -43,7 +50,7 @@ Result<Bytes> read_regular_file(const std::filesystem::path& path, const std::st
     return Error{name + ": " + std::to_string(size) + " bytes, more than the " + std::to_string(max_bytes) + "-byte limit for this input"};
   }
   std::FILE* file = std::fopen(name.c_str(), "rb");
-  if (file == nullptr) return Error{name + ": cannot open" + what};
+  if (file == nullptr) return Error{name + ": cannot open" + what + ": " + std::strerror(errno)};  // e.g. "Permission denied"
   // Read at most one byte past the size seen: a file that grows meanwhile is cut, never read forever.
   Bytes bytes(static_cast<std::size_t>(size) + 1, 0);
   const std::size_t got = std::fread(bytes.data(), 1, bytes.size(), file);

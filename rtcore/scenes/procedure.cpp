@@ -156,7 +156,7 @@ Result<Procedure> parse_procedure(const std::string& text, const std::string& so
     for (std::size_t c = 0; c < 8; ++c) {
       // Decimal only, as the mesh readers take numbers: strtod also took hexadecimal ("0x3").
       const std::optional<double> parsed = parse_finite(words[c].text);
-      if (!parsed) return error_at(c, std::string(kColumns[c]) + " is not a number: " + quoted_word(words[c].text));
+      if (!parsed) return error_at(c, std::string(kColumns[c]) + " is " + not_finite_kind(words[c].text) + ": " + quoted_word(words[c].text));
       v[c] = *parsed;
     }
     constexpr double kLimits[6][2] = {{0.0, 86400.0},           {-kMaxGimbalDeg, kMaxGimbalDeg}, {-kMaxGimbalDeg, kMaxGimbalDeg},

@@ -40,6 +40,22 @@ TEST(ReadTextFile, MissingFileNamesThePathAndWhatItWas) {
   EXPECT_EQ(text.error().rfind(path.string() + ": cannot open (calibration)", 0), 0u) << text.error();
 }
 
+// Audit 32, F14: a link to nothing was "no such file", though the name is there; a loop says so itself.
+TEST(ReadTextFile, ALinkToNothingIsNamedAsOne) {
+  const std::filesystem::path loop_a = scratch("loop_a"), loop_b = scratch("loop_b"), dangling = scratch("dangling");
+  for (const auto& p : {loop_a, loop_b, dangling}) std::filesystem::remove(p);
+  std::filesystem::create_symlink(loop_b, loop_a);
+  std::filesystem::create_symlink(loop_a, loop_b);
+  std::filesystem::create_symlink(scratch("gone"), dangling);
+  const Result<std::string> missing = read_text_file(dangling, " the mesh");
+  ASSERT_FALSE(missing);
+  EXPECT_EQ(missing.error(), dangling.string() + ": cannot open the mesh: a symbolic link whose target is missing");
+  const Result<std::string> loop = read_text_file(loop_a, " the mesh");
+  ASSERT_FALSE(loop);
+  EXPECT_EQ(loop.error(), loop_a.string() + ": cannot open the mesh: " + std::make_error_code(std::errc::too_many_symbolic_link_levels).message());
+  for (const auto& p : {loop_a, loop_b, dangling}) std::filesystem::remove(p);
+}
+
 // Audit 6, C: UTF-16 text ("Unicode" in Windows editors) read as a NUL after every character.
 TEST(Utf8Text, Utf16AndNulBytesAreNamed) {
   // ASCII as UTF-16 without a byte-order mark: a NUL after (little-endian) or before each character.

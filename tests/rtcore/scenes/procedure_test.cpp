@@ -75,6 +75,9 @@ TEST(Procedure, ErrorsNameTheLineAndColumn) {
   EXPECT_NE(error_of("0 0 0 0 100 0 2 0\n").find("mine.txt:1:15: cut must be 0 or 1"), std::string::npos);
   EXPECT_NE(error_of("0 0 zero 0 100 0 0 0\n").find("mine.txt:1:5: pitch_deg is not a number: 'zero'"), std::string::npos);
   EXPECT_NE(error_of("0 0 0 0 0x10 0 0 0\n").find("insertion_mm is not a number: '0x10'"), std::string::npos);  // decimal only, as the meshes
+  // A number past a double's range, or nan, is a number that is not finite, as the docs say (audit 32, F14).
+  EXPECT_NE(error_of("0 0 0 0 1e999 0 0 0\n").find("insertion_mm is not a finite number: '1e999'"), std::string::npos);
+  EXPECT_NE(error_of("0 nan 0 0 100 0 0 0\n").find("yaw_deg is not a finite number: 'nan'"), std::string::npos);
   // A NUL in a word used to cut the message short at it (audit 24).
   EXPECT_NE(error_of(std::string("0 0 0 0 100 0 0 0\x00x\n", 20)).find("coagulate is not a number: '0\\x00x'"), std::string::npos)
       << error_of(std::string("0 0 0 0 100 0 0 0\x00x\n", 20));
