@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <string_view>
 
 #include "rtcore/base/checked_number.h"
 #include "rtcore/base/text_file.h"
@@ -108,7 +109,11 @@ Result<std::vector<Action>> parse_actions(const std::string& text, const std::st
     };
     double frame = 0.0;
     // The bound is --frames' own: a larger number, past 2^64 above all, would not convert to a frame.
-    if (words.size() < 3 || words[0] != "frame" || !parse_number(words[1], frame) || frame < 0 || frame != std::floor(frame) || frame > kMaxFrame) {
+    // Digits only (a '+' may lead, as on the command line), as --frames and --keyframe take a count
+    // ("1e1" was read as 10: audit 32, F14).
+    const std::string_view count = words.size() < 2 ? std::string_view() : std::string_view(words[1]).substr(words[1].starts_with('+') ? 1 : 0);
+    const bool digits = !count.empty() && std::all_of(count.begin(), count.end(), [](char c) { return c >= '0' && c <= '9'; });
+    if (words.size() < 3 || words[0] != "frame" || !digits || !parse_number(words[1], frame) || frame > kMaxFrame) {
       return Error{at(words[0] != "frame" ? 0 : 1) + "expected 'frame N VERB ...' with N a whole number of frames up to 100000000, got '" + written + "'"};
     }
     const VerbSpec* spec = nullptr;

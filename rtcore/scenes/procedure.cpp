@@ -148,9 +148,11 @@ Result<Procedure> parse_procedure(const std::string& text, const std::string& so
     };
     if (words.size() > 8) return error_at(8, "more than 8 columns");
     if (words.size() < 8) {
+      // A spreadsheet in a locale whose decimal mark is ',' exports ';' between columns (audit 32, F14).
+      const std::string hint = line.find(';') != std::string_view::npos ? " (columns are separated by blanks or commas, not ';')" : "";
       return position_error(source_name, number, line.size() + 1,
                             "expected 8 columns (time_s yaw_deg pitch_deg roll_deg insertion_mm loop_mm cut coagulate), found " +
-                                std::to_string(words.size()));
+                                std::to_string(words.size()) + hint);
     }
     double v[8];
     for (std::size_t c = 0; c < 8; ++c) {

@@ -84,6 +84,8 @@ TEST(ActionScript, ErrorsNameTheLineAndTheProblem) {
       {"frame 1 quit now\n", "takes 0 argument(s), got 1"},
       {"frame 1 replay rewind\n", "unknown operation 'rewind'"},
       {"frame -3 quit\n", "t:1:"},
+      {"frame 1e1 quit\n", "t:1:7: expected 'frame N VERB ...' with N a whole number"},
+      {"frame 2.0 quit\n", "t:1:7: expected 'frame N VERB ...' with N a whole number"},
   };
   for (const auto& [text, expected] : cases) {
     Result<std::vector<Action>> parsed = parse_actions(text, "t");

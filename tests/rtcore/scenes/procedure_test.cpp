@@ -78,6 +78,7 @@ TEST(Procedure, ErrorsNameTheLineAndColumn) {
   // A number past a double's range, or nan, is a number that is not finite, as the docs say (audit 32, F14).
   EXPECT_NE(error_of("0 0 0 0 1e999 0 0 0\n").find("insertion_mm is not a finite number: '1e999'"), std::string::npos);
   EXPECT_NE(error_of("0 nan 0 0 100 0 0 0\n").find("yaw_deg is not a finite number: 'nan'"), std::string::npos);
+  EXPECT_NE(error_of("0;0;0;0;100;0;0;0\n").find("found 1 (columns are separated by blanks or commas, not ';')"), std::string::npos);
   // A NUL in a word used to cut the message short at it (audit 24).
   EXPECT_NE(error_of(std::string("0 0 0 0 100 0 0 0\x00x\n", 20)).find("coagulate is not a number: '0\\x00x'"), std::string::npos)
       << error_of(std::string("0 0 0 0 100 0 0 0\x00x\n", 20));
