@@ -17,7 +17,13 @@ int main(int argc, char** argv) {
     // --help and --version print and succeed; any other command line that cannot be parsed (a
     // missing file, an unknown option, a value out of range) is a usage error: 2, as for most Unix
     // tools, rather than CLI11's own codes (105 to 109) that scripts would have to learn.
-    return app.exit(e) == 0 ? 0 : 2;
+    if (app.exit(e) != 0) return 2;
+    // Help printed into a full disk or a closed pipe is lost as a report would be (audit 32, F15).
+    if (resecto::Status flushed = resecto::flush_standard_output(); !flushed) {
+      std::fprintf(stderr, "resecto: %s\n", flushed.error().c_str());
+      return 1;
+    }
+    return 0;
   } catch (const resecto::InterruptedRun& e) {
     // The run stopped early but wrote everything it had: its outputs are whole, the exit code a
     // shell's for the signal.

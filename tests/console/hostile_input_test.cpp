@@ -395,6 +395,7 @@ TEST_F(HostileInput, AFullStandardOutputIsAFailure) {
                        "mesh check > /dev/full");
   expect_clean_failure(run_resecto_bounded(collide_args(arg("p.off")) + " --json", 5.0, 512, "/dev/full"),
                        "cannot write to standard output", "collide --json > /dev/full");
+  expect_clean_failure(run_resecto_bounded("--help", 5.0, 512, "/dev/full"), "cannot write to standard output", "--help > /dev/full");
 }
 
 // Files saved by Windows editors and spreadsheets start with a UTF-8 byte-order mark: read as if it were not there.
