@@ -51,5 +51,13 @@ TEST(ParamsCommand, SetTakesALeadingPlus) {
   EXPECT_EQ(plus.exit_code, 0) << plus.err;
 }
 
+// Audit 32, F15: a parameter given twice kept the last value without a word.
+TEST(ParamsCommand, SetRefusesAParameterGivenTwice) {
+  const CommandOutput twice = run_resecto("run --headless --triangles 1296 --seconds 0.05 --set stiffness=40 --set viscous_damping=20 --set stiffness=60");
+  EXPECT_EQ(twice.exit_code, 1);
+  EXPECT_NE(twice.err.find("--set stiffness=60: stiffness is already set by --set stiffness=40; give each parameter once"), std::string::npos)
+      << twice.err;
+}
+
 }  // namespace
 }  // namespace resecto::testing
