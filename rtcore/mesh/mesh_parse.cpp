@@ -190,6 +190,7 @@ Result<RawMesh> parse_off(std::string_view text, const std::string& name) {
   std::string_view line;
   std::vector<std::string_view> header;  // "OFF" and the three counts, over one or two lines
   while (header.size() < 4 && lines.next(line)) {
+    const std::size_t header_before = header.size();
     for (std::string_view word : split_words(line, true)) {
       if (header.empty()) {
         if (word == "OFF") {
@@ -205,6 +206,9 @@ Result<RawMesh> parse_off(std::string_view text, const std::string& name) {
       if (header.size() == 4) return lines.error_at(word, "unexpected " + quoted_word(word) + " after the vertex, face and edge counts");
       header.push_back(word);
     }
+    // Some exporters write only the vertex and face counts on their line ("8 6"): the edge count,
+    // which no reader uses, is then taken as 0 rather than read from the first vertex (audit 32, F14).
+    if (header_before <= 1 && header.size() == 3) header.push_back("0");
   }
   if (header.empty()) return Error{name + ": expected 'OFF' at the start of the file, found nothing"};
   if (header.size() < 4) return lines.error("the header ends before its vertex, face and edge counts");

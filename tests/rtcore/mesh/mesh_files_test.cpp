@@ -349,6 +349,17 @@ TEST(MeshFiles, APlyPropertyDeclaredTwiceInAnElementIsRefused) {
   EXPECT_TRUE(read) << read.error();
 }
 
+// Audit 32, F14: some exporters write only the vertex and face counts ("8 12"); the edge count no
+// reader uses was then read from the first vertex, and the error blamed its second coordinate.
+TEST(MeshFiles, AnOffHeaderWithoutItsEdgeCountIsRead) {
+  std::string text = cube_off();
+  text.replace(text.find("8 12 0\n"), 7, "8 12\n");
+  EXPECT_EQ(validation_error(write_file("two_counts.off", text)), "");
+  std::string same_line = cube_off();
+  same_line.replace(0, std::string("OFF\n8 12 0\n").size(), "OFF 8 12\n");
+  EXPECT_EQ(validation_error(write_file("two_counts_one_line.off", same_line)), "");
+}
+
 // A Windows "Unicode" save is UTF-16: named as such rather than read as a NUL after every character.
 // PLY and ASCII STL too (an STL's binary layout, whose header is free bytes, is known by its size).
 TEST(MeshFiles, AUtf16TextMeshIsNamedAsOne) {
