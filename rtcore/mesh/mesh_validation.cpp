@@ -361,6 +361,11 @@ Result<SurfaceReport> validate_closed_surface(const TriangleMesh& mesh, const Va
   }
   for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
     if (component_first_face[v] != UINT32_MAX && component_volume[v] <= 0.0) {
+      // A rightly wound cavity encloses negative volume too, and was told to turn its faces (audit 32,
+      // F14): a shell inside another is named as the cavity it is.
+      if (report.components > 1) {
+        if (Status nested = check_no_nested_shells(mesh, components, component_first_face); !nested) return Error{nested.error()};
+      }
       return Error{"inward orientation: the component containing " + face_name(mesh, component_first_face[v]) +
                    " encloses negative volume; faces must wind counter-clockwise seen from outside"};
     }

@@ -390,8 +390,9 @@ TEST(MeshFiles, AsciiStlMayStartWithAByteOrderMark) {
   EXPECT_EQ(validation_error(write_file("bom.stl", "\xEF\xBB\xBF" + stl)), "");
 }
 
-/// Two outward unit-cube shells in one OFF file, the second scaled by `scale` and moved by `offset`.
-std::string two_cubes_off(double scale, double offset) {
+/// Two unit-cube shells in one OFF file, the second scaled by `scale` and moved by `offset`; both
+/// outward, or the second wound inward (as a cavity's wall is).
+std::string two_cubes_off(double scale, double offset, bool second_inward = false) {
   const double corners[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
   std::string text = "OFF\n16 24 0\n";
   for (int shell = 0; shell < 2; ++shell) {
@@ -402,7 +403,9 @@ std::string two_cubes_off(double scale, double offset) {
   }
   for (int shell = 0; shell < 2; ++shell) {
     for (const auto& t : kCubeFaces) {
-      text += "3 " + std::to_string(t[0] + 8 * shell) + " " + std::to_string(t[1] + 8 * shell) + " " + std::to_string(t[2] + 8 * shell) + "\n";
+      const bool flip = second_inward && shell == 1;
+      text += "3 " + std::to_string(t[0] + 8 * shell) + " " + std::to_string(t[flip ? 2 : 1] + 8 * shell) + " " +
+              std::to_string(t[flip ? 1 : 2] + 8 * shell) + "\n";
     }
   }
   return text;
@@ -413,6 +416,12 @@ TEST(MeshFiles, AShellInsideAnotherIsRefusedAndShellsSideBySideAreRead) {
   // tetrahedralizing it then lost that volume without a word.
   const std::string nested = validation_error(write_file("nested.off", two_cubes_off(0.2, 0.4)));
   EXPECT_NE(nested.find("nested shells: the component containing face 12 lies inside the component containing face 0"), std::string::npos) << nested;
+  // A cavity wound as one should be (inward) was told to turn its faces (audit 32, F14).
+  const std::string cavity = validation_error(write_file("cavity.off", two_cubes_off(0.2, 0.4, true)));
+  EXPECT_NE(cavity.find("nested shells: the component containing face 12 lies inside the component containing face 0; a solid with a cavity"),
+            std::string::npos)
+      << cavity;
+  EXPECT_NE(validation_error(write_file("inward_apart.off", two_cubes_off(0.5, 2.0, true))).find("inward orientation"), std::string::npos);
   Result<TriangleMesh> apart = read_surface_mesh(write_file("apart.off", two_cubes_off(0.5, 2.0)));
   ASSERT_TRUE(apart) << apart.error();
   Result<SurfaceReport> report = validate_closed_surface(*apart);
