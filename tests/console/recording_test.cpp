@@ -60,6 +60,7 @@ void rewrite(const rec::Recording& r, const std::filesystem::path& out, Edit edi
   for (const rec::ChunkLocation& chunk : r.chunks()) {
     if (is(chunk, rec::ChunkType::kIndex)) continue;
     std::vector<std::uint8_t> payload(r.payload(chunk).begin(), r.payload(chunk).end());
+    // Each entry's first tick as the recorder writes it: `rec verify` checks it against the chunk.
     if (edit(chunk, payload)) writer.add_chunk(static_cast<rec::ChunkType>(chunk.type), payload, rec::first_tick_of(chunk.type, payload));
   }
   ASSERT_TRUE(writer.close());
