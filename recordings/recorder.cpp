@@ -246,7 +246,8 @@ Result<RecorderCounters> Recorder::finish(const nlohmann::ordered_json& extra) {
   const std::string text = summary.dump();
   writer_.add_chunk(ChunkType::kSummary, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
   ++counters_.chunks;
-  note_error(writer_.close());
+  // The writer's error says where the partial recording is, and that the old file is untouched.
+  if (Status closed = writer_.close(); !closed) counters_.write_error = closed.error();
   counters_.bytes = writer_.bytes_written();
   if (!counters_.write_error.empty()) return Error{counters_.write_error};
   return counters_;

@@ -40,13 +40,14 @@ struct RecorderCounters {
   std::uint64_t ticks_lost = 0, steps_lost = 0, commands_lost = 0, keyframes_lost = 0;  ///< ring full
   std::uint64_t chunks = 0, bytes = 0;
   double keyframe_encode_ms_max = 0.0, keyframe_encode_ms_mean = 0.0;
-  std::string write_error;  ///< the first I/O failure; recording stopped there
+  std::string write_error;  ///< the first I/O failure (recording stopped there), and where the partial file is
 };
 
 class Recorder {
  public:
-  /// Creates the file, writes the header (the description's simulation config is replaced by
-  /// `sim`'s) and starts the recorder thread.
+  /// Creates the partial file beside `path` (RecordingWriter), writes the header (the description's
+  /// simulation config is replaced by `sim`'s) and starts the recorder thread. `path` itself is
+  /// replaced only by a successful finish().
   static Result<std::unique_ptr<Recorder>> start(const std::filesystem::path& path, SessionHeader description, const Simulation& sim,
                                                  const RecorderSettings& settings = {});
   ~Recorder();

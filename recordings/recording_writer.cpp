@@ -2,12 +2,15 @@
 #include "recordings/recording_writer.h"
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "recordings/byte_io.h"
+#include "rtcore/base/atomic_file.h"
 
 namespace resecto::rec {
 
@@ -52,13 +55,29 @@ void append_index_and_trailer(std::vector<std::uint8_t>& out, std::uint64_t out_
 }
 
 RecordingWriter::~RecordingWriter() {
+  // Not closed (an error left the run, or it is unwinding): the partial file stays for `rec recover`.
   if (fd_ >= 0) ::close(fd_);
 }
 
-Status RecordingWriter::open(const std::filesystem::path& path) {
-  path_ = path.string();
-  fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd_ < 0) return Error{path_ + ": cannot create the recording: " + std::strerror(errno)};
+Error RecordingWriter::fail(const std::string& what, int error_number) {
+  if (first_error_.empty()) first_error_ = partial_ + ": " + what + ": " + std::strerror(error_number);
+  return Error{first_error_};
+}
+
+Status RecordingWriter::open(const std::filesystem::path& target) {
+  target_ = target.string();
+  Result<std::filesystem::path> destination = resolve_links(target);
+  if (!destination) return Error{destination.error()};
+  destination_ = destination->string();
+  partial_ = destination_ + ".partial";
+  first_error_.clear();
+  fd_ = ::open(partial_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) return fail("cannot create the recording", errno);
+  // The recording replaces the target's contents, not its permissions (as AtomicFile keeps them).
+  struct stat existing {};
+  if (::stat(destination_.c_str(), &existing) == 0 && S_ISREG(existing.st_mode) && ::fchmod(fd_, existing.st_mode & 07777) != 0) {
+    return fail("cannot set the permissions", errno);
+  }
   pending_.assign(std::begin(kFileSignature), std::end(kFileSignature));
   return flush();
 }
@@ -69,12 +88,14 @@ void RecordingWriter::add_chunk(ChunkType type, std::span<const std::uint8_t> pa
 }
 
 Status RecordingWriter::flush() {
+  // After a failure the file ends somewhere inside a chunk: appending more would only bury it.
+  if (!first_error_.empty()) return Error{first_error_};
   std::size_t done = 0;
   while (done < pending_.size()) {
     const ssize_t n = ::write(fd_, pending_.data() + done, pending_.size() - done);
     if (n < 0) {
       if (errno == EINTR) continue;
-      return Error{path_ + ": write failed: " + std::strerror(errno)};
+      return fail("write failed", errno);
     }
     done += static_cast<std::size_t>(n);
   }
@@ -85,17 +106,25 @@ Status RecordingWriter::flush() {
 
 Status RecordingWriter::sync() {
   if (Status flushed = flush(); !flushed) return flushed;
-  if (::fdatasync(fd_) != 0) return Error{path_ + ": fdatasync failed: " + std::strerror(errno)};
+  if (::fdatasync(fd_) != 0) return fail("fdatasync failed", errno);
   return Ok{};
 }
 
 Status RecordingWriter::close() {
-  if (fd_ < 0) return Ok{};
+  if (fd_ < 0) {
+    if (first_error_.empty()) return Ok{};
+    return Error{first_error_};
+  }
   append_index_and_trailer(pending_, file_offset_, index_, next_sequence_++);
-  Status synced = sync();
-  ::close(fd_);
+  Status status = sync();
+  if (::close(fd_) != 0 && status) status = fail("close failed", errno);
   fd_ = -1;
-  return synced;
+  if (status && std::rename(partial_.c_str(), destination_.c_str()) != 0) status = fail("cannot rename it to " + destination_, errno);
+  if (status) return Ok{};
+  // The old recording is whole; the new one is as far as it got, which `rec recover` can mend.
+  first_error_ =
+      status.error() + "; " + target_ + " was left as it was: the recording made is in " + partial_ + " (`resecto rec recover` mends it)";
+  return Error{first_error_};
 }
 
 }  // namespace resecto::rec

@@ -1,7 +1,8 @@
 // RecordingWriter: appends framed chunks to a recording file and, on close, the summary, the index
-// and the trailer. It writes in place (not to a temporary renamed at the end): a recording exists to
-// survive the process, so at every moment the file on disk is valid up to its last whole chunk.
-// Single-threaded: the recorder thread owns it; `rec recover` uses it too.
+// and the trailer. It streams into TARGET.partial beside the target, valid at every moment up to its
+// last whole chunk (a recording exists to survive the process: `rec recover` mends a partial file),
+// and renames it over the target only once closed: a run that fails or dies leaves the old recording
+// at the target whole. Single-threaded: the recorder thread owns it.
 #pragma once
 
 #include <cstdint>
@@ -40,23 +41,33 @@ class RecordingWriter {
   RecordingWriter(const RecordingWriter&) = delete;
   RecordingWriter& operator=(const RecordingWriter&) = delete;
 
-  /// Creates (truncates) `path` and writes the signature.
-  Status open(const std::filesystem::path& path);
+  /// Creates (truncates) the partial file beside `target` (links followed, as every output's) and
+  /// writes the signature; nothing happens to `target` yet.
+  Status open(const std::filesystem::path& target);
   /// Buffers one chunk; `first_tick` goes into the index.
   void add_chunk(ChunkType type, std::span<const std::uint8_t> payload, std::uint64_t first_tick = 0);
   /// Hands the buffered chunks to the operating system (a killed process then loses nothing more).
+  /// After a failure nothing more is written and every call reports the first failure again.
   Status flush();
   /// flush() and fdatasync(): on the disk even if the machine loses power.
   Status sync();
-  /// Writes the index chunk and trailer, syncs and closes.
+  /// Writes the index chunk and trailer, syncs, closes and renames the partial file over the target.
+  /// After any failure the target is left as it was and the error says where the partial file is.
   Status close();
 
   std::uint64_t bytes_written() const { return file_offset_ + pending_.size(); }
-  const std::string& path() const { return path_; }
+  /// The file being written: the target's name with ".partial" appended, in the target's folder.
+  const std::string& partial_path() const { return partial_; }
 
  private:
+  /// Remembers the first failure (`what` failed on the partial file) and returns it.
+  Error fail(const std::string& what, int error_number);
+
   int fd_ = -1;
-  std::string path_;
+  std::string target_;       ///< as given, for messages
+  std::string destination_;  ///< the file replaced: the target with its links followed
+  std::string partial_;
+  std::string first_error_;
   std::uint64_t file_offset_ = 0;  ///< bytes already handed to the OS
   std::vector<std::uint8_t> pending_;
   std::vector<IndexEntry> index_;

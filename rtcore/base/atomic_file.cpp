@@ -50,10 +50,8 @@ bool names_a_system_object(const std::filesystem::path& path) {
   return *element == "dev" || *element == "proc";
 }
 
-/// The file an output at `target` really is: a symbolic link is followed to the file it names (so
-/// the link stays a link and its file is the one replaced), link by link, each relative link from its
-/// own folder. A link into /dev or /proc (/dev/stdout, /proc/self/fd/1) is refused: renaming over it
-/// would destroy the system's link, and its file may be a pipe or a terminal.
+}  // namespace
+
 Result<std::filesystem::path> resolve_links(const std::filesystem::path& target) {
   std::filesystem::path path = target;
   for (int hops = 0; hops < 40; ++hops) {
@@ -69,6 +67,8 @@ Result<std::filesystem::path> resolve_links(const std::filesystem::path& target)
   }
   return Error{target.string() + ": too many levels of symbolic links"};
 }
+
+namespace {
 
 /// The checks every output path gets: a file name, and only a regular file in the way (renaming over
 /// a device or a folder would destroy it), `target` being the path with its links followed.

@@ -47,6 +47,12 @@ class AtomicFile {
   std::string first_error_;
 };
 
+/// The file an output at `target` really is: a symbolic link is followed to the file it names (so
+/// the link stays a link and its file is the one replaced), link by link, each relative link from its
+/// own folder. A link into /dev or /proc (/dev/stdout, /proc/self/fd/1) is refused: renaming over it
+/// would destroy the system's link, and its file may be a pipe or a terminal.
+Result<std::filesystem::path> resolve_links(const std::filesystem::path& target);
+
 /// Writes `bytes` as the whole of `target` through an AtomicFile.
 Status write_file_atomically(const std::filesystem::path& target, std::string_view bytes);
 

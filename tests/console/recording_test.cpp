@@ -510,6 +510,31 @@ TEST(RunCommand, OutputsAndLengthAreCheckedBeforeTheRun) {
   EXPECT_NE(short_run.err.find("at least one collision step"), std::string::npos) << short_run.err;
 }
 
+// A run killed mid-recording (or one whose disk fills) left the user's old recording replaced by an
+// unclosed file: the recorder streamed into the target from the start (audit 7, F2). The new recording
+// now grows in FILE.partial and replaces FILE only once closed.
+TEST(RecordingCommands, ARunKilledWhileRecordingLeavesTheOldRecordingWhole) {
+  const auto dir = scratch_directory("recording_killed_over_old");
+  const auto old = dir / "old.rsrec";
+  record(old, "--seconds 0.5");
+  const std::string before = testing::read_text(old);
+  // A run of ten simulated minutes, killed after 4 s of wall time (the model builds in under one).
+  const testing::CommandOutput killed =
+      testing::run_resecto_bounded("run --headless --procedure demo --triangles 1296 --seconds 600 --record " + old.string(), 4.0, 2048);
+  EXPECT_EQ(killed.exit_code, -1) << killed.err;
+  EXPECT_EQ(testing::read_text(old), before);
+  const auto partial = dir / "old.rsrec.partial";
+  ASSERT_TRUE(std::filesystem::exists(partial));
+  const testing::CommandOutput verify = run_resecto("rec verify " + partial.string());
+  EXPECT_NE((verify.out + verify.err).find("the recording was not closed"), std::string::npos) << verify.out << verify.err;
+  const testing::CommandOutput recovered = run_resecto("rec recover " + partial.string() + " " + (dir / "mended.rsrec").string());
+  EXPECT_EQ(recovered.exit_code, 0) << recovered.err;
+  // A run that finishes replaces the old recording and leaves no partial file behind.
+  record(old, "--seconds 0.5");
+  EXPECT_FALSE(std::filesystem::exists(partial));
+  EXPECT_EQ(run_resecto("rec verify " + old.string()).exit_code, 0);
+}
+
 TEST(RecordingCommands, ExportsKeyframesAndInputsThatOtherProgramsRead) {
   const auto dir = scratch_directory("recording_export");
   const auto file = dir / "demo.rsrec";
@@ -581,7 +606,9 @@ TEST(RecordingCommands, ExportsKeyframesAndInputsThatOtherProgramsRead) {
 
 TEST(RecordingCommands, AKilledRealTimeRecordingRecoversAtLeastFourOfFiveSeconds) {
   const auto dir = scratch_directory("recording_killed");
-  const auto file = dir / "killed.rsrec";
+  const auto target = dir / "killed.rsrec";
+  // A killed run's recording is in the partial file it was writing; the target is never made.
+  const std::filesystem::path file = target.string() + ".partial";
   const pid_t child = ::fork();
   ASSERT_GE(child, 0);
   if (child == 0) {
@@ -589,7 +616,7 @@ TEST(RecordingCommands, AKilledRealTimeRecordingRecoversAtLeastFourOfFiveSeconds
     // The 1296-triangle gland keeps real time on a slow or loaded machine (the 8640 one fell behind
     // on a 2-vCPU Xeon and simulated 3.x s in 5): this tests the recorder's flushing, not the core's speed.
     ::execl(RESECTO_EXE, RESECTO_EXE, "run", "--headless", "--realtime", "--procedure", "demo", "--triangles", "1296", "--seconds", "60", "--record",
-            file.c_str(), static_cast<char*>(nullptr));
+            target.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
   // The recording starts when the model is built and the recorder has written its header.
@@ -601,6 +628,7 @@ TEST(RecordingCommands, AKilledRealTimeRecordingRecoversAtLeastFourOfFiveSeconds
   int status = 0;
   ::waitpid(child, &status, 0);
   ASSERT_TRUE(WIFSIGNALED(status));
+  EXPECT_FALSE(std::filesystem::exists(target));
   const nlohmann::json info = json_of(run_resecto("rec info " + file.string() + " --json"));
   EXPECT_EQ(info["index_present"], false);
   const auto recovered = dir / "recovered.rsrec";
@@ -616,7 +644,8 @@ TEST(RecordingCommands, AKilledRealTimeRecordingRecoversAtLeastFourOfFiveSeconds
 }
 
 /// Starts `resecto run --headless` with `extra` options recording to `file` (stdout to `out`), waits
-/// for the recording's header, lets it run `seconds`, then sends `signal_number`; returns its status.
+/// for the recording's header (in the partial file until the recording is closed), lets it run
+/// `seconds`, then sends `signal_number`; returns its status.
 int interrupt_headless_run(const std::filesystem::path& file, const std::filesystem::path& out, const std::vector<std::string>& extra,
                            double seconds, int signal_number) {
   const pid_t child = ::fork();
@@ -631,7 +660,8 @@ int interrupt_headless_run(const std::filesystem::path& file, const std::filesys
     ::execv(RESECTO_EXE, argv.data());
     ::_exit(127);
   }
-  for (int i = 0; i < 600 && !(std::filesystem::exists(file) && std::filesystem::file_size(file) > 100); ++i) {
+  const std::filesystem::path partial = file.string() + ".partial";
+  for (int i = 0; i < 600 && !(std::filesystem::exists(partial) && std::filesystem::file_size(partial) > 100); ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
@@ -665,8 +695,11 @@ TEST(RecordingCommands, CtrlCOrSigtermEndsARunWithEveryOutputWholeAndTheShellsEx
     EXPECT_EQ(json_of(replay)["mismatches"], 0);
     EXPECT_EQ(json_of(replay)["ticks"], r["ticks"]);
     EXPECT_EQ(run_resecto("mesh check " + surface.string()).exit_code, 0) << name;
-    // No temporary is left beside the outputs.
-    for (const auto& entry : std::filesystem::directory_iterator(dir)) EXPECT_NE(entry.path().extension(), ".tmp") << entry.path();
+    // No temporary or partial file is left beside the outputs.
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+      EXPECT_NE(entry.path().extension(), ".tmp") << entry.path();
+      EXPECT_NE(entry.path().extension(), ".partial") << entry.path();
+    }
     // The file says it was cut short: its score is of the procedure as far as it went, and says so.
     const testing::CommandOutput scored = run_resecto("score " + file.string() + " --json --quiet");
     ASSERT_EQ(scored.exit_code, 0) << scored.err;
