@@ -5,12 +5,72 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <optional>
 
 #include "recordings/recording_writer.h"
 #include "rtcore/base/json_text.h"
 #include "rtcore/base/text_file.h"
 
 namespace resecto::rec {
+namespace {
+
+/// The ticks one ticks or steps chunk holds, for naming the chunks a tick is recorded in.
+struct ChunkTicks {
+  std::uint64_t first = 0, last = 0;
+  std::size_t chunk = 0;  ///< into the scan's chunks
+};
+
+template <class Record>
+void note_chunk_ticks(std::span<const Record> records, std::size_t chunk, std::vector<ChunkTicks>& out) {
+  if (records.empty()) return;
+  const auto [lo, hi] =
+      std::minmax_element(records.begin(), records.end(), [](const Record& a, const Record& b) { return a.tick < b.tick; });
+  out.push_back({lo->tick, hi->tick, chunk});
+}
+
+/// The same ticks recorded twice with different content, in `sorted` (by tick, each tick's copies in
+/// file order): each run of such ticks named with the chunks that hold its first. A copied chunk
+/// repeats its records alike and is harmless; copies that differ mean a reader keeping either may
+/// replay inputs the run never had. `encode` writes one record as the file holds it (bit for bit).
+template <class Record, class Encode>
+void name_differing_copies(std::span<const Record> sorted, std::span<const ChunkTicks> chunks, std::span<const ChunkLocation> locations,
+                           const char* kind, Encode encode, std::vector<std::string>& errors) {
+  std::vector<std::uint8_t> a, b;
+  auto differ = [&](const Record& x, const Record& y) {
+    encode(std::span(&x, 1), a);
+    encode(std::span(&y, 1), b);
+    return a != b;
+  };
+  auto name_run = [&](std::uint64_t first, std::uint64_t last) {
+    std::string holders;
+    for (const ChunkTicks& c : chunks) {
+      if (c.first > first || c.last < first) continue;
+      const ChunkLocation& chunk = locations[c.chunk];
+      holders.append(holders.empty() ? "" : ", ")
+          .append(std::to_string(chunk.sequence))
+          .append(" at byte ")
+          .append(std::to_string(chunk.offset));
+    }
+    std::string ticks = std::to_string(first);
+    if (last > first) ticks.append("-").append(std::to_string(last));
+    errors.push_back(std::string(kind) + " records of ticks " + ticks + " are in the file twice, and differ (" + kind + " chunks " +
+                     holders + "): which the run had is unknown; readers keep the first");
+  };
+  std::optional<std::pair<std::uint64_t, std::uint64_t>> run;
+  for (std::size_t i = 1; i < sorted.size() && errors.size() < Recording::kMostProblemsListed; ++i) {
+    if (sorted[i].tick != sorted[i - 1].tick || !differ(sorted[i - 1], sorted[i])) continue;
+    const std::uint64_t tick = sorted[i].tick;
+    if (run && tick <= run->second + 1) {
+      run->second = tick;
+      continue;
+    }
+    if (run) name_run(run->first, run->second);
+    run = std::pair(tick, tick);
+  }
+  if (run && errors.size() < Recording::kMostProblemsListed) name_run(run->first, run->second);
+}
+
+}  // namespace
 
 Result<Recording> Recording::open(const std::filesystem::path& path) {
   // Only a regular file, read once to its size: a device or a pipe named as a recording would be
@@ -37,6 +97,7 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
     return Error{name + ": not a Resecto recording (bad signature)"};
   }
   bool have_header = false;
+  std::vector<ChunkTicks> tick_chunks, step_chunks;
   for (std::size_t c = 0; c < r.scan_.chunks.size(); ++c) {
     if (have_header && r.scan_.chunks[c].type == static_cast<std::uint16_t>(ChunkType::kHeader)) {
       // A second header starts another recording (two files joined): its ticks would pass for this
@@ -60,14 +121,22 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
       }
       case ChunkType::kTicks: {
         Result<std::vector<TickRecord>> ticks = decode_tick_block(payload);
-        if (!ticks) r.content_errors_.push_back(where + ": " + ticks.error());
-        else r.ticks_.insert(r.ticks_.end(), ticks->begin(), ticks->end());
+        if (!ticks) {
+          r.content_errors_.push_back(where + ": " + ticks.error());
+          break;
+        }
+        note_chunk_ticks<TickRecord>(*ticks, c, tick_chunks);
+        r.ticks_.insert(r.ticks_.end(), ticks->begin(), ticks->end());
         break;
       }
       case ChunkType::kSteps: {
         Result<std::vector<StepRecord>> steps = decode_step_block(payload);
-        if (!steps) r.content_errors_.push_back(where + ": " + steps.error());
-        else r.steps_.insert(r.steps_.end(), steps->begin(), steps->end());
+        if (!steps) {
+          r.content_errors_.push_back(where + ": " + steps.error());
+          break;
+        }
+        note_chunk_ticks<StepRecord>(*steps, c, step_chunks);
+        r.steps_.insert(r.steps_.end(), steps->begin(), steps->end());
         break;
       }
       case ChunkType::kCommands: {
@@ -118,12 +187,16 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
   }
   r.check_chunk_order();
 
-  // Sorted by tick; a record seen twice (never written so, but a copied chunk could be) is kept once.
+  // Sorted by tick; a record seen twice (never written so, but a copied chunk could be) is kept once,
+  // the first in file order (stable sort), and copies that differ are named (audit 7, F4: two ticks
+  // chunks with different inputs for the same ticks read as "ok").
   auto by_tick = [](const auto& a, const auto& b) { return a.tick < b.tick; };
   auto same_tick = [](const auto& a, const auto& b) { return a.tick == b.tick; };
   std::stable_sort(r.ticks_.begin(), r.ticks_.end(), by_tick);
+  name_differing_copies<TickRecord>(r.ticks_, tick_chunks, r.scan_.chunks, "ticks", encode_tick_block, r.content_errors_);
   r.ticks_.erase(std::unique(r.ticks_.begin(), r.ticks_.end(), same_tick), r.ticks_.end());
   std::stable_sort(r.steps_.begin(), r.steps_.end(), by_tick);
+  name_differing_copies<StepRecord>(r.steps_, step_chunks, r.scan_.chunks, "steps", encode_step_block, r.content_errors_);
   r.steps_.erase(std::unique(r.steps_.begin(), r.steps_.end(), same_tick), r.steps_.end());
   std::stable_sort(r.keyframes_.begin(), r.keyframes_.end(), by_tick);
   r.keyframes_.erase(std::unique(r.keyframes_.begin(), r.keyframes_.end(), same_tick), r.keyframes_.end());

@@ -61,8 +61,9 @@ class Recording {
   /// one was never closed (the run was killed), though it may replay up to where it stops.
   const ChunkLocation* index_chunk() const;
   bool closed() const { return index_present() || index_chunk() != nullptr; }
-  /// Chunks whose CRCs held but whose content did not decode (should never happen; counted). Keyframe
-  /// chunks are not among them: keyframe_problems() has those.
+  /// What the intact chunks hold that no recorder writes: chunks whose CRCs held but whose content
+  /// did not decode, a second header, the same ticks recorded twice with different content (should
+  /// never happen; counted). Keyframe chunks are not among them: keyframe_problems() has those.
   std::span<const std::string> content_errors() const { return content_errors_; }
   /// What is wrong with the file's bookkeeping though every chunk is intact: index entries that do
   /// not name the chunks as they are, chunks numbered out of order. No reader needs either (replay

@@ -70,7 +70,7 @@ namespace {
 std::string uncompared_hashes(const Recording& recording, std::uint64_t reached) {
   if (!recording.damaged().empty() || !recording.content_errors().empty()) {
     return "the recording is damaged (" + std::to_string(recording.damaged().size()) + " damaged ranges, " +
-           std::to_string(recording.content_errors().size()) + " undecodable chunks; `resecto rec verify` names them)";
+           std::to_string(recording.content_errors().size()) + " content problems; `resecto rec verify` names them)";
   }
   const std::uint64_t in_file = recording.steps().size();
   const std::optional<std::uint64_t> written = recording.summary_count("steps");

@@ -131,7 +131,7 @@ void verify(const std::string& file) {
     ++problems;
   }
   for (const std::string& e : r.content_errors()) {
-    std::fprintf(stderr, "%s: undecodable: %s\n", file.c_str(), e.c_str());
+    std::fprintf(stderr, "%s: content: %s\n", file.c_str(), e.c_str());
     ++problems;
   }
   if (!r.index_present()) {

@@ -237,6 +237,44 @@ TEST(RecordingCommands, ARecoveryWithAGapIsSoundButNotOk) {
   EXPECT_DOUBLE_EQ(info["duration_s"].get<double>(), 2.0) << "the procedure spans the gap";
 }
 
+// A second ticks chunk for the same ticks with other inputs: `rec verify` said "ok" and every reader
+// kept the first silently (audit 7, F4). Verify names the ticks and both chunks; replay --verify and
+// score refuse the file for the same content problem.
+TEST(RecordingCommands, TicksRecordedTwiceWithDifferentInputsAreAProblemForEveryReader) {
+  const auto [dir, file, r] = record_and_open("recording_conflicting_ticks", "--seconds 1");
+  ASSERT_TRUE(r);
+  const auto conflicting = dir / "conflicting.rsrec";
+  {
+    rec::RecordingWriter writer;
+    ASSERT_TRUE(writer.open(conflicting));
+    std::vector<std::uint8_t> copy;
+    for (const rec::ChunkLocation& chunk : r->chunks()) {
+      if (is(chunk, rec::ChunkType::kIndex)) continue;
+      const std::span<const std::uint8_t> payload = r->payload(chunk);
+      writer.add_chunk(static_cast<rec::ChunkType>(chunk.type), payload, rec::first_tick_of(chunk.type, payload));
+      if (!is(chunk, rec::ChunkType::kTicks) || !copy.empty()) continue;
+      // Right after the first ticks chunk, its ticks again with the sheath 20 mm deeper from tick 100.
+      Result<std::vector<rec::TickRecord>> ticks = rec::decode_tick_block(payload);
+      ASSERT_TRUE(ticks && ticks->size() > 200);
+      for (std::size_t i = 100; i < ticks->size(); ++i) (*ticks)[i].input.joints.insertion_m += 0.020;
+      rec::encode_tick_block(*ticks, copy);
+      writer.add_chunk(rec::ChunkType::kTicks, copy, ticks->front().tick);
+    }
+    ASSERT_TRUE(writer.close());
+  }
+  const testing::CommandOutput verify = run_resecto("rec verify " + conflicting.string());
+  EXPECT_EQ(verify.exit_code, 1);
+  EXPECT_EQ(verify.out.find(": ok,"), std::string::npos) << verify.out;
+  EXPECT_NE(verify.err.find(": content: ticks records of ticks 100-"), std::string::npos) << verify.err;
+  EXPECT_NE(verify.err.find("are in the file twice, and differ (ticks chunks "), std::string::npos) << verify.err;
+  const testing::CommandOutput replay = run_resecto("replay " + conflicting.string() + " --verify");
+  EXPECT_EQ(replay.exit_code, 1) << replay.out;
+  EXPECT_NE(replay.err.find("1 content problems"), std::string::npos) << replay.err;
+  const testing::CommandOutput scored = run_resecto("score --quiet " + conflicting.string());
+  EXPECT_EQ(scored.exit_code, 1);
+  EXPECT_NE(scored.err.find("skipped: " + conflicting.string() + ": ticks records of ticks 100-"), std::string::npos) << scored.err;
+}
+
 TEST(RecordingCommands, ACutRecordingRecoveredDoesNotVerifyAsWhole) {
   const auto [dir, file, r] = record_and_open("recording_cut_recovered", "--seconds 2");
   ASSERT_TRUE(r);

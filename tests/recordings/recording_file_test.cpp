@@ -625,5 +625,46 @@ TEST(RecordingFile, ASecondRecordingJoinedOnIsLeftOutAndNamed) {
   EXPECT_EQ(recovered->ticks().size(), original->ticks().size());
 }
 
+// The same ticks in two ticks chunks: a copy alike is harmless, but copies that differ leave a
+// reader keeping either replaying inputs the run may never have had. `rec verify` said "ok" of it and
+// readers kept the first silently (audit 7, F4).
+TEST(RecordingFile, TicksRecordedTwiceWithDifferentInputsAreNamedWithTheirChunks) {
+  const Recording original = open_bytes(testing::short_recording().file);
+  const ChunkLocation* copied = nullptr;
+  for (const ChunkLocation& c : original.chunks()) {
+    if (c.type == static_cast<std::uint16_t>(ChunkType::kTicks) && !copied) copied = &c;
+  }
+  ASSERT_NE(copied, nullptr);
+  Result<std::vector<TickRecord>> ticks = decode_tick_block(original.payload(*copied));
+  ASSERT_TRUE(ticks && ticks->size() > 20);
+  // Every chunk but the index again, then a copy of the first ticks chunk: alike, or with ticks 5-9 moved.
+  auto with_copy = [&](std::span<const TickRecord> copy) {
+    std::vector<std::uint8_t> bytes(std::begin(kFileSignature), std::end(kFileSignature)), payload;
+    std::uint32_t sequence = 0;
+    for (const ChunkLocation& c : original.chunks()) {
+      if (c.type != static_cast<std::uint16_t>(ChunkType::kIndex))
+        append_chunk(bytes, static_cast<ChunkType>(c.type), sequence++, original.payload(c));
+    }
+    encode_tick_block(copy, payload);
+    append_chunk(bytes, ChunkType::kTicks, sequence, payload);
+    return open_bytes(bytes);
+  };
+  const Recording alike = with_copy(*ticks);
+  EXPECT_TRUE(alike.content_errors().empty()) << alike.content_errors()[0];
+  EXPECT_EQ(alike.ticks().size(), original.ticks().size());
+
+  std::vector<TickRecord> moved = *ticks;
+  for (std::size_t i = 5; i < 10; ++i) moved[i].input.joints.insertion_m += 0.020;
+  const Recording differing = with_copy(moved);
+  ASSERT_EQ(differing.content_errors().size(), 1u);
+  const std::uint64_t first = (*ticks)[5].tick, last = (*ticks)[9].tick;
+  const std::string expected = "ticks records of ticks " + std::to_string(first) + "-" + std::to_string(last) +
+                               " are in the file twice, and differ (ticks chunks " + std::to_string(copied->sequence) + " at byte " +
+                               std::to_string(copied->offset) + ", ";
+  EXPECT_NE(differing.content_errors()[0].find(expected), std::string::npos) << differing.content_errors()[0];
+  // The first copy in the file is the one kept, as before.
+  EXPECT_EQ(differing.ticks()[5].input.joints.insertion_m, original.ticks()[5].input.joints.insertion_m);
+}
+
 }  // namespace
 }  // namespace resecto::rec
