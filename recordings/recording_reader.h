@@ -108,6 +108,10 @@ class Recording {
   /// The damaged ranges `rec recover` left out when it made this file, over every recovery of it; 0
   /// for a file no recovery made. What they held is lost, though the file itself is sound.
   std::uint64_t recovered_damaged_ranges() const;
+  /// Whether `rec recover` made this file from a damaged recording its recorder never closed: no
+  /// summary says how many ticks the procedure had, so what the ranges left out held is unknown (the
+  /// end of the procedure, perhaps). Replay, score and `rec verify` all say so.
+  bool recovered_from_unclosed() const { return recovered_damaged_ranges() > 0 && !summary_count("ticks"); }
 
   /// Simulated seconds from the first recorded tick to the end of the last (a gap a recovery left
   /// counts: the procedure spans it, though its ticks are lost).

@@ -91,7 +91,7 @@ std::string uncompared_hashes(const Recording& recording, std::uint64_t reached)
   }
   // A recovery of a cut or killed file: the recorder never said how many hashes it wrote, and the
   // damaged ranges the recovery left out (a cut end among them, perhaps) may have held some.
-  if (dropped > 0 && !written) {
+  if (recording.recovered_from_unclosed()) {
     return "`resecto rec recover` made it from a damaged recording that was never closed (" + std::to_string(dropped) +
            " damaged ranges left out): how many hashes those held is unknown";
   }

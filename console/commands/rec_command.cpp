@@ -184,6 +184,15 @@ void verify(const std::string& file) {
                 static_cast<unsigned long long>(*written - r.ticks().size()));
     return;
   }
+  // A recovery of a file never closed: the ranges it left out may have held the procedure's end, and
+  // no summary says (audit 7, F6: "ok" for a file `replay --verify` and `score` refuse).
+  if (r.recovered_from_unclosed()) {
+    std::printf(
+        "%s`rec recover` made it from a damaged recording that was never closed (%llu damaged ranges left out): how much of the "
+        "procedure those held is unknown\n",
+        sound.c_str(), static_cast<unsigned long long>(r.recovered_damaged_ranges()));
+    return;
+  }
   std::printf("%s: ok, %zu chunks, every CRC matches, every keyframe decodes, index present; all %zu recorded ticks replay\n", file.c_str(),
               r.chunks().size(), r.ticks().size());
 }
