@@ -177,11 +177,19 @@ void verify(const std::string& file) {
   }
   // A recovery that left out the last ticks chunks leaves no gap: only the recorder's summary says
   // how many it wrote (audit 30, F3: "ok" for a file that had lost its last quarter).
+  const char* why_fewer =
+      r.recovered_damaged_ranges() > 0 ? "`rec recover` left out the damaged chunks that held the rest" : "chunks were removed";
   if (const std::optional<std::uint64_t> written = r.summary_count("ticks"); written && *written > r.ticks().size()) {
     std::printf("%sit holds only %zu of the %llu ticks its recorder wrote (%s): the procedure's last %llu ticks are lost\n", sound.c_str(),
-                r.ticks().size(), static_cast<unsigned long long>(*written),
-                r.recovered_damaged_ranges() > 0 ? "`rec recover` left out the damaged chunks that held the rest" : "chunks were removed",
+                r.ticks().size(), static_cast<unsigned long long>(*written), why_fewer,
                 static_cast<unsigned long long>(*written - r.ticks().size()));
+    return;
+  }
+  // Steps' hashes lost the same way: every tick replays, but `replay --verify` cannot vouch for the
+  // steps whose hashes are gone (audit 7, F6: "ok" for a file replay --verify refuses).
+  if (const std::optional<std::uint64_t> written = r.summary_count("steps"); written && *written > r.steps().size()) {
+    std::printf("%sit holds only %zu of the %llu collision steps' hashes its recorder wrote (%s): a replay cannot verify the rest\n",
+                sound.c_str(), r.steps().size(), static_cast<unsigned long long>(*written), why_fewer);
     return;
   }
   // A recovery of a file never closed: the ranges it left out may have held the procedure's end, and

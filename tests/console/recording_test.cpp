@@ -362,6 +362,15 @@ TEST(RecordingCommands, ARecoveryWithoutSomeStepHashesDoesNotVerifyAsWhole) {
   EXPECT_EQ(out["recorded_hashes"], 60);
   EXPECT_LT(out["hashes_in_file"].get<int>(), 60);
   EXPECT_EQ(out["mismatches"], 0);
+  // rec verify says the same of it: sound, not "ok" (audit 7, F6: "ok" for a file replay --verify refuses).
+  const testing::CommandOutput verify = run_resecto("rec verify " + recovered.string());
+  EXPECT_EQ(verify.exit_code, 0) << verify.err;
+  EXPECT_EQ(verify.out.find(": ok,"), std::string::npos) << verify.out;
+  EXPECT_NE(verify.out.find(
+                "it holds only " + out["hashes_in_file"].dump() +
+                " of the 60 collision steps' hashes its recorder wrote (`rec recover` left out the damaged chunks that held the rest)"),
+            std::string::npos)
+      << verify.out;
 }
 
 TEST(RecordingCommands, VerifyDecodesEveryKeyframeAndFindsTicksThatCannotReplay) {
