@@ -148,6 +148,10 @@ Result<RecordingScore> score_recording(const std::filesystem::path& path, const 
   Result<rec::Recording> recording = rec::Recording::open(path);
   if (!recording) return Error{recording.error()};  // it names the file
   std::string note;
+  // Each fault that leaves the procedure whole is said; the first says why the file scores anyway.
+  auto note_fault = [&](const std::string& fault) {
+    note = note.empty() ? name + ": " + fault + ", but every tick and command the recorder wrote is intact: scored" : note + "; " + fault;
+  };
   if (!recording->damaged().empty()) {
     // Damage that took only keyframes, hashes or bytes past the end leaves every tick and command the
     // recorder counted when it closed the file: the procedure is whole, and scores (the `rec recover`
@@ -158,13 +162,17 @@ Result<RecordingScore> score_recording(const std::filesystem::path& path, const 
     const bool whole = holds_every_tick_and_command(*recording) && recording->content_errors().empty() &&
                        recording->replayable_ticks() == recording->ticks().size();
     if (!whole) return Error{name + ": " + damaged + "; a score from part of a procedure would mislead"};
-    note = name + ": " + damaged + ", but every tick and command the recorder wrote is intact: scored";
+    note_fault(damaged);
   }
+  // Cut after the recorder's summary, before its index: the summary vouches for the procedure (else
+  // lost_part_of_procedure skips the file below), but the file is not closed, as `rec verify` says
+  // (audit 7, F5: scored without a word).
+  if (!recording->closed()) note_fault("not closed (no index; `resecto rec recover` closes it)");
   if (!recording->content_errors().empty()) return Error{name + ": " + recording->content_errors().front()};
   // Keyframes are the debrief's pictures, not its figures: a file whose only fault is there scores.
   if (const std::vector<std::string> keyframes = recording->keyframe_problems(); !keyframes.empty()) {
     const std::string fault = std::to_string(keyframes.size()) + " unusable keyframes (the first: " + keyframes.front() + ")";
-    note = note.empty() ? name + ": " + fault + ", but every tick and command the recorder wrote is intact: scored" : note + "; " + fault;
+    note_fault(fault);
   }
   if (std::string lost = lost_part_of_procedure(*recording); !lost.empty())
     return Error{name + ": " + lost + "; a score from part of a procedure would mislead"};

@@ -261,6 +261,20 @@ TEST(ScoreCommand, ARecordingCutBetweenChunksIsSkippedAsNeverClosed) {
   }
   EXPECT_NE(scored.err.find("3 of 3 recordings skipped"), std::string::npos) << scored.err;
   EXPECT_EQ(score_json(file.string()).at("scored").size(), 1u);
+  // Cut after the summary, before the index: the summary shows the whole procedure, so it scores, but
+  // not without saying the file is not closed, as `rec verify` does (audit 7, F5: scored without a word).
+  const std::size_t index = bytes.rfind(std::string("CHNK\x07\x00", 6));
+  ASSERT_NE(index, std::string::npos);
+  const auto before_index = dir / "before_index.resecto";
+  std::ofstream(before_index, std::ios::binary) << bytes.substr(0, index);
+  const CommandOutput unclosed = run_resecto("score --quiet --json " + before_index.string());
+  EXPECT_EQ(unclosed.exit_code, 0) << unclosed.err;
+  EXPECT_NE(unclosed.err.find("note: " + before_index.string() +
+                              ": not closed (no index; `resecto rec recover` closes it), but every tick and "
+                              "command the recorder wrote is intact: scored"),
+            std::string::npos)
+      << unclosed.err;
+  EXPECT_EQ(json::parse(unclosed.out)["scored"][0]["metrics"], score_json(file.string())["scored"][0]["metrics"]);
 }
 
 TEST(ScoreCommand, RecordingsOfOneNameFromTwoFoldersGetAPageEach) {
