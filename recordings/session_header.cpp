@@ -138,6 +138,12 @@ std::size_t most_surface_triangles(const SimulationConfig& config) {
   return std::max<std::size_t>(4 * TissueConfig::kMinNodeCapacity, 16 * static_cast<std::size_t>(std::max(0, config.prostate_triangles)));
 }
 
+std::size_t least_surface_triangles(const SimulationConfig& config) {
+  // Half the triangles asked for: the grid's count is within half a percent of them where one fits,
+  // and never far off where none does.
+  return static_cast<std::size_t>(std::max(0, config.prostate_triangles)) / 2;
+}
+
 std::string build_identity() {
   std::string id = "resecto " RESECTO_VERSION_STRING;
 #if defined(__clang__)
@@ -201,6 +207,15 @@ Result<SessionHeader> header_from_json(std::string_view text) {
       JsonFields::fail("surface_triangles", std::to_string(h.surface_triangles) + " is more than a gland of " +
                                                 std::to_string(h.simulation.prostate_triangles) + " triangles holds (at most " +
                                                 std::to_string(most_surface_triangles(h.simulation)) + ")");
+    }
+    // The gland built from the settings has a surface within a percent of the triangles asked for
+    // (generate_prostate's grid): a count far below says the header was edited, and a replay would
+    // first build the model the settings ask for (54 s and 2.5 GB at 300,000) only to refuse it then
+    // (audit 7, F3). The recorder writes the surface at the start, before any cut.
+    if (h.surface_triangles < least_surface_triangles(h.simulation)) {
+      JsonFields::fail("surface_triangles", std::to_string(h.surface_triangles) + " is far fewer than a gland of " +
+                                                std::to_string(h.simulation.prostate_triangles) + " triangles has (at least " +
+                                                std::to_string(least_surface_triangles(h.simulation)) + "): the header was edited");
     }
     const std::array<double, 3> origin = q.numbers<3>("origin_m");
     for (std::size_t i = 0; i < 3; ++i) h.grid.origin[i] = static_cast<float>(origin[i]);

@@ -40,6 +40,8 @@ struct SessionHeader {
 /// allocated).
 std::size_t most_nodes(const SimulationConfig& config);
 std::size_t most_surface_triangles(const SimulationConfig& config);
+/// The fewest surface triangles the gland a header's settings build has at the start (before any cut).
+std::size_t least_surface_triangles(const SimulationConfig& config);
 
 /// This build's identity string.
 std::string build_identity();

@@ -447,6 +447,31 @@ TEST(RecordingCommands, TicksLostFromTheEndOrAnEditedHeaderAreNamed) {
   EXPECT_NE(replayed.err.find("'s header says " + std::to_string(r->header().nodes + 1) + " nodes"), std::string::npos) << replayed.err;
 }
 
+// The gland's size edited in a 1296-triangle recording's header: replay built the 300,000-triangle
+// model (54 s, 2.5 GB) before refusing the counts, and `rec info` accepted the file (audit 7, F3).
+// Every reader now refuses it at once, from the header alone.
+TEST(RecordingCommands, AHeaderAskingForAGlandFarLargerThanItsSurfaceIsRefusedAtOnce) {
+  const auto [dir, file, r] = record_and_open("recording_edited_gland", "--seconds 0.5");
+  ASSERT_TRUE(r);
+  const auto edited = dir / "edited.rsrec";
+  rewrite(*r, edited, [&](const rec::ChunkLocation& chunk, std::vector<std::uint8_t>& payload) {
+    if (is(chunk, rec::ChunkType::kHeader)) {
+      nlohmann::ordered_json header = nlohmann::ordered_json::parse(payload.begin(), payload.end());
+      header["simulation"]["prostate_triangles"] = 300000;
+      const std::string text = header.dump();
+      payload.assign(text.begin(), text.end());
+    }
+    return true;
+  });
+  const std::string why =
+      "surface_triangles: " + std::to_string(r->header().surface_triangles) + " is far fewer than a gland of 300000 triangles has";
+  for (const char* command : {"replay ", "rec info ", "rec verify ", "score --quiet "}) {
+    const testing::CommandOutput out = testing::run_resecto_bounded(command + edited.string(), 5.0, 1024);
+    EXPECT_EQ(out.exit_code, 1) << command << out.err;
+    EXPECT_NE(out.err.find(why), std::string::npos) << command << out.err;
+  }
+}
+
 TEST(RecordingCommands, TicksLostInTheMiddleAreNamedAndNoExportPassesOverThem) {
   const auto [dir, file, r] = record_and_open("recording_lost_middle", "--seconds 2");
   ASSERT_TRUE(r);

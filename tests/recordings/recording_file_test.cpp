@@ -325,6 +325,7 @@ SessionHeader sound_header() {
   header.calibration = nlohmann::ordered_json::object();
   header.grid.bits = 11;
   header.grid.range = 0.1f;
+  header.surface_triangles = static_cast<std::uint32_t>(header.simulation.prostate_triangles);  // the gland's, within a percent
   return header;
 }
 
@@ -370,6 +371,27 @@ TEST(SessionHeaderJson, CountsPastWhatTheGlandHoldsAreRefused) {
   json["surface_triangles"] = header.surface_triangles;
   json["nodes"] = most_nodes(header.simulation);
   EXPECT_TRUE(header_from_json(json.dump()));
+}
+
+// A header of a 1296-triangle gland whose settings were edited to 300,000: replay built the big
+// model (54 s, 2.5 GB) before refusing the counts, and `rec info` accepted it (audit 7, F3). The
+// surface a recorder writes is within a percent of the triangles asked for: refused on reading.
+TEST(SessionHeaderJson, ASurfaceFarSmallerThanTheSettingsGlandIsRefused) {
+  nlohmann::ordered_json json = header_to_json(sound_header());
+  json["surface_triangles"] = 1302;
+  json["simulation"]["prostate_triangles"] = 300000;
+  EXPECT_EQ(header_from_json(json.dump()).error(),
+            "header: surface_triangles: 1302 is far fewer than a gland of 300000 triangles has (at least 150000): the header was edited");
+  json["simulation"]["prostate_triangles"] = 1296;
+  EXPECT_TRUE(header_from_json(json.dump()));
+  // The recorder's own header passes for every gland it builds, the smallest included.
+  for (const int triangles : {200, 1296}) {
+    SimulationConfig config;
+    config.prostate_triangles = triangles;
+    auto sim = Simulation::create(config);
+    ASSERT_TRUE(sim);
+    EXPECT_GE((*sim)->prostate().surface.triangle_count(), least_surface_triangles(config)) << triangles;
+  }
 }
 
 // Headers written before the contact search could keep its candidates have no contact_reuse_m: such
