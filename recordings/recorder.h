@@ -63,6 +63,8 @@ class Recorder {
   Result<RecorderCounters> finish(const nlohmann::ordered_json& extra = nullptr);
   /// Lost records so far (any thread).
   std::uint64_t lost() const;
+  /// The file the chunks go to until finish() renames it over the target (any thread: set at start).
+  const std::string& partial_path() const { return writer_.partial_path(); }
   /// The recorder thread, for raising its priority in real-time runs.
   std::thread::native_handle_type native_handle() { return thread_.native_handle(); }
 

@@ -251,9 +251,10 @@ void draw_recording_panel(ConsoleController& console) {
   const CoreStatus& s = console.frame().status;
   ConsoleUi& ui = console.ui();
   if (s.recording) {
-    // The file grows as the recorder thread flushes (twice a second); its size is the disk's word.
+    // The partial file grows as the recorder thread flushes (twice a second); its size is the disk's
+    // word. The target is replaced only when the recording is closed.
     std::error_code error;
-    const auto bytes = std::filesystem::file_size(s.recording_path.data(), error);
+    const auto bytes = std::filesystem::file_size(s.recording_partial_path.data(), error);
     if (!error) ui.recording_bytes_seen = bytes;
     const double seconds = static_cast<double>(FrameProfiler::now_ns() - ui.recording_started_ns) * 1e-9;
     const double simulated_s = static_cast<double>(s.next_tick - s.recording_start_tick) * console.session().simulation().config().tick_s();

@@ -160,6 +160,7 @@ void CoreSession::start_recording(const std::string& path) {
     status_.recording_start_tick = sim_->tick();
     status_.recording_lost = 0;
     copy_text(status_.recording_path, path);
+    copy_text(status_.recording_partial_path, recorder_->partial_path());
     status_.recording_message[0] = '\0';
   }
   publish();

@@ -94,6 +94,7 @@ struct CoreStatus {
   std::uint64_t recordings_finished = 0;
   std::uint64_t recorded_bytes = 0, recorded_ticks = 0, recorded_keyframes = 0;
   std::array<char, 512> recording_path{};
+  std::array<char, 520> recording_partial_path{};  ///< where the recording grows until it is closed and renamed
   std::array<char, 512> recording_message{};  ///< the last recording error, empty when none
 };
 

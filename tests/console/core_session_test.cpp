@@ -5,6 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
 #include <thread>
 
 #include "console/headless/headless_run.h"
@@ -64,6 +68,36 @@ TEST(CoreSession, PauseHoldsAndStepsRunExactlyTheTicksAsked) {
   EXPECT_TRUE(stepped.paused);
   session.stop();
   EXPECT_EQ(session.simulation().tick(), paused.next_tick + 1000);
+}
+
+// The console's recording grows in PATH.partial, which its panel shows the size of, and replaces an
+// older recording at PATH only when stopped: a crash or a full disk left the old one truncated (audit 7, F2).
+TEST(CoreSession, ARecordingReplacesTheFileAtItsPathOnlyWhenStopped) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "resecto_core_session_record";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path path = dir / "session.rsrec", partial = dir / "session.rsrec.partial";
+  { std::ofstream(path) << "the old recording"; }
+  Result<std::unique_ptr<CoreSession>> created = CoreSession::create(lockstep_demo());
+  ASSERT_TRUE(created);
+  CoreSession& session = **created;
+  session.start();
+  CoreControl record{CoreControlKind::kRecordStart, {}, 0, 0, 1.0, path.string()};
+  ASSERT_TRUE(session.send(record));
+  const CoreStatus recording =
+      wait_for(session, [](const CoreStatus& s) { return s.recording && s.next_tick > s.recording_start_tick + 200; });
+  EXPECT_EQ(std::string(recording.recording_partial_path.data()), partial.string());
+  EXPECT_TRUE(std::filesystem::exists(partial));
+  {
+    std::ifstream in(path);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "the old recording");
+  }
+  ASSERT_TRUE(session.send({CoreControlKind::kRecordStop, {}, 0, 0, 1.0, {}}));
+  const CoreStatus stopped = wait_for(session, [](const CoreStatus& s) { return s.recordings_finished > 0; });
+  session.stop();
+  EXPECT_EQ(stopped.recording_message[0], '\0') << stopped.recording_message.data();
+  EXPECT_FALSE(std::filesystem::exists(partial));
+  EXPECT_GT(std::filesystem::file_size(path), 1000u);
 }
 
 TEST(CoreSession, APausedCoreLeavesThePhysicsHelperAsleep) {
