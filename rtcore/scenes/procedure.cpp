@@ -190,6 +190,13 @@ Result<Procedure> load_procedure(const std::filesystem::path& path) {
   return parse_procedure(*text, path.string());
 }
 
+namespace {
+
+/// The built-in procedures' names, the list builtin_procedure() answers to.
+bool is_builtin_name(std::string_view name) { return name == "demo" || name == "turp"; }
+
+}  // namespace
+
 Result<Procedure> builtin_procedure(const std::string& name) {
   if (name == "demo") return parse_procedure(kDemoProcedure, "demo");
   if (name == "turp") return Procedure{"turp", turp_keyframes()};
@@ -212,7 +219,7 @@ Result<Procedure> find_procedure(const std::string& name_or_path) {
 std::optional<std::string> shadowed_file_note(const std::string& name_or_path) {
   // A file named demo beside the user was passed over without a word (audit 32, F13).
   std::error_code error;
-  if (!names_a_builtin_procedure(name_or_path) || !builtin_procedure(name_or_path) || !std::filesystem::exists(name_or_path, error)) return std::nullopt;
+  if (!is_builtin_name(name_or_path) || !std::filesystem::exists(name_or_path, error)) return std::nullopt;
   return "note: --procedure " + name_or_path + " is the built-in procedure; to read the file " + name_or_path + " here, write ./" + name_or_path;
 }
 
