@@ -344,12 +344,17 @@ Status ConsoleWindow::choose_shown(bool fresh_live_frame) {
 
 Status ConsoleWindow::run() {
   std::int64_t last_frame_ns = now_ns();
+  // The hand-driven device and replay playback advance by the time between frame starts: a frame's
+  // whole period, not just the wait between the last swap and this frame's start (audit 8, G17:
+  // holding a key moved the sheath 0.1 mm in 3 s, and replay played 2 ms in 3 s).
+  std::int64_t last_begin_ns = last_frame_ns;
   Status failure = Ok{};
   // Ctrl-C in the terminal closes the window as its close button does (console/live/interrupt.h).
   while (!quit_ && !glfwWindowShouldClose(window_) && interrupt_signal() == 0) {
     glfwPollEvents();
     const std::int64_t begin_ns = now_ns();
-    const double dt_s = std::min(0.25, static_cast<double>(begin_ns - last_frame_ns) * 1e-9);
+    const double dt_s = std::min(0.25, static_cast<double>(begin_ns - last_begin_ns) * 1e-9);
+    last_begin_ns = begin_ns;
     while (next_action_ < actions_.size() && actions_[next_action_].frame <= ui_.frame) {
       if (Status applied = apply_action(actions_[next_action_++]); !applied) {
         failure = applied;

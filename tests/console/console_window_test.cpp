@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "console/headless/headless_run.h"
+#include "device/input/manual_motion.h"
 #include "recordings/recording_reader.h"
 #include "tests/console/run_resecto.h"
 
@@ -413,6 +414,43 @@ TEST(ConsoleWindow, RecordedSessionReplaysAtAScrubbedTimeWithTheRecordedToolPose
   EXPECT_EQ(verification.at("mismatches"), 0);
   EXPECT_EQ(verification.at("verified").get<std::size_t>(), opened->steps().size());
   EXPECT_GT(load_png(dir / "replay.png").width, 0);
+}
+
+// Audit 8, G17: the hand-driven device and replay playback advanced by the wait between a frame's
+// swap and the next frame's start, not by the frame's period: a held key moved the sheath 0.1 mm in
+// 3 s and "play" showed 2 ms of a recording in 3 s. Both must move at their rates (within a factor
+// of two: the frames' own times wander).
+TEST(ConsoleWindow, HeldKeyAndReplayPlayAdvanceAtTheirRates) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_rates");
+  constexpr int kFrames = 30;
+  const auto seconds_of_frames = [&](const nlohmann::json& report) {
+    // Frames 1 .. kFrames - 1 hold the key or play: their count times the median frame time.
+    return (kFrames - 2) * report.at("frame_ms").at("median").get<double>() * 1e-3;
+  };
+  std::ofstream(dir / "w.actions") << "frame 1 key W down\nframe " << kFrames << " quit\n";
+  const CommandOutput held = run_in_xvfb("console --device keyboard --insertion-mm 100 --triangles 1296 --width 800 --height 600 --actions " +
+                                             (dir / "w.actions").string() + " --report " + (dir / "w.json").string(),
+                                         dir);
+  ASSERT_EQ(held.exit_code, 0) << held.err;
+  const nlohmann::json w = load_json(dir / "w.json");
+  const double moved_mm = w.at("metrics").at("max_insertion_mm").get<double>() - 100.0;
+  const double expected_mm = std::min(130.0, ManualMotionLimits{}.insertion_rate_mm_s * seconds_of_frames(w));
+  EXPECT_GT(moved_mm, 0.5 * expected_mm) << "the sheath crawls";
+  EXPECT_LT(moved_mm, 2.0 * expected_mm + 1.0);
+
+  const auto recording = dir / "r.rsrec";
+  ASSERT_EQ(run_resecto("run --headless --triangles 1296 --seconds 8 --record " + recording.string()).exit_code, 0);
+  std::ofstream(dir / "p.actions") << "frame 1 replay play\nframe " << kFrames << " quit\n";
+  const CommandOutput played = run_in_xvfb("console --triangles 1296 --width 800 --height 600 --replay " + recording.string() +
+                                               " --actions " + (dir / "p.actions").string() + " --report " + (dir / "p.json").string(),
+                                           dir);
+  ASSERT_EQ(played.exit_code, 0) << played.err;
+  const nlohmann::json p = load_json(dir / "p.json");
+  const double shown_s = p.at("replay").at("time_s").get<double>();
+  const double expected_s = std::min(8.0, seconds_of_frames(p));
+  EXPECT_GT(shown_s, 0.5 * expected_s) << "playback crawls";
+  EXPECT_LT(shown_s, 2.0 * expected_s + 0.1);
 }
 
 TEST(ConsoleWindow, BadActionsAreClearErrors) {
