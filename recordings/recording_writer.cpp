@@ -64,6 +64,31 @@ Error RecordingWriter::fail(const std::string& what, int error_number) {
   return Error{first_error_};
 }
 
+Result<std::filesystem::path> partial_recording_path(const std::filesystem::path& target) {
+  Result<std::filesystem::path> destination = resolve_links(target);
+  if (!destination) return Error{destination.error()};
+  return std::filesystem::path(destination->string() + ".partial");
+}
+
+Status check_partial_recording_path(const std::filesystem::path& target, std::span<const std::filesystem::path> inputs) {
+  Result<std::filesystem::path> partial = partial_recording_path(target);
+  if (!partial) return Error{partial.error()};
+  struct stat existing {};
+  if (::lstat(partial->c_str(), &existing) != 0) return Ok{};  // nothing there: the usual case
+  if (!S_ISREG(existing.st_mode)) {
+    return Error{partial->string() + ": not a regular file (a link, folder or device) where the recording to " + target.string() +
+                 " streams until it is closed: move it away"};
+  }
+  for (const std::filesystem::path& input : inputs) {
+    std::error_code error;
+    if (!input.empty() && std::filesystem::equivalent(input, *partial, error) && !error) {
+      return Error{partial->string() + ": is the input " + input.string() + "; recording to " + target.string() +
+                   " streams into it and would destroy it (give another output path)"};
+    }
+  }
+  return Ok{};
+}
+
 Status RecordingWriter::open(const std::filesystem::path& target) {
   target_ = target.string();
   Result<std::filesystem::path> destination = resolve_links(target);
@@ -71,8 +96,15 @@ Status RecordingWriter::open(const std::filesystem::path& target) {
   destination_ = destination->string();
   partial_ = destination_ + ".partial";
   first_error_.clear();
-  fd_ = ::open(partial_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (Status usable = check_partial_recording_path(target); !usable) {
+    first_error_ = usable.error();
+    return usable;
+  }
+  // No link followed and no FIFO waited on, should one appear after the check.
+  fd_ = ::open(partial_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
   if (fd_ < 0) return fail("cannot create the recording", errno);
+  struct stat opened {};
+  if (::fstat(fd_, &opened) != 0 || !S_ISREG(opened.st_mode)) return fail("cannot create the recording", EINVAL);
   // The recording replaces the target's contents, not its permissions (as AtomicFile keeps them).
   struct stat existing {};
   if (::stat(destination_.c_str(), &existing) == 0 && S_ISREG(existing.st_mode) && ::fchmod(fd_, existing.st_mode & 07777) != 0) {

@@ -34,6 +34,15 @@ Result<std::vector<IndexEntry>> decode_index(std::span<const std::uint8_t> paylo
 void append_index_and_trailer(std::vector<std::uint8_t>& out, std::uint64_t out_offset, std::span<const IndexEntry> entries,
                               std::uint32_t sequence);
 
+/// The file a recording to `target` streams into until it is closed: the target, links followed, with
+/// ".partial" appended.
+Result<std::filesystem::path> partial_recording_path(const std::filesystem::path& target);
+/// Whether a recording to `target` may stream into its partial file, checked before the run: a stale
+/// partial file is replaced, but a link, folder, FIFO or device there is refused (opened blindly, a
+/// link's target was overwritten and a FIFO blocked the run for good), and so is one of `inputs` (the
+/// partial file of a killed run, opened for replay). Audit 8, G2 and G3.
+Status check_partial_recording_path(const std::filesystem::path& target, std::span<const std::filesystem::path> inputs = {});
+
 class RecordingWriter {
  public:
   RecordingWriter() = default;

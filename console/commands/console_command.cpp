@@ -15,6 +15,7 @@
 #include "console/gui/console_app.h"
 #include "console/gui/tissue_presets.h"
 #include "console/live/interrupt.h"
+#include "recordings/recording_writer.h"
 #include "rtcore/base/atomic_file.h"
 
 namespace resecto::cli {
@@ -77,6 +78,9 @@ void open_console(const ConsoleCliOptions& o) {
   std::erase_if(inputs, [](const std::filesystem::path& p) { return p.empty(); });
   const std::vector<std::filesystem::path> outputs{o.record, o.report, o.screenshot};
   if (Status writable = check_output_paths(outputs, inputs); !writable) throw std::runtime_error(writable.error());
+  if (!o.record.empty()) {
+    if (Status writable = rec::check_partial_recording_path(o.record, inputs); !writable) throw std::runtime_error(writable.error());
+  }
   gui::ConsoleOptions options;
   options.input_paths = inputs;
   Result<Procedure> procedure = find_procedure(o.procedure);

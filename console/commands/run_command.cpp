@@ -18,6 +18,7 @@
 #include "console/commands/parameter_options.h"
 #include "console/headless/headless_run.h"
 #include "console/live/interrupt.h"
+#include "recordings/recording_writer.h"
 #include "rtcore/base/atomic_file.h"
 #include "rtcore/base/units.h"
 #include "rtcore/mesh/mesh_io.h"
@@ -90,6 +91,9 @@ void run(const RunOptions& o) {
   const std::vector<std::filesystem::path> inputs{std::filesystem::exists(o.procedure) ? o.procedure : std::string(), o.calibration};
   const std::vector<std::filesystem::path> outputs{o.record, o.report, o.trace, o.export_surface};
   if (Status ok = check_output_paths(outputs, inputs); !ok) throw std::runtime_error(ok.error());
+  if (!o.record.empty()) {
+    if (Status ok = rec::check_partial_recording_path(o.record, inputs); !ok) throw std::runtime_error(ok.error());
+  }
   options.seed = o.seed;
   options.simulation.prostate_triangles = o.triangles;
   options.simulation.collision_hz = o.collision_hz;

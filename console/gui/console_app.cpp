@@ -58,6 +58,8 @@ class ConsoleWindow {
         controller_(session, ui_, settings_), actions_(std::move(actions)) {
     ui_.manual = ManualMotion(options.core.device.manual_start);
     controller_.protect_inputs(options.input_paths);
+    controller_.claim_output(options.report_path, OutputKind::kReport);
+    controller_.claim_output(options.screenshot_path, OutputKind::kScreenshot);
     // Checked with the other outputs before the window opened (open_console): it starts.
     if (!options.record_path.empty()) (void)controller_.start_recording(options.record_path);
     for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
@@ -147,7 +149,8 @@ Status ConsoleWindow::apply_action(const Action& a) {
       }
       break;
     case ActionVerb::kScreenshot:
-      if (Status writable = controller_.check_output(a.words[0]); !writable) return fail(writable.error());
+      if (Status writable = controller_.check_output(a.words[0], OutputKind::kScreenshot); !writable) return fail(writable.error());
+      controller_.claim_output(a.words[0], OutputKind::kScreenshot);
       screenshots_due_.push_back(a.words[0]);
       break;
     case ActionVerb::kPreset:
@@ -486,6 +489,7 @@ ordered_json make_report(CoreSession& session, ConsoleUi& ui, const ConsoleOptio
   }
   r["parameter_changes"] = changes;
   r["screenshots"] = ui.screenshots;
+  if (const int signal_number = interrupt_signal(); signal_number != 0) r["interrupted"] = signal_name(signal_number);
   const CoreStatus& status = session.frames().read_slot().status;
   r["recording"] = {{"active", status.recording}, {"path", std::string(status.recording_path.data())},
                     {"finished", status.recordings_finished}, {"bytes", status.recorded_bytes}, {"ticks", status.recorded_ticks},
@@ -610,6 +614,8 @@ Result<ordered_json> run_console(const ConsoleOptions& options) {
   if (!options.report_path.empty()) {
     if (Status written = write_file_atomically(options.report_path, report.dump(2) + "\n"); !written) return Error{written.error()};
   }
+  // After the report (which holds it too): a recording lost is a failed session, as in a headless run.
+  if (!session.recording_error().empty()) return Error{session.recording_error()};
   return report;
 }
 

@@ -6,6 +6,7 @@
 #include "console/gui/tissue_presets.h"
 #include "rtcore/base/atomic_file.h"
 #include "rtcore/base/checked_number.h"
+#include "recordings/recording_writer.h"
 #include "rtcore/base/units.h"
 
 namespace resecto::gui {
@@ -71,23 +72,71 @@ Status ConsoleController::set_by_key(const std::string& key, double value) {
   return Ok{};
 }
 
-Status ConsoleController::check_output(const std::string& path) const {
+namespace {
+
+const char* output_kind_name(OutputKind kind) {
+  switch (kind) {
+    case OutputKind::kRecording: return "recording";
+    case OutputKind::kReport: return "report";
+    case OutputKind::kScreenshot: return "screenshot";
+    case OutputKind::kPreset: return "preset";
+  }
+  return "output";
+}
+
+bool same_output(const std::filesystem::path& a, const std::filesystem::path& b) {
+  std::error_code error;
+  if (std::filesystem::absolute(a, error).lexically_normal() == std::filesystem::absolute(b, error).lexically_normal()) return true;
+  return std::filesystem::equivalent(a, b, error) && !error;
+}
+
+}  // namespace
+
+Status ConsoleController::check_output(const std::string& path, OutputKind kind) const {
   std::vector<std::filesystem::path> inputs = inputs_;
   if (!ui_.replay_path.empty()) inputs.emplace_back(ui_.replay_path);
-  return check_output_path(path, inputs);
+  if (Status writable = check_output_path(path, inputs); !writable) return writable;
+  for (const auto& [claimed, claimed_kind] : claimed_) {
+    // A screenshot or preset may be taken again over its own file; a recording is never replaced by
+    // this session's next one.
+    if ((claimed_kind != kind || kind == OutputKind::kRecording) && same_output(claimed, path)) {
+      return Error{path + ": is this session's " + output_kind_name(claimed_kind) + " (" + claimed.string() + "); writing the " +
+                   output_kind_name(kind) + " there would lose it (give another path)"};
+    }
+  }
+  if (kind == OutputKind::kRecording) return rec::check_partial_recording_path(path, inputs);
+  return Ok{};
+}
+
+void ConsoleController::claim_output(const std::filesystem::path& path, OutputKind kind) {
+  if (path.empty()) return;
+  claimed_.emplace_back(path, kind);
+  if (kind == OutputKind::kRecording) {
+    if (Result<std::filesystem::path> partial = rec::partial_recording_path(path)) claimed_.emplace_back(*partial, kind);
+  }
 }
 
 Status ConsoleController::start_recording(const std::string& path) {
-  if (Status writable = check_output(path); !writable) return writable;
+  // One recording at a time; a second start used to be dropped without a word (audit 8, G5). Asked
+  // and not yet taken by the core counts as running, unless the core said it could not start it.
+  if (recording_asked_ && (frame().status.recording || frame().status.recording_message[0] == '\0')) {
+    return Error{"record " + path + ": a recording is running already (" + recording_asked_path_ + "); `record stop` it first"};
+  }
+  if (Status writable = check_output(path, OutputKind::kRecording); !writable) return writable;
   CoreControl control;
   control.kind = CoreControlKind::kRecordStart;
   control.path = path;
   if (!send(control)) return Error{ui_.message};
+  claim_output(path, OutputKind::kRecording);
+  recording_asked_ = true;
+  recording_asked_path_ = path;
   ui_.recording_started_ns = FrameProfiler::now_ns();
   return Ok{};
 }
 
-void ConsoleController::stop_recording() { send({CoreControlKind::kRecordStop, {}, 0, 0, 1.0, {}}); }
+void ConsoleController::stop_recording() {
+  if (send({CoreControlKind::kRecordStop, {}, 0, 0, 1.0, {}})) recording_asked_ = false;
+}
 
 Status ConsoleController::open_replay(const std::string& path) {
   if (Status opened = ui_.replay.open(path); !opened) {
@@ -122,8 +171,9 @@ void ConsoleController::step(std::uint32_t ticks) { send({CoreControlKind::kStep
 void ConsoleController::set_speed(double speed) { send({CoreControlKind::kSpeed, {}, 0, 0, speed, {}}); }
 
 Status ConsoleController::save_preset(const std::string& path) {
-  Status saved = check_output(path);
+  Status saved = check_output(path, OutputKind::kPreset);
   if (saved) saved = gui::save_preset(path, frame().status.parameters);
+  if (saved) claim_output(path, OutputKind::kPreset);
   ui_.preset_message = saved ? "saved " + path : saved.error();
   return saved;
 }

@@ -5,11 +5,16 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "console/gui/console_state.h"
 
 namespace resecto::gui {
+
+/// What a file this session writes holds: one path holds one of them (audit 8, G1: a `record` action
+/// onto --report's path lost the recording, a screenshot onto --record's path the screenshot).
+enum class OutputKind { kRecording, kReport, kScreenshot, kPreset };
 
 class ConsoleController {
  public:
@@ -40,9 +45,12 @@ class ConsoleController {
   /// Starts recording the live session to `path` (the core creates the file at its next tick), once
   /// check_output() passes it.
   Status start_recording(const std::string& path);
-  /// Whether `path` may be written: check_output_path(), with the session's files it reads (the
-  /// recording open for replay, and those of protect_inputs()) as inputs it would destroy.
-  Status check_output(const std::string& path) const;
+  /// Whether `path` may be written as `kind`: check_output_path(), with the session's files it reads
+  /// (the recording open for replay, and those of protect_inputs()) as inputs it would destroy, and
+  /// never a path this session writes as another kind (nor a recording's, or its partial file's, twice).
+  Status check_output(const std::string& path, OutputKind kind) const;
+  /// Notes that this session writes `path` as `kind` (--report and --screenshot, before the first frame).
+  void claim_output(const std::filesystem::path& path, OutputKind kind);
   /// Files the session reads (--actions, --preset, --replay): never written over by a recording,
   /// screenshot or preset this session makes.
   void protect_inputs(std::vector<std::filesystem::path> inputs) { inputs_ = std::move(inputs); }
@@ -66,6 +74,9 @@ class ConsoleController {
   ConsoleUi& ui_;
   ConsoleSettings& settings_;
   std::vector<std::filesystem::path> inputs_;  // protect_inputs()
+  std::vector<std::pair<std::filesystem::path, OutputKind>> claimed_;  // claim_output()
+  bool recording_asked_ = false;  // start_recording() sent, stop_recording() not yet
+  std::string recording_asked_path_;
 };
 
 }  // namespace resecto::gui

@@ -7,6 +7,7 @@
 
 #include "console/headless/headless_run.h"
 #include "console/headless/lockstep_device.h"
+#include "console/live/interrupt.h"
 #include "device/calibration/calibration.h"
 #include "device/link/calibration_adapter.h"
 #include "recordings/recorder.h"
@@ -154,6 +155,7 @@ void CoreSession::start_recording(const std::string& path) {
   Result<std::unique_ptr<rec::Recorder>> started = rec::Recorder::start(path, std::move(description), *sim_);
   if (!started) {
     copy_text(status_.recording_message, "recording " + path + ": " + started.error());
+    if (first_recording_error_.empty()) first_recording_error_ = "recording " + path + ": " + started.error();
   } else {
     recorder_ = std::move(*started);
     status_.recording = true;
@@ -168,19 +170,26 @@ void CoreSession::start_recording(const std::string& path) {
 
 void CoreSession::finish_recording() {
   if (!recorder_) return;
-  Result<rec::RecorderCounters> finished =
-      recorder_->finish({{"ticks", sim_->tick()}, {"state_hash", hex_hash(sim_->state_hash())}});
+  nlohmann::ordered_json run = {{"ticks", sim_->tick()}, {"state_hash", hex_hash(sim_->state_hash())}};
+  // A session closed by Ctrl-C is a procedure cut short, as a headless run's (audit 8, G18).
+  if (const int signal_number = interrupt_signal(); signal_number != 0) run["interrupted"] = signal_name(signal_number);
+  const std::string path(status_.recording_path.data());
+  Result<rec::RecorderCounters> finished = recorder_->finish(run);
   recorder_.reset();
   status_.recording = false;
   ++status_.recordings_finished;
   if (!finished) {
     copy_text(status_.recording_message, "recording: " + finished.error());
+    if (first_recording_error_.empty()) first_recording_error_ = "recording " + path + ": " + finished.error();
   } else {
     status_.recorded_bytes = finished->bytes;
     status_.recorded_ticks = finished->ticks;
     status_.recorded_keyframes = finished->keyframes;
     status_.recording_lost = finished->ticks_lost + finished->steps_lost + finished->commands_lost + finished->keyframes_lost;
-    if (!finished->write_error.empty()) copy_text(status_.recording_message, "recording: " + finished->write_error);
+    if (!finished->write_error.empty()) {
+      copy_text(status_.recording_message, "recording: " + finished->write_error);
+      if (first_recording_error_.empty()) first_recording_error_ = "recording " + path + ": " + finished->write_error;
+    }
   }
   publish();
 }

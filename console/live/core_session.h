@@ -135,6 +135,9 @@ class CoreSession {
   /// After stop(): how well the schedule held.
   const DeadlineReport& deadlines() const { return scheduler_.report(); }
   const FrameProfiler& profiler() const { return profiler_; }
+  /// After stop(): the first recording that could not be started or finished whole, empty when none
+  /// (the panel shows the last one; a session ends with exit 1 on this one, audit 8, G4).
+  const std::string& recording_error() const { return first_recording_error_; }
 
  private:
   CoreSession(const CoreSessionOptions& options, std::unique_ptr<Simulation> sim);
@@ -168,6 +171,7 @@ class CoreSession {
   std::uint64_t publishes_ = 0;
   std::vector<std::pair<std::uint64_t, std::uint64_t>> hashes_;
   std::unique_ptr<rec::Recorder> recorder_;
+  std::string first_recording_error_;
   bool have_held_sample_ = false;
 
   std::atomic<std::uint64_t> next_tick_{0};

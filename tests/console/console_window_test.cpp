@@ -453,6 +453,25 @@ TEST(ConsoleWindow, HeldKeyAndReplayPlayAdvanceAtTheirRates) {
   EXPECT_LT(shown_s, 2.0 * expected_s + 0.1);
 }
 
+// Audit 8, G18: a console closed by Ctrl-C said its outputs were complete but marked neither its
+// report nor its recording as cut short, as a headless run's are; score then took it as finished.
+TEST(ConsoleWindow, CtrlCMarksTheReportAndTheRecordingInterrupted) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_interrupted");
+  const std::string recording = (dir / "s.rsrec").string();
+  const std::string report = (dir / "r.json").string();
+  // Ctrl-C once the recording is being written (the window is up and the core ticking).
+  const std::string inner = std::string(RESECTO_EXE) + " console --triangles 1296 --width 800 --height 600 --record " + recording +
+                            " --report " + report + " >/dev/null 2>" + (dir / "err.txt").string() + " & p=$!; while [ ! -f " + recording +
+                            ".partial ]; do sleep 0.2; done; sleep 1; kill -INT $p; wait $p; echo $? >" + (dir / "status.txt").string();
+  ASSERT_EQ(std::system(("xvfb-run -a -s '-screen 0 1920x1200x24' sh -c '" + inner + "' </dev/null").c_str()), 0);
+  EXPECT_EQ(read_text(dir / "status.txt"), "130\n") << read_text(dir / "err.txt");
+  EXPECT_EQ(load_json(report).at("interrupted"), "SIGINT");
+  const CommandOutput info = run_resecto("rec info " + recording);
+  EXPECT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_NE(info.out.find("interrupted by SIGINT"), std::string::npos) << info.out;
+}
+
 TEST(ConsoleWindow, BadActionsAreClearErrors) {
   REQUIRE_X_SERVER();
   const auto dir = scratch_directory("console_errors");
@@ -525,6 +544,26 @@ TEST(ConsoleWindow, OutputsNeverReplaceDevicesInputsOrFailSilently) {
   const CommandOutput over_actions = run_in_xvfb(base + "--actions " + (dir / "q.actions").string() + " --report " + (dir / "q.actions").string(), dir);
   EXPECT_EQ(over_actions.exit_code, 1);
   EXPECT_EQ(read_text(dir / "q.actions"), "frame 3 quit\n");
+
+  // Audit 8: an action's output onto another of the session's outputs (G1), a second recording started
+  // while one runs (G5), a recording whose partial file cannot be made (G4) or is the replayed input (G2).
+  expect_refused("frame 1 record " + (dir / "rep.json").string() + "\n", " --report " + (dir / "rep.json").string(),
+                 "is this session's report");
+  expect_refused("frame 1 screenshot " + (dir / "main.rsrec").string() + "\n", " --record " + (dir / "main.rsrec").string(),
+                 "is this session's recording");
+  expect_refused("frame 1 preset save " + (dir / "main.rsrec.partial").string() + "\n", " --record " + (dir / "main.rsrec").string(),
+                 "is this session's recording");
+  expect_refused("frame 1 record " + (dir / "second.rsrec").string() + "\n", " --record " + (dir / "main.rsrec").string(),
+                 "a recording is running already");
+  std::filesystem::create_directory(dir / "blocked.rsrec.partial");
+  expect_refused("frame 1 record " + (dir / "blocked.rsrec").string() + "\n", "", "not a regular file");
+  std::filesystem::copy_file(recorded, dir / "killed.rsrec.partial");
+  const CommandOutput over_partial = run_in_xvfb(base + "--replay " + (dir / "killed.rsrec.partial").string() + " --record " +
+                                                     (dir / "killed.rsrec").string() + " --actions " + (dir / "q.actions").string(),
+                                                 dir);
+  EXPECT_EQ(over_partial.exit_code, 1);
+  EXPECT_NE(over_partial.err.find("is the input"), std::string::npos) << over_partial.err;
+  EXPECT_EQ(read_text(dir / "killed.rsrec.partial"), original);
 
   // Numbers past what a frame or a drag can hold are refused with the line, not run at frame 0.
   expect_refused("frame 1e300 quit\n", "", "a.actions:1:7: expected 'frame N VERB");

@@ -615,6 +615,29 @@ TEST(RecordingCommands, ARunKilledWhileRecordingLeavesTheOldRecordingWhole) {
   EXPECT_EQ(run_resecto("rec verify " + old.string()).exit_code, 0);
 }
 
+// Audit 8, G3: the partial file was opened blindly: a link there had its target overwritten, and a
+// FIFO blocked the run in open() for good. Both are refused before the model is built.
+TEST(RecordingCommands, ALinkOrFifoWhereThePartialFileGoesIsRefusedBeforeTheRun) {
+  const auto dir = scratch_directory("recording_partial_in_the_way");
+  std::ofstream(dir / "notes.txt") << "precious notes\n";
+  std::filesystem::create_symlink(dir / "notes.txt", dir / "linked.rsrec.partial");
+  const testing::CommandOutput linked = run_resecto("run --headless --triangles 1296 --seconds 0.2 --record " + (dir / "linked.rsrec").string());
+  EXPECT_EQ(linked.exit_code, 1);
+  EXPECT_NE(linked.err.find("linked.rsrec.partial: not a regular file"), std::string::npos) << linked.err;
+  EXPECT_EQ(testing::read_text(dir / "notes.txt"), "precious notes\n");
+  EXPECT_FALSE(std::filesystem::exists(dir / "linked.rsrec"));
+  ASSERT_EQ(::mkfifo((dir / "piped.rsrec.partial").c_str(), 0600), 0);
+  const testing::CommandOutput piped =
+      testing::run_resecto_bounded("run --headless --triangles 1296 --seconds 0.2 --record " + (dir / "piped.rsrec").string(), 60.0, 2048);
+  EXPECT_EQ(piped.exit_code, 1) << piped.err;
+  EXPECT_NE(piped.err.find("piped.rsrec.partial: not a regular file"), std::string::npos) << piped.err;
+  // A stale partial file of a killed run is a regular file: replaced, as documented.
+  std::ofstream(dir / "stale.rsrec.partial") << "stale";
+  EXPECT_EQ(run_resecto("run --headless --triangles 1296 --seconds 0.2 --record " + (dir / "stale.rsrec").string()).exit_code, 0);
+  EXPECT_FALSE(std::filesystem::exists(dir / "stale.rsrec.partial"));
+  EXPECT_EQ(run_resecto("rec verify " + (dir / "stale.rsrec").string()).exit_code, 0);
+}
+
 TEST(RecordingCommands, ExportsKeyframesAndInputsThatOtherProgramsRead) {
   const auto dir = scratch_directory("recording_export");
   const auto file = dir / "demo.rsrec";
