@@ -2,10 +2,11 @@
 // scores recordings by re-simulating them through the core (console/score/rescore.h). A recording
 // that cannot be scored is reported on standard error, naming why, and skipped; the rest are scored;
 // the exit status is 1 when any was skipped.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <map>
 #include <memory>
+#include <set>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -40,15 +41,31 @@ void score(const ScoreOptions& o) {
   if (comparing && o.compare.size() != 2) refuse_command_line("score --compare takes two recordings (trainee and expert)");
   if (comparing && !o.files.empty()) refuse_command_line("score --compare A B takes no other FILE");
   if (comparing && o.html.empty()) refuse_command_line("score --compare A B needs --html OUT (the side-by-side page)");
-  const std::vector<std::string>& files = comparing ? o.compare : o.files;
-  if (files.empty()) refuse_command_line("score: no recording given (resecto score FILE... or --compare A B)");
+  if ((comparing ? o.compare : o.files).empty()) refuse_command_line("score: no recording given (resecto score FILE... or --compare A B)");
+  // A recording named twice in a cohort is scored once: twice, it counted twice in the CSV and made
+  // two pages of one debrief. A comparison of a recording with itself stays as asked.
+  std::vector<std::string> files;
+  for (const std::string& file : comparing ? o.compare : o.files) {
+    const auto same = [&](const std::string& other) {
+      std::error_code error;
+      return std::filesystem::absolute(other).lexically_normal() == std::filesystem::absolute(file).lexically_normal() ||
+             (std::filesystem::equivalent(other, file, error) && !error);
+    };
+    if (!comparing && std::any_of(files.begin(), files.end(), same)) {
+      std::fprintf(stderr, "note: %s is given more than once; scored once\n", file.c_str());
+      continue;
+    }
+    files.push_back(file);
+  }
+  // Several recordings asked for: --html names a folder of pages, however many were distinct.
+  const bool cohort = !comparing && o.files.size() > 1;
 
   // The outputs checked before minutes of re-simulation: never a recording being scored, never the
   // same file twice. With several recordings --html is a folder of pages, made later.
   const std::vector<std::filesystem::path> inputs(files.begin(), files.end());
-  const std::vector<std::filesystem::path> outputs{o.csv, comparing || files.size() == 1 ? o.html : std::string()};
+  const std::vector<std::filesystem::path> outputs{o.csv, !cohort ? o.html : std::string()};
   if (Status ok = check_output_paths(outputs, inputs); !ok) throw std::runtime_error("score: " + ok.error());
-  if (!comparing && files.size() > 1 && !o.html.empty()) {  // the folder of pages
+  if (cohort && !o.html.empty()) {  // the folder of pages
     if (Status ok = check_output_folder(o.html, "with several recordings --html names a folder of pages"); !ok) throw std::runtime_error("score --html " + ok.error());
   }
 
@@ -81,7 +98,7 @@ void score(const ScoreOptions& o) {
     write_or_throw(o.csv, csv);
   }
   if (!o.html.empty()) {
-    if (comparing || files.size() == 1) {
+    if (!cohort) {
       if (!scored.empty()) write_or_throw(o.html, debrief_html(scored));
     } else if (!scored.empty()) {
       // Several recordings: OUT is a directory holding one page per recording (none made when every
@@ -91,14 +108,17 @@ void score(const ScoreOptions& o) {
       if (error) throw std::runtime_error("score --html " + o.html + ": cannot create the directory: " + error.message());
       // A page per recording, named by its file's stem; recordings of one stem from different
       // folders (trainee1/demo.rsrec, trainee2/demo.rsrec) get -2, -3, ... rather than one page each
-      // written over the last.
-      std::map<std::string, int> pages_of_stem;
+      // written over the last, and a suffix never takes a name another recording's page has
+      // (a/x, b/x and c/x-2 lost b's page to c's, audit 8, G8).
+      std::set<std::string> pages;
       for (const RecordingScore& s : scored) {
         const std::string stem = std::filesystem::path(s.file).stem().string();
-        const int seen = ++pages_of_stem[stem];
-        std::string page = stem;
-        if (seen > 1) page.append("-").append(std::to_string(seen));  // appended: GCC 12's -O3 -Wrestrict false positive
-        page.append(".html");
+        std::string page = stem + ".html";
+        for (int n = 2; pages.count(page) != 0; ++n) {
+          page = stem;
+          page.append("-").append(std::to_string(n)).append(".html");  // appended: GCC 12's -O3 -Wrestrict false positive
+        }
+        pages.insert(page);
         write_or_throw(std::filesystem::path(o.html) / page, debrief_html(std::span<const RecordingScore>(&s, 1)));
       }
     }

@@ -288,6 +288,24 @@ TEST(ScoreCommand, RecordingsOfOneNameFromTwoFoldersGetAPageEach) {
   ASSERT_EQ(scored.exit_code, 0) << scored.err;
   EXPECT_TRUE(std::filesystem::is_regular_file(dir / "pages" / "demo.html"));
   EXPECT_TRUE(std::filesystem::is_regular_file(dir / "pages" / "demo-2.html"));
+
+  // A third named demo-2 gets a page of its own, not trainee2's (audit 8, G8); a recording named twice
+  // is scored once.
+  std::filesystem::create_directories(dir / "trainee3");
+  run_and_record("demo", dir / "trainee3" / "demo-2.resecto", " --seconds 0.5 --seed 3");
+  const std::string first = (dir / "trainee1" / "demo.resecto").string();
+  const CommandOutput three = run_resecto("score --quiet --csv " + (dir / "three.csv").string() + " --html " + (dir / "three").string() + " " +
+                                          first + " " + (dir / "trainee2" / "demo.resecto").string() + " " +
+                                          (dir / "trainee3" / "demo-2.resecto").string() + " " + first);
+  ASSERT_EQ(three.exit_code, 0) << three.err;
+  EXPECT_NE(three.err.find("is given more than once; scored once"), std::string::npos) << three.err;
+  std::size_t pages = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "three")) pages += entry.path().extension() == ".html";
+  EXPECT_EQ(pages, 3u);
+  EXPECT_NE(testing::read_text(dir / "three" / "demo-2.html").find("trainee2"), std::string::npos);
+  EXPECT_NE(testing::read_text(dir / "three" / "demo-2-2.html").find("trainee3"), std::string::npos);
+  const std::string csv = testing::read_text(dir / "three.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4) << csv;  // the header and three rows
 }
 
 TEST(ScoreCommand, BadArgumentsAreNamed) {
