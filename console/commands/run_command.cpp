@@ -204,6 +204,17 @@ void register_run(CLI::App& app) {
           refuse_command_line(std::string(console_only) + " is an option of the operator console; a --headless run follows its procedure through the emulated device");
         }
       }
+    } else {
+      // And the other way: the console runs until its window closes, in real time, with the core's
+      // default contact search and input filter, and writes no trace or surface; taking these
+      // silently let a user wait for a file that never came (audit 8, G7).
+      for (const char* headless_only : {"--seconds", "--realtime", "--trace", "--export-surface", "--json", "--inline-collision", "--raw-input",
+                                        "--contact-reuse-mm", "--contact-margin-mm"}) {
+        if (cmd->count(headless_only) > 0) {
+          refuse_command_line(std::string(headless_only) + " is an option of a --headless run; without --headless `resecto run` opens the operator "
+                              "console, which runs until its window closes (add --headless, or leave the option out)");
+        }
+      }
     }
     run(*o);
   });
