@@ -75,6 +75,7 @@ class ConsoleWindow {
 
  private:
   Status apply_action(const Action& action);
+  Status account_for_unrun_actions() const;
   void read_manual_input(double dt_s);
   /// Chooses what the views show and brings its renderer up to date.
   Status choose_shown(bool fresh_live_frame);
@@ -422,7 +423,29 @@ Status ConsoleWindow::run() {
     ++ui_.frame;
     if (options_.frames > 0 && ui_.frame >= options_.frames) quit_ = true;
   }
+  if (failure && interrupt_signal() == 0) failure = account_for_unrun_actions();
   return failure;
+}
+
+Status ConsoleWindow::account_for_unrun_actions() const {
+  // A script's actions past the session's end (after a quit, past --frames, or the window closed)
+  // never ran; an output among them is a failed session, as a --screenshot never taken is (audit 8, G6).
+  if (next_action_ >= actions_.size()) return Ok{};
+  const std::size_t unrun = actions_.size() - next_action_;
+  for (std::size_t i = next_action_; i < actions_.size(); ++i) {
+    const Action& a = actions_[i];
+    const bool output = a.verb == ActionVerb::kScreenshot || (a.verb == ActionVerb::kRecord && a.words[0] != "stop") ||
+                        (a.verb == ActionVerb::kPreset && a.words[0] == "save");
+    if (output) {
+      return Error{options_.actions_path + ":" + std::to_string(a.line) + ": frame " + std::to_string(a.frame) + " never came: the session ended after " +
+                   std::to_string(ui_.frame) + " frames (a quit action, --frames or the window closed first), so this output was not written; " +
+                   std::to_string(unrun) + " of the script's actions did not run"};
+    }
+  }
+  std::fprintf(stderr, "note: %zu of %s's actions did not run (from line %d, frame %llu): the session ended after %llu frames\n", unrun,
+               options_.actions_path.c_str(), actions_[next_action_].line, static_cast<unsigned long long>(actions_[next_action_].frame),
+               static_cast<unsigned long long>(ui_.frame));
+  return Ok{};
 }
 
 ordered_json make_report(CoreSession& session, ConsoleUi& ui, const ConsoleOptions& options, double wall_s, int width, int height) {

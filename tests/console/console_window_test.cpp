@@ -555,6 +555,10 @@ TEST(ConsoleWindow, OutputsNeverReplaceDevicesInputsOrFailSilently) {
                  "is this session's recording");
   expect_refused("frame 1 record " + (dir / "second.rsrec").string() + "\n", " --record " + (dir / "main.rsrec").string(),
                  "a recording is running already");
+  // An output action past the session's end (G6): a failed session, as a --screenshot never taken.
+  expect_refused("frame 0 quit\nframe 5 screenshot " + (dir / "late.png").string() + "\n", "", "a.actions:2: frame 5 never came");
+  expect_refused("frame 50 record " + (dir / "late.rsrec").string() + "\n", "", "a.actions:1: frame 50 never came");
+  EXPECT_FALSE(std::filesystem::exists(dir / "late.png"));
   std::filesystem::create_directory(dir / "blocked.rsrec.partial");
   expect_refused("frame 1 record " + (dir / "blocked.rsrec").string() + "\n", "", "not a regular file");
   std::filesystem::copy_file(recorded, dir / "killed.rsrec.partial");
