@@ -5,8 +5,18 @@
 
 namespace resecto {
 
+namespace {
+
+// Whether the tick's own cost fits the rate run: then the misses were not the tick's doing, and a
+// slower rate is no cure (audit 8, G19: "ticks (p99 212 us) do not fit the 1042 us").
+bool ticks_fit(const RealtimeFigures& run) {
+  return run.tick_p99_us <= kAdviceTickShare * 1e6 / (run.collision_hz * static_cast<double>(run.substeps));
+}
+
+}  // namespace
+
 std::int64_t advised_substeps(const RealtimeFigures& run) {
-  if (!(run.miss_fraction > kAdviceMissFraction)) return 0;
+  if (!(run.miss_fraction > kAdviceMissFraction) || ticks_fit(run)) return 0;
   // A physics step costs the same at any rate, so the tick measured here is the tick a slower rate
   // would have; fewer substeps give each one a longer period.
   for (std::int64_t fewer = run.substeps / 2; fewer >= 1; fewer /= 2) {
@@ -18,6 +28,15 @@ std::int64_t advised_substeps(const RealtimeFigures& run) {
 std::string realtime_advice(const RealtimeFigures& run) {
   if (!(run.miss_fraction > kAdviceMissFraction)) return {};
   char text[512];
+  if (ticks_fit(run)) {
+    std::snprintf(text, sizeof text,
+                  "%.1f%% of the deadlines were missed, but the ticks themselves fit (p99 %.0f us of the %.0f us of %.0f Hz physics): "
+                  "the core was kept from running (other programs on the machine, a window opening, a session too short to settle), "
+                  "so no slower rate is advised",
+                  100.0 * run.miss_fraction, run.tick_p99_us, 1e6 / (run.collision_hz * static_cast<double>(run.substeps)),
+                  run.collision_hz * static_cast<double>(run.substeps));
+    return text;
+  }
   if (const std::int64_t fewer = advised_substeps(run); fewer > 0) {
     const double physics_hz = run.collision_hz * static_cast<double>(run.substeps);
     const double advised_hz = run.collision_hz * static_cast<double>(fewer);

@@ -30,14 +30,14 @@ struct RealtimeFigures {
 };
 
 /// The substeps realtime_advice() names: the fewest halvings of `run.substeps` at which the run's
-/// tick p99 fills at most kAdviceTickShare of the longer tick. 0 when the run kept its deadlines or
-/// not even one substep would fit.
+/// tick p99 fills at most kAdviceTickShare of the longer tick. 0 when the run kept its deadlines, when
+/// its tick p99 fits the rate it ran (the misses were not the tick's cost), or not even one substep would fit.
 std::int64_t advised_substeps(const RealtimeFigures& run);
 
 /// Empty for a run that kept its deadlines (misses at most kAdviceMissFraction). Otherwise a
-/// sentence: the fewest halvings of --substeps at which the run's tick p99 fills at most
-/// kAdviceTickShare of the longer tick, or, when not even one physics step per collision step
-/// would fit, a coarser gland.
+/// sentence: that the ticks fit the rate run (so nothing slower is advised), or the fewest halvings of
+/// --substeps at which the run's tick p99 fills at most kAdviceTickShare of the longer tick, or, when
+/// not even one physics step per collision step would fit, a coarser gland.
 std::string realtime_advice(const RealtimeFigures& run);
 
 /// The figures of a running simulation (its rates and gland) with its deadlines so far.

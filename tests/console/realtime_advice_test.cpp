@@ -40,6 +40,17 @@ TEST(RealtimeAdvice, NamesTheFewestHalvingsOfTheSubstepsThatFit) {
   EXPECT_NE(at_200.find("--substeps 2 (200 Hz"), std::string::npos) << at_200;
 }
 
+// Audit 8, G19: a short console session missed 2.9% with a tick p99 of 212 us and was told its ticks
+// "do not fit the 1042 us": misses whose ticks fit the rate are not the tick's cost.
+TEST(RealtimeAdvice, NoSlowerRateWhenTheTicksFitTheRateRun) {
+  const std::string advice = realtime_advice(figures_from_report(0.029, 212));
+  EXPECT_EQ(advised_substeps(figures_from_report(0.029, 212)), 0);
+  EXPECT_EQ(advice.find("--substeps"), std::string::npos) << advice;
+  EXPECT_NE(advice.find("the ticks themselves fit (p99 212 us of the 1042 us of 960 Hz physics)"), std::string::npos) << advice;
+  // 0.75 of 1042 us is 781: just past it, the halving is advised again.
+  EXPECT_EQ(advised_substeps(figures_from_report(0.029, 790)), 8);
+}
+
 TEST(RealtimeAdvice, ACoarserGlandWhenNoPhysicsRateFits) {
   const std::string advice = realtime_advice(figures_from_report(0.9, 20000));
   EXPECT_EQ(advice.find("--substeps"), std::string::npos) << advice;
