@@ -136,7 +136,8 @@ nlohmann::json summary_json(const MonitorOptions& o, const LinkCounters& c, cons
 }
 
 void check_probability(double p, const char* name) {
-  if (!(p >= 0.0 && p <= 1.0)) fail(std::string("--") + name + " must be a probability in [0, 1]");
+  // Options that cannot be run together: a command-line error, exit 2 (audit 8, G11).
+  if (!(p >= 0.0 && p <= 1.0)) refuse_command_line(std::string("--") + name + " must be a probability in [0, 1]");
 }
 
 void run_monitor(const MonitorOptions& o) {

@@ -7,6 +7,7 @@
 
 #include "rtcore/base/atomic_file.h"
 #include "rtcore/base/json_text.h"
+#include "rtcore/base/quoted_word.h"
 #include "rtcore/base/text_file.h"
 
 namespace resecto::gui {
@@ -34,7 +35,7 @@ Result<TissueParameters> load_preset(const std::filesystem::path& path, const Ti
   }
   for (const auto& [key, value] : preset.items()) {
     if (key != "resecto_preset" && key != "parameters") {
-      return Error{path.string() + ": unknown key '" + key + "' (a preset holds \"resecto_preset\" and \"parameters\")"};
+      return Error{path.string() + ": unknown key " + quoted_word(key) + " (a preset holds \"resecto_preset\" and \"parameters\")"};
     }
   }
   if (!preset.contains("parameters") || !preset["parameters"].is_object()) {
@@ -43,8 +44,9 @@ Result<TissueParameters> load_preset(const std::filesystem::path& path, const Ti
   TissueParameters result = base;
   for (const auto& [key, value] : preset["parameters"].items()) {
     const std::optional<TissueParameter> id = find_tissue_parameter(key);
-    if (!id) return Error{path.string() + ": unknown parameter '" + key + "' (see resecto params)"};
-    if (!value.is_number()) return Error{path.string() + ": parameter '" + key + "' must be a number"};
+    // Quoted: a key holding a NUL cut the message short, an escape sequence reached the terminal (audit 8, G13).
+    if (!id) return Error{path.string() + ": unknown parameter " + quoted_word(key) + " (see resecto params)"};
+    if (!value.is_number()) return Error{path.string() + ": parameter " + quoted_word(key) + " must be a number"};
     if (Status set = result.set(*id, value.get<double>()); !set) return Error{path.string() + ": " + set.error()};
   }
   return result;

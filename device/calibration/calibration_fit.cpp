@@ -103,10 +103,19 @@ Result<SheathFit> fit_sheath(const std::vector<SheathSample>& samples, const std
     sxy += (s.potentiometer_counts - mean_x) * (s.position_mm - mean_y);
   }
   if (sxx <= 1e-12) return Error{source + ": every sheath measurement has the same potentiometer reading; cannot fit a slope"};
+  // Checked before the gain: rows at one position fit a gain of 0, which the gain's message called
+  // "outside +-0.5 mm/count" (audit 8, G12).
+  const auto [lowest, highest] = std::minmax_element(samples.begin(), samples.end(),
+                                                     [](const SheathSample& a, const SheathSample& b) { return a.position_mm < b.position_mm; });
+  if (highest->position_mm <= lowest->position_mm) {
+    return Error{source + ": every sheath measurement is at the same position (" + mm(lowest->position_mm) +
+                 " mm): measure across the sheath's travel"};
+  }
   SheathFit fit;
   fit.gain_mm_per_count = sxy / sxx;
   fit.offset_mm = mean_y - fit.gain_mm_per_count * mean_x;
-  if (std::abs(fit.gain_mm_per_count) * 1e6 > LP3500_SHEATH_GAIN_LIMIT_NM || fit.gain_mm_per_count == 0.0) {
+  if (fit.gain_mm_per_count == 0.0) return Error{source + ": fitted gain 0 mm/count: the potentiometer readings do not follow the positions"};
+  if (std::abs(fit.gain_mm_per_count) * 1e6 > LP3500_SHEATH_GAIN_LIMIT_NM) {
     return Error{source + ": fitted gain " + mm(fit.gain_mm_per_count) + " mm/count is outside the board's +-0.5 mm/count"};
   }
   fit.min_mm = samples.front().position_mm;
@@ -117,7 +126,6 @@ Result<SheathFit> fit_sheath(const std::vector<SheathSample>& samples, const std
     const double fitted = fit.gain_mm_per_count * s.potentiometer_counts + fit.offset_mm;
     fit.residuals.push_back({s.line, s.position_mm, fitted - s.position_mm});
   }
-  if (fit.max_mm <= fit.min_mm) return Error{source + ": every sheath measurement is at the same position"};
   summarise(fit);
   // A gain fitted over a short stretch of the travel multiplies its errors out to the ends (two rows 1
   // mm apart gave a table of 10-11 mm); a caliper reads to a tenth of a millimetre and the

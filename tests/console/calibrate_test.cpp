@@ -98,6 +98,12 @@ TEST(CalibrateCommand, NamesBadInputs) {
   EXPECT_NE(none.exit_code, 0);
   EXPECT_NE(none.err.find("--sheath"), std::string::npos) << none.err;
   EXPECT_EQ(run_resecto("device calibrate --help").exit_code, 0);
+  // Rows at one position (different readings): the coverage is what is wrong, not a gain of 0
+  // "outside +-0.5 mm/count" (audit 8, G12).
+  write_text(dir / "one_place.csv", "position_mm,potentiometer_counts\n10,3700\n10,3600\n10,3500\n");
+  const auto one_place = run_resecto("device calibrate --sheath " + (dir / "one_place.csv").string() + " -o " + (dir / "x.json").string());
+  EXPECT_EQ(one_place.exit_code, 1);
+  EXPECT_NE(one_place.err.find("every sheath measurement is at the same position (10.000 mm)"), std::string::npos) << one_place.err;
 }
 
 }  // namespace

@@ -124,6 +124,9 @@ TEST(TissuePresets, RoundTripAndClearErrors) {
 
   const std::pair<const char*, const char*> bad[] = {
       {R"({"resecto_preset": 1, "parameters": {"hardness": 3}})", "unknown parameter 'hardness'"},
+      // A NUL or escape in a key is written out, not sent raw (audit 8, G13).
+      {R"({"resecto_preset": 1, "parameters": {"stiff\u0000ness": 3}})", "unknown parameter 'stiff\\x00ness' (see resecto params)"},
+      {R"({"resecto_preset": 1, "parameters": {"\u001b[2J": 3}})", "unknown parameter '\\x1b[2J'"},
       {R"({"resecto_preset": 1, "parameters": {"stiffness": 9000}})", "out of range"},
       {R"({"resecto_preset": 1, "parameters": {"stiffness": "hard"}})", "must be a number"},
       {R"({"parameters": {}})", "not a Resecto preset"},

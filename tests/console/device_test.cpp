@@ -92,7 +92,7 @@ TEST(DeviceCommand, BadArgumentsFailWithAReason) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("--drop"), std::string::npos) << r.err;
   r = run_resecto("device monitor --device emulator --seconds 0.1 --drop 0.6 --corrupt 0.6");
-  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(r.exit_code, 2) << "options that cannot be run together: a command-line error";
   EXPECT_NE(r.err.find("probability"), std::string::npos) << r.err;
   r = run_resecto("device monitor --device emulator --seconds 0.1 --calibration /nonexistent/cal.json");
   EXPECT_NE(r.exit_code, 0);
