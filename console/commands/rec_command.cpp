@@ -77,13 +77,18 @@ void info(const InfoOptions& o) {
     missing.push_back({first, last});
     missing_text += (missing_text.empty() ? "; missing " : ", ") + std::to_string(first) + (last > first ? "-" + std::to_string(last) : "");
   }
+  // A recording started mid-session replays nothing: re-simulation needs the session from tick 0
+  // (it said "1370 replayable" of a file replay and score refuse, audit 8, G15).
+  const bool mid_session = h.start_tick != 0;
+  const std::uint64_t replayable = mid_session ? 0 : r.replayable_ticks();
   ordered_json out = {{"file", o.file},
                       {"build", h.build},
                       {"procedure", h.procedure},
                       {"mode", h.mode},
                       {"duration_s", r.duration_s()},
                       {"ticks", r.ticks().size()},
-                      {"replayable_ticks", r.replayable_ticks()},
+                      {"start_tick", h.start_tick},
+                      {"replayable_ticks", replayable},
                       {"collision_steps", r.steps().size()},
                       {"commands", r.commands().size()},
                       {"keyframes", r.keyframes().size()},
@@ -102,8 +107,10 @@ void info(const InfoOptions& o) {
   }
   std::printf("%s: %s recording of '%s' by %s\n", o.file.c_str(), h.mode.c_str(), h.procedure.c_str(), h.build.c_str());
   std::printf("  duration   %.2f s, %zu ticks (%llu replayable%s), %zu collision steps, %zu commands\n", r.duration_s(), r.ticks().size(),
-              static_cast<unsigned long long>(r.replayable_ticks()),
-              r.missing_ticks() > 0 ? ("; " + std::to_string(r.missing_ticks()) + " missing in a gap a recovery left").c_str() : "",
+              static_cast<unsigned long long>(replayable),
+              mid_session           ? ("; recorded from mid-session, from tick " + std::to_string(h.start_tick)).c_str()
+              : r.missing_ticks() > 0 ? ("; " + std::to_string(r.missing_ticks()) + " missing in a gap a recovery left").c_str()
+                                      : "",
               r.steps().size(), r.commands().size());
   std::printf("  keyframes  %zu (%.1f Hz%s), grid %d bits over %.1f mm\n", r.keyframes().size(), keyframe_hz, missing_text.c_str(),
               h.grid.bits, static_cast<double>(h.grid.range) * 1e3);
@@ -199,6 +206,12 @@ void verify(const std::string& file) {
         "%s`rec recover` made it from a damaged recording that was never closed (%llu damaged ranges left out): how much of the "
         "procedure those held is unknown\n",
         sound.c_str(), static_cast<unsigned long long>(r.recovered_damaged_ranges()));
+    return;
+  }
+  if (start != 0) {
+    std::printf("%sit starts at tick %llu (recorded from mid-session): no tick can be re-simulated (replay and score need the session "
+                "from tick 0); its keyframes can be browsed and exported\n",
+                sound.c_str(), static_cast<unsigned long long>(start));
     return;
   }
   std::printf("%s: ok, %zu chunks, every CRC matches, every keyframe decodes, index present; all %zu recorded ticks replay\n", file.c_str(),

@@ -472,6 +472,24 @@ TEST(ConsoleWindow, CtrlCMarksTheReportAndTheRecordingInterrupted) {
   EXPECT_NE(info.out.find("interrupted by SIGINT"), std::string::npos) << info.out;
 }
 
+// Audit 8, G15: a recording started mid-session verified "ok ... all 1370 recorded ticks replay" and
+// showed 1370 replayable in `rec info`, while replay and score refuse it.
+TEST(ConsoleWindow, AMidSessionRecordingIsSoundButNotReplayable) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_mid_session");
+  const auto recording = dir / "mid.rsrec";
+  std::ofstream(dir / "m.actions") << "frame 5 record " << recording.string() << "\nframe 25 record stop\nframe 26 quit\n";
+  const CommandOutput made = run_in_xvfb("console --triangles 1296 --width 800 --height 600 --actions " + (dir / "m.actions").string(), dir);
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  const CommandOutput verify = run_resecto("rec verify " + recording.string());
+  EXPECT_EQ(verify.exit_code, 0) << verify.err;
+  EXPECT_EQ(verify.out.find(": ok,"), std::string::npos) << verify.out;
+  EXPECT_NE(verify.out.find("(recorded from mid-session): no tick can be re-simulated"), std::string::npos) << verify.out;
+  const CommandOutput info = run_resecto("rec info " + recording.string());
+  EXPECT_NE(info.out.find("(0 replayable; recorded from mid-session, from tick "), std::string::npos) << info.out;
+  EXPECT_EQ(run_resecto("replay " + recording.string() + " --verify").exit_code, 1);
+}
+
 TEST(ConsoleWindow, BadActionsAreClearErrors) {
   REQUIRE_X_SERVER();
   const auto dir = scratch_directory("console_errors");
