@@ -148,7 +148,13 @@ void CoreSession::run_core() {
 void CoreSession::start_recording(const std::string& path) {
   if (recorder_) return;
   rec::SessionHeader description;
-  description.procedure = options_.device.procedure.name;
+  // What drove the tool: the procedure only when the board followed it; a person's hands otherwise, or
+  // a cohort's CSV could not tell a trainee's session from the scripted demo (audit 8, G14).
+  switch (options_.device.source) {
+    case DeviceSource::kEmulatorScript: description.procedure = options_.device.procedure.name; break;
+    case DeviceSource::kEmulatorManual: description.procedure = "hand-driven (keyboard, mouse or gamepad)"; break;
+    case DeviceSource::kHid: description.procedure = "hand-driven (LP3500 over USB HID)"; break;
+  }
   description.mode = "console";
   description.seed = options_.device.seed;
   description.calibration = nlohmann::ordered_json::parse(device::calibration_to_json(options_.device.calibration));

@@ -430,9 +430,13 @@ TEST(ConsoleWindow, HeldKeyAndReplayPlayAdvanceAtTheirRates) {
   };
   std::ofstream(dir / "w.actions") << "frame 1 key W down\nframe " << kFrames << " quit\n";
   const CommandOutput held = run_in_xvfb("console --device keyboard --insertion-mm 100 --triangles 1296 --width 800 --height 600 --actions " +
-                                             (dir / "w.actions").string() + " --report " + (dir / "w.json").string(),
+                                             (dir / "w.actions").string() + " --report " + (dir / "w.json").string() + " --record " +
+                                             (dir / "w.rsrec").string(),
                                          dir);
   ASSERT_EQ(held.exit_code, 0) << held.err;
+  // Recorded as what drove it, not as the demo procedure the session never followed (audit 8, G14).
+  const CommandOutput info = run_resecto("rec info " + (dir / "w.rsrec").string());
+  EXPECT_NE(info.out.find("console recording of 'hand-driven (keyboard, mouse or gamepad)'"), std::string::npos) << info.out;
   const nlohmann::json w = load_json(dir / "w.json");
   const double moved_mm = w.at("metrics").at("max_insertion_mm").get<double>() - 100.0;
   const double expected_mm = std::min(130.0, ManualMotionLimits{}.insertion_rate_mm_s * seconds_of_frames(w));
