@@ -6,8 +6,12 @@
 #include <cmath>
 #include <string_view>
 
+#include "console/gui/replay_browser.h"
+#include "console/live/core_session.h"
+#include "device/input/manual_motion.h"
 #include "rtcore/base/checked_number.h"
 #include "rtcore/base/text_file.h"
+#include "rtcore/base/units.h"
 #include "rtcore/tissue/tissue_parameters.h"
 
 namespace resecto::gui {
@@ -72,11 +76,29 @@ Status check_set_action(const std::string& key, double value) {
     return check.set(*id, value);
   }
   if (key == "speed") {
-    if (!(value > 0.0 && value <= 1.0)) return Error{"speed " + exact_number(value) + " is outside (0, 1]"};
+    // The core's own range: a slower value was clamped to it without a word (audit 8, G9).
+    if (!(value >= kSlowestCoreSpeed && value <= 1.0)) return Error{"speed " + exact_number(value) + " is outside [1/64, 1] (of real time)"};
     return Ok{};
   }
   if (!is_joint_key(key)) return Error{"unknown key '" + key + "': a tissue parameter (resecto params), yaw, pitch, roll, insertion, loop or speed"};
+  // The hand-driven device's travel, as its keys and sliders keep it (a value past it was clamped
+  // without a word, audit 8, G9); the sheath turns freely, so any roll is one.
+  const ManualMotionLimits travel;
+  const auto within = [&](double low, double high, const char* unit) -> Status {
+    if (value >= low && value <= high) return Ok{};
+    return Error{key + " " + exact_number(value) + " is outside the device's travel [" + exact_number(low) + ", " + exact_number(high) + "] " + unit};
+  };
+  if (key == "yaw") return within(-units::rad_to_deg(travel.yaw_range_rad), units::rad_to_deg(travel.yaw_range_rad), "degrees");
+  if (key == "pitch") return within(-units::rad_to_deg(travel.pitch_range_rad), units::rad_to_deg(travel.pitch_range_rad), "degrees");
+  if (key == "insertion") return within(0.0, travel.insertion_max_mm, "mm");
+  if (key == "loop") return within(0.0, travel.loop_max_mm, "mm");
   return Ok{};
+}
+
+Status check_replay_speed(double speed) {
+  if (speed >= ReplayBrowser::kMinSpeed && speed <= ReplayBrowser::kMaxSpeed) return Ok{};
+  return Error{"replay speed " + exact_number(speed) + " is outside [" + exact_number(ReplayBrowser::kMinSpeed) + ", " +
+               exact_number(ReplayBrowser::kMaxSpeed) + "], the replay panel's range"};
 }
 
 Status check_actions_for_device(const std::vector<Action>& actions, bool manual_device, const std::string& source_name) {
@@ -171,6 +193,9 @@ Result<std::vector<Action>> parse_actions(const std::string& text, const std::st
         if (!takes_argument && !plain) return Error{where + "replay: unknown operation '" + op + "' (open, play, pause, step, seek, speed, verify)"};
         if (takes_argument != (a.words.size() == 2)) return Error{where + "replay " + op + (takes_argument ? " needs one argument" : " takes no argument")};
         if ((op == "seek" || op == "speed") && !parse_number(a.words[1], a.value)) return Error{at(4) + "replay " + op + ": '" + a.words[1] + "' is not a number"};
+        if (op == "speed") {
+          if (Status valid = check_replay_speed(a.value); !valid) return Error{at(4) + valid.error()};
+        }
         break;
       }
       default: break;

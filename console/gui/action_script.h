@@ -50,6 +50,8 @@ bool is_joint_key(const std::string& key);
 /// `set KEY VALUE` checked without a session: KEY known, VALUE in its range (a joint's travel is
 /// clamped by the device's limits, as the keys' is).
 Status check_set_action(const std::string& key, double value);
+/// `replay speed X`'s range, the replay panel's slider's.
+Status check_replay_speed(double speed);
 /// Whether the action drives the hand-driven device (pedals, keys, the endoscope drag, a joint).
 bool action_needs_manual_device(const Action& action);
 /// An error naming the first action that needs the hand-driven device when the session has none,

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "console/gui/action_script.h"
 #include "console/gui/tissue_presets.h"
 #include "rtcore/base/atomic_file.h"
 #include "rtcore/base/checked_number.h"
@@ -53,7 +54,7 @@ Status ConsoleController::set_by_key(const std::string& key, double value) {
     return Ok{};
   }
   if (key == "speed") {
-    if (!(value > 0.0 && value <= 1.0)) return Error{"speed " + exact_number(value) + " is outside (0, 1]"};
+    if (Status valid = check_set_action(key, value); !valid) return valid;
     set_speed(value);
     return Ok{};
   }
@@ -158,7 +159,7 @@ Status ConsoleController::replay_operation(const std::string& op, double argumen
   else if (op == "step") r.step();
   else if (op == "seek") r.seek(argument);
   else if (op == "speed") {
-    if (!(argument > 0.0 && argument <= 16.0)) return Error{"replay speed " + exact_number(argument) + " is outside (0, 16]"};
+    if (Status valid = check_replay_speed(argument); !valid) return valid;
     r.set_speed(argument);
   } else if (op == "verify") r.start_verification();
   else return Error{"replay: unknown operation '" + op + "'"};

@@ -313,7 +313,10 @@ void draw_replay_panel(ConsoleController& console) {
   ImGui::SameLine();
   float speed = static_cast<float>(replay.speed());
   ImGui::SetNextItemWidth(100);
-  if (ImGui::SliderFloat("speed##replay", &speed, 0.1f, 4.0f, "%.2fx", ImGuiSliderFlags_Logarithmic)) replay.set_speed(speed);
+  if (ImGui::SliderFloat("speed##replay", &speed, static_cast<float>(ReplayBrowser::kMinSpeed), static_cast<float>(ReplayBrowser::kMaxSpeed),
+                         "%.2fx", ImGuiSliderFlags_Logarithmic)) {
+    replay.set_speed(speed);
+  }
   ImGui::SameLine();
   ImGui::BeginDisabled(replay.verifying());
   if (ImGui::Button(replay.verifying() ? "Verifying..." : "Verify")) replay.start_verification();

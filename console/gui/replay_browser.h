@@ -47,6 +47,10 @@ class ReplayBrowser {
   bool playing() const { return playing_; }
   /// To the next keyframe (pauses).
   void step();
+  /// Playback speeds the panel's slider and the `replay speed` action take (one range for both: the
+  /// action took up to 16x, the slider 4x, audit 8, G9).
+  static constexpr double kMinSpeed = 0.1;
+  static constexpr double kMaxSpeed = 4.0;
   void set_speed(double speed) { speed_ = speed; }
   double speed() const { return speed_; }
   /// Scrubs to `time_s` (clamped to the recording).

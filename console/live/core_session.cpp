@@ -218,7 +218,7 @@ void CoreSession::take_controls() {
       case CoreControlKind::kStep:
         if (status_.paused) status_.pending_steps += control.steps;
         break;
-      case CoreControlKind::kSpeed: status_.speed = std::clamp(control.speed, 1.0 / 64.0, 1.0); break;
+      case CoreControlKind::kSpeed: status_.speed = std::clamp(control.speed, kSlowestCoreSpeed, 1.0); break;
       case CoreControlKind::kRecordStart: start_recording(control.path); break;
       case CoreControlKind::kRecordStop: finish_recording(); break;
     }

@@ -104,6 +104,9 @@ struct LiveFrame {
   CoreStatus status;
 };
 
+/// The core's slowest speed (a fraction of real time); its fastest is real time.
+inline constexpr double kSlowestCoreSpeed = 1.0 / 64.0;
+
 class CoreSession {
  public:
   /// Builds the simulation and the device; starts nothing.
