@@ -368,10 +368,19 @@ std::string summarize_report(const ordered_json& r) {
   // Only the JSON said so (audit 32, F11): a procedure that moves the tool further between two contact
   // searches than their margin covers may pass through tissue without a contact being found.
   if (const auto outran = m.at("contact_margin_exceeded_ticks").get<std::uint64_t>(); outran > 0) {
+    // In real time, reports that come late or are lost make the tool jump as a fast hand would; the
+    // procedure is then not the only suspect (audit 8, G10: a --spin-us that starved the link thread
+    // lost 267 reports, and the warning blamed the procedure, which in batch stays within the margin).
+    const std::string cause =
+        r.at("mode") == "realtime"
+            ? "the procedure moves faster than a hand can, or the device's reports came late or were lost (" +
+                  std::to_string(r.at("device").at("lost").get<std::uint64_t>()) +
+                  " lost: a core that starves the link thread, a long --spin-us or a loaded machine; the same procedure in batch tells which)"
+            : std::string("the procedure moves faster than a hand can");
     std::snprintf(text, sizeof text,
                   "  warning    on %llu ticks the tool had moved past the contact search's margin since the last search (up to %.2f mm): "
-                  "contacts there may have been missed; the procedure moves faster than a hand can\n",
-                  static_cast<unsigned long long>(outran), m.at("max_tool_travel_since_search_mm").get<double>());
+                  "contacts there may have been missed; %s\n",
+                  static_cast<unsigned long long>(outran), m.at("max_tool_travel_since_search_mm").get<double>(), cause.c_str());
     summary += text;
   }
   if (r.contains("recording")) {
