@@ -217,6 +217,15 @@ Result<HallFit> fit_hall_table(const std::vector<HallSample>& samples, const std
     fit.residuals.push_back({s.line, s.position_mm, fitted_mm - s.position_mm});
   }
   summarise(fit);
+  // Repeats at one position 2000 counts apart made a table missing its own rows by 10 mm, written with
+  // exit 0 (audit 8, G16); the sheath's fit refuses such rows too.
+  const auto worst = std::max_element(fit.residuals.begin(), fit.residuals.end(),
+                                      [](const Residual& a, const Residual& b) { return std::abs(a.residual_mm) < std::abs(b.residual_mm); });
+  if (worst != fit.residuals.end() && std::abs(worst->residual_mm) > kMaxHallResidualMm) {
+    return Error{source + ":" + std::to_string(worst->line) + ": the table through the rows (repeats averaged) misses this one (" +
+                 mm(worst->position_mm) + " mm) by " + mm(std::abs(worst->residual_mm)) + " mm, more than " + mm(kMaxHallResidualMm) +
+                 ": rows repeated at one position disagree; check them and measure again"};
+  }
   return fit;
 }
 

@@ -70,6 +70,9 @@ Result<SheathFit> fit_sheath(const std::vector<SheathSample>& samples, const std
 
 /// How far the table may be extrapolated past the measured range at either end.
 inline constexpr double kHallExtrapolationLimitMm = 1.0;
+/// The most a measured row may be off the table: only rows repeated at one position can be (the table
+/// runs through their mean), and two that far apart are a misread, not the sensor's noise.
+inline constexpr double kMaxHallResidualMm = 1.0;
 
 /// The Hall table at 0, 0.5, ..., 36.5 mm. Refuses measurements whose Hall sums are not strictly
 /// monotone in position, that cover too little of the travel, or whose table would round flat.

@@ -191,6 +191,16 @@ TEST(CalibrationFit, HallTableRefusesNonMonotoneShortOrFlatData) {
   const auto flat = fit_hall_table(sweep(0, 36, 1.0), "h.csv");  // 0.5 count per 0.5 mm: rounds flat
   ASSERT_FALSE(flat.ok());
   EXPECT_NE(flat.error().find("too flat"), std::string::npos) << flat.error();
+  // Repeats at one position that disagree by far more than the sensor's noise (audit 8, G16): refused,
+  // naming a row; repeats that agree within a count are averaged as before.
+  auto disagreeing = sweep(0, 36, 20.0);
+  disagreeing.push_back({10.0, 3000.0 + 20.0 * 10.0 + 30.0, 100});  // reads 1.5 mm off
+  const auto misread = fit_hall_table(disagreeing, "h.csv");
+  ASSERT_FALSE(misread.ok());
+  EXPECT_NE(misread.error().find("rows repeated at one position disagree"), std::string::npos) << misread.error();
+  auto agreeing = sweep(0, 36, 20.0);
+  agreeing.push_back({10.0, 3000.0 + 20.0 * 10.0 + 1.0, 100});
+  EXPECT_TRUE(fit_hall_table(agreeing, "h.csv").ok());
 }
 
 // The laboratory procedure on the emulated device: park the loop at caliper positions, average the
