@@ -45,12 +45,14 @@ TEST(LoopHelper, TheHelperTakesChunksFromTheOtherEnd) {
   // With the helper on call and a loop long enough for it to arrive, it runs some chunks, and they
   // are the loop's last ones: the owner's share is a prefix, the helper's the rest.
   LoopHelper helper;
-  helper.call_in();
   const std::thread::id owner = std::this_thread::get_id();
   std::vector<int> by_owner(256, -1);
   std::vector<std::uint64_t> sink(256, 0);
   bool helped = false;
   for (int attempt = 0; attempt < 1000 && !helped; ++attempt) {
+    // Called in for every loop, as the core does each step: an owner descheduled for over kIdleOnCall
+    // between loops (ctest -j2 on a loaded machine) had let the helper go home for every later attempt.
+    helper.call_in();
     auto body = [&](std::uint32_t chunk) {
       by_owner[chunk] = std::this_thread::get_id() == owner ? 1 : 0;
       std::uint64_t work = chunk;
