@@ -46,11 +46,7 @@ void score(const ScoreOptions& o) {
   // two pages of one debrief. A comparison of a recording with itself stays as asked.
   std::vector<std::string> files;
   for (const std::string& file : comparing ? o.compare : o.files) {
-    const auto same = [&](const std::string& other) {
-      std::error_code error;
-      return std::filesystem::absolute(other).lexically_normal() == std::filesystem::absolute(file).lexically_normal() ||
-             (std::filesystem::equivalent(other, file, error) && !error);
-    };
+    const auto same = [&](const std::string& other) { return names_one_file(other, file); };
     if (!comparing && std::any_of(files.begin(), files.end(), same)) {
       std::fprintf(stderr, "note: %s is given more than once; scored once\n", file.c_str());
       continue;

@@ -5,9 +5,9 @@
 
 #include "console/gui/action_script.h"
 #include "console/gui/tissue_presets.h"
+#include "recordings/recording_writer.h"
 #include "rtcore/base/atomic_file.h"
 #include "rtcore/base/checked_number.h"
-#include "recordings/recording_writer.h"
 #include "rtcore/base/units.h"
 
 namespace resecto::gui {
@@ -85,12 +85,6 @@ const char* output_kind_name(OutputKind kind) {
   return "output";
 }
 
-bool same_output(const std::filesystem::path& a, const std::filesystem::path& b) {
-  std::error_code error;
-  if (std::filesystem::absolute(a, error).lexically_normal() == std::filesystem::absolute(b, error).lexically_normal()) return true;
-  return std::filesystem::equivalent(a, b, error) && !error;
-}
-
 }  // namespace
 
 Status ConsoleController::check_output(const std::string& path, OutputKind kind) const {
@@ -100,7 +94,7 @@ Status ConsoleController::check_output(const std::string& path, OutputKind kind)
   for (const auto& [claimed, claimed_kind] : claimed_) {
     // A screenshot or preset may be taken again over its own file; a recording is never replaced by
     // this session's next one.
-    if ((claimed_kind != kind || kind == OutputKind::kRecording) && same_output(claimed, path)) {
+    if ((claimed_kind != kind || kind == OutputKind::kRecording) && names_one_file(claimed, path)) {
       return Error{path + ": is this session's " + output_kind_name(claimed_kind) + " (" + claimed.string() + "); writing the " +
                    output_kind_name(kind) + " there would lose it (give another path)"};
     }

@@ -232,14 +232,20 @@ Status check_output_path(const std::filesystem::path& output, std::span<const st
   return check_writable_folder(resolved->parent_path().empty() ? std::filesystem::path(".") : resolved->parent_path(), output);
 }
 
+bool names_one_file(const std::filesystem::path& a, const std::filesystem::path& b) {
+  std::error_code error;
+  const std::filesystem::path absolute_a = std::filesystem::absolute(a, error);
+  if (!error && absolute_a.lexically_normal() == std::filesystem::absolute(b, error).lexically_normal() && !error) return true;
+  return same_file(a, b);
+}
+
 Status check_output_paths(std::span<const std::filesystem::path> outputs, std::span<const std::filesystem::path> inputs) {
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     if (outputs[i].empty()) continue;
     if (Status ok = check_output_path(outputs[i], inputs); !ok) return ok;
     for (std::size_t j = 0; j < i; ++j) {
       // Two outputs on one path: compared as written and, when the file exists, as files.
-      if (!outputs[j].empty() && (std::filesystem::absolute(outputs[j]).lexically_normal() == std::filesystem::absolute(outputs[i]).lexically_normal() ||
-                                  same_file(outputs[j], outputs[i]))) {
+      if (!outputs[j].empty() && names_one_file(outputs[j], outputs[i])) {
         return Error{outputs[i].string() + ": given for two outputs; the second would replace the first"};
       }
     }

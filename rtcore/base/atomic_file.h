@@ -65,6 +65,9 @@ Status check_output_path(const std::filesystem::path& output, std::span<const st
 /// a file in its place (the error says `what` the folder is for), or a nearest existing folder this
 /// process cannot write in, is an error.
 Status check_output_folder(const std::filesystem::path& output, const std::string& what);
+/// Whether two paths name one file: the same as written (made absolute and normal, so a file not yet
+/// made counts), or one existing file (hard links, symbolic links and `..` included).
+bool names_one_file(const std::filesystem::path& a, const std::filesystem::path& b);
 /// The same for several outputs of one command, which must also differ from each other (the last
 /// written would replace the others). Empty paths are outputs not asked for and are skipped.
 Status check_output_paths(std::span<const std::filesystem::path> outputs, std::span<const std::filesystem::path> inputs = {});
