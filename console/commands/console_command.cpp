@@ -14,6 +14,7 @@
 #include "console/commands/parameter_options.h"
 #include "console/gui/console_app.h"
 #include "console/gui/tissue_presets.h"
+#include "console/headless/lockstep_device.h"
 #include "console/live/interrupt.h"
 #include "recordings/recording_writer.h"
 #include "rtcore/base/atomic_file.h"
@@ -86,10 +87,13 @@ void open_console(const ConsoleCliOptions& o) {
   Result<Procedure> procedure = find_procedure(o.procedure);
   if (!procedure) throw std::runtime_error(procedure.error());
   if (const std::optional<std::string> note = shadowed_file_note(o.procedure)) std::fprintf(stderr, "%s\n", note->c_str());
-  options.core.device.procedure = std::move(*procedure);
   options.core.device.source = o.device == "keyboard" ? DeviceSource::kEmulatorManual
                                : o.device == "hid"    ? DeviceSource::kHid
                                                       : DeviceSource::kEmulatorScript;
+  if (options.core.device.source == DeviceSource::kEmulatorScript) {
+    if (Status followed = check_encoder_speeds(*procedure); !followed) throw std::runtime_error(followed.error());
+  }
+  options.core.device.procedure = std::move(*procedure);
   options.core.device.manual_start.insertion_mm = o.start_insertion_mm;
   options.core.device.seed = o.seed;
   if (!o.calibration.empty()) {

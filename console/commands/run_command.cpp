@@ -17,6 +17,7 @@
 #include "console/commands/console_command.h"
 #include "console/commands/parameter_options.h"
 #include "console/headless/headless_run.h"
+#include "console/headless/lockstep_device.h"
 #include "console/live/interrupt.h"
 #include "recordings/recording_writer.h"
 #include "rtcore/base/atomic_file.h"
@@ -73,6 +74,7 @@ void run(const RunOptions& o) {
   Result<Procedure> procedure = find_procedure(o.procedure);
   if (!procedure) throw std::runtime_error(procedure.error());
   if (const std::optional<std::string> note = shadowed_file_note(o.procedure)) std::fprintf(stderr, "%s\n", note->c_str());
+  if (Status followed = check_encoder_speeds(*procedure); !followed) throw std::runtime_error(followed.error());
   options.procedure = std::move(*procedure);
   options.seconds = o.seconds;
   options.realtime = o.realtime;

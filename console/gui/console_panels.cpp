@@ -135,6 +135,10 @@ void draw_device_panel(ConsoleController& console) {
       row("reports / lost", "%" PRIu64 " / %" PRIu64, c.reports, c.lost);
       row("rejected / dup.", "%" PRIu64 " / %" PRIu64, c.rejected, c.duplicates);
       row("latency", "median %.0f us, p99 %.0f us", c.latency_median_us, c.latency_p99_us);
+      // A flagged encoder has lost counts: its angle below is off from then on.
+      const BoardFlagCounts& f = c.board_flags;
+      row("encoder faults", "yaw %" PRIu64 ", pitch %" PRIu64 ", roll %" PRIu64, f.illegal_transitions[0], f.illegal_transitions[1],
+          f.illegal_transitions[2]);
     } else {
       row("connection", "lockstep (stepped with the core)");
       row("reports / lost", "%" PRIu64 " / %" PRIu64, s.lockstep_reports, s.lockstep_lost);

@@ -19,6 +19,7 @@
 #include "device/calibration/calibration.h"
 #include "device/link/tool_input.h"
 #include "recordings/recorder.h"
+#include "resecto/lp3500_board.h"
 #include "rtcore/concurrency/spsc_ring.h"
 #include "rtcore/concurrency/triple_buffer.h"
 #include "rtcore/core/fixed_step_scheduler.h"
@@ -69,6 +70,15 @@ class SnapshotConsumer {
 ordered_json stage_json(const StageStatistics& s) {
   return {{"median_us", s.median_us}, {"p95_us", s.p95_us}, {"p99_us", s.p99_us}, {"max_us", s.max_us},
           {"budget_us", s.budget_us}, {"samples", s.samples}, {"over_budget", s.over_budget}};
+}
+
+ordered_json board_flags_json(const BoardFlagCounts& f) {
+  return {{"illegal_transitions", {{"yaw", f.illegal_transitions[0]}, {"pitch", f.illegal_transitions[1]}, {"roll", f.illegal_transitions[2]}}},
+          {"sheath_clamped", f.sheath_clamped},
+          {"loop_clamped", f.loop_clamped},
+          {"stalls", f.stalls},
+          {"overruns", f.overruns},
+          {"no_adc_sample", f.no_adc_sample}};
 }
 
 }  // namespace
@@ -290,12 +300,14 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
     const LockstepCounters& c = lockstep->counters();
     r["device"] = {{"transport", "emulator (lockstep)"}, {"reports", c.reports}, {"accepted", c.accepted}, {"lost", c.lost},
                    {"duplicates", c.duplicates}, {"rejected", c.rejected},
-                   {"rate_hz", r["simulated_s"].get<double>() > 0 ? static_cast<double>(c.accepted) / r["simulated_s"].get<double>() : 0.0}};
+                   {"rate_hz", r["simulated_s"].get<double>() > 0 ? static_cast<double>(c.accepted) / r["simulated_s"].get<double>() : 0.0},
+                   {"board_flags", board_flags_json(c.board_flags)}};
   } else {
     const LinkCounters c = live->link().counters();
     r["device"] = {{"transport", "emulator (link thread)"}, {"reports", c.reports}, {"accepted", c.accepted}, {"lost", c.lost},
                    {"duplicates", c.duplicates}, {"rejected", c.rejected}, {"rate_hz", c.rate_hz},
-                   {"latency_us", {{"median", c.latency_median_us}, {"p99", c.latency_p99_us}}}};
+                   {"latency_us", {{"median", c.latency_median_us}, {"p99", c.latency_p99_us}}},
+                   {"board_flags", board_flags_json(c.board_flags)}};
     r["input_to_snapshot_us"] = {{"median", input_to_snapshot_us.quantile(0.5)}, {"p99", input_to_snapshot_us.quantile(0.99)},
                                  {"max", input_to_snapshot_us.max()}};
   }
@@ -382,6 +394,23 @@ std::string summarize_report(const ordered_json& r) {
                   "contacts there may have been missed; %s\n",
                   static_cast<unsigned long long>(outran), m.at("max_tool_travel_since_search_mm").get<double>(), cause.c_str());
     summary += text;
+  }
+  // A flagged encoder lost counts: its angle is off from there on, though every report passed its CRC.
+  if (r.at("device").contains("board_flags")) {
+    for (const auto& [encoder, reports] : r.at("device").at("board_flags").at("illegal_transitions").items()) {
+      if (reports.get<std::uint64_t>() == 0) continue;
+      std::snprintf(text, sizeof text,
+                    "  warning    the %s encoder flagged an illegal transition in %llu reports: the joint turned faster than the board "
+                    "decodes (%u counts/s, %.0f deg/s at 4096 counts a turn), so its angle was wrong from the first one on\n",
+                    encoder.c_str(), static_cast<unsigned long long>(reports.get<std::uint64_t>()), LP3500_MAX_COUNT_RATE_HZ,
+                    LP3500_MAX_COUNT_RATE_HZ * 360.0 / 4096.0);
+      summary += text;
+    }
+    if (const auto overruns = r.at("device").at("board_flags").at("overruns").get<std::uint64_t>(); overruns > 0) {
+      std::snprintf(text, sizeof text, "  warning    the board's capture rings overflowed in %llu reports: readings were lost on the board\n",
+                    static_cast<unsigned long long>(overruns));
+      summary += text;
+    }
   }
   if (r.contains("recording")) {
     const auto& recording = r.at("recording");

@@ -8,9 +8,11 @@
 #include <cstdint>
 
 #include "device/calibration/calibration.h"
+#include "device/link/board_flags.h"
 #include "device/link/report_decoder.h"
 #include "device/link/sequence_tracker.h"
 #include "firmware/emulator/lp3500_emulator.h"
+#include "rtcore/base/result.h"
 #include "rtcore/concurrency/spsc_ring.h"
 #include "rtcore/scenes/procedure.h"
 
@@ -18,6 +20,11 @@ namespace resecto {
 
 /// The board's motion script for a procedure (degrees and millimetres to the emulator's units).
 firmware::MotionScript motion_script_for(const Procedure& procedure);
+
+/// Refuses a procedure that turns yaw, pitch or roll faster than the emulated board's quadrature
+/// decoding follows: past that the counts alias (a jump of three counts reads as one back), so the
+/// angle the host reads is wrong from then on and no check downstream can tell.
+Status check_encoder_speeds(const Procedure& procedure);
 
 /// What the lockstep link saw.
 struct LockstepCounters {
@@ -27,6 +34,7 @@ struct LockstepCounters {
   std::uint64_t duplicates = 0;
   std::uint64_t rejected = 0;
   std::uint64_t ring_full = 0;  ///< samples the core's ring could not take
+  BoardFlagCounts board_flags;  ///< the board's fault flags over the accepted reports
 };
 
 class LockstepDevice {

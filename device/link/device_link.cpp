@@ -244,6 +244,7 @@ void DeviceLink::handle_report(std::int64_t host_ns, std::span<const std::uint8_
   if (segment_accepted_++ == 0) segment_first_ns_ = host_ns;
   last_accept_ns_ = host_ns;
   ++counters_.accepted;
+  counters_.board_flags.count(sample.status);
   if (flush_pending_event()) push(sample);
   else ++counters_.ring_full;
 }

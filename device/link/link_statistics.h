@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 
+#include "device/link/board_flags.h"
 #include "device/link/report_decoder.h"
 
 namespace resecto {
@@ -30,6 +31,7 @@ struct LinkCounters {
   std::uint64_t disconnects = 0;
   std::uint64_t silence_timeouts = 0;   ///< of the disconnects, those caused by silence
   std::uint64_t failed_opens = 0;
+  BoardFlagCounts board_flags;          ///< the board's fault flags over the accepted reports
   double rate_hz = 0.0;                 ///< accepted samples per second while connected (host time)
   double latency_median_us = 0.0;       ///< device->host, above the estimated clock offset
   double latency_p99_us = 0.0;

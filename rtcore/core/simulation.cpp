@@ -468,7 +468,8 @@ void Simulation::update_metrics(const TickInput& input, bool collision_tick) {
   if (!collision_tick) return;
   // The costlier measures once per collision step.
   metrics_.max_tissue_displacement_mm = std::max(metrics_.max_tissue_displacement_mm, units::m_to_mm(tissue_->max_displacement_m()));
-  if (cutting) {
+  // Only a loop out of the sheath can cut: a pedal pressed with the loop retracted risks nothing (audit 9).
+  if (loop_cutting()) {
     const double margin_m = placed_.poses.loop.apply_point(loop_front_tool_).z - verumontanum_z_m_;
     const double margin_mm = units::m_to_mm(margin_m);
     metrics_.distal_margin_mm = std::min(metrics_.distal_margin_mm.value_or(margin_mm), margin_mm);

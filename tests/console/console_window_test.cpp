@@ -146,6 +146,17 @@ TEST(ConsoleWindow, RendersAndWritesAScreenshotOfTheSizeAsked) {
   EXPECT_NE(run.out.find("input-to-photon"), std::string::npos) << run.out;
 }
 
+// Audit 9: the console's emulator follows a procedure as a headless run's does, so it refuses one that
+// turns faster than the encoders are decoded, before the window opens.
+TEST(ConsoleWindow, AProcedureTurningFasterThanTheEncodersDecodeIsRefused) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_encoder_speed");
+  std::ofstream(dir / "flick.txt") << "0 0 0 0 125 0 0 0\n0.5 0 0 0 125 0 0 0\n0.502 25 0 0 125 0 0 0\n1 0 0 0 125 0 0 0\n";
+  const CommandOutput console = run_in_xvfb("console --procedure " + (dir / "flick.txt").string(), dir);
+  EXPECT_EQ(console.exit_code, 1);
+  EXPECT_NE(console.err.find("the yaw turns 25 deg (12500 deg/s)"), std::string::npos) << console.err;
+}
+
 TEST(ConsoleWindow, EndoscopeShowsTissueAndTurnsWhenTheSheathRolls) {
   REQUIRE_X_SERVER();
   const auto dir = scratch_directory("console_roll");

@@ -2,6 +2,8 @@
 // surface `--export-surface` writes passes `resecto mesh check` and encloses the remaining tissue.
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include <nlohmann/json.hpp>
 
 #include "rtcore/mesh/mesh_io.h"
@@ -40,6 +42,29 @@ TEST(Resection, DemoReportsTheCutAndExportsAValidRemainingSurface) {
   ASSERT_TRUE(mesh) << mesh.error();
   const double volume_ml = signed_volume(*mesh) * 1e6;
   EXPECT_NEAR(volume_ml * 1.05, m.at("remaining_tissue_g").get<double>(), 1e-6 * m.at("remaining_tissue_g").get<double>());
+}
+
+// Audit 9: the pedal pressed with the loop retracted into the sheath counted verumontanum violations,
+// though such a loop cannot cut. Out of the sheath distal to the verumontanum (where the external
+// sphincter lies) it counts, tissue or not.
+TEST(Resection, OnlyALoopOutOfTheSheathCountsAgainstTheVerumontanum) {
+  const auto dir = scratch_directory("resection_verumontanum");
+  const auto violations = [&](double loop_mm) {
+    const std::string loop = std::to_string(loop_mm);
+    std::ofstream(dir / "p.txt") << "0 0 0 0 125 0 0 0\n0.5 0 0 0 125 " << loop << " 0 0\n1.0 0 0 0 125 " << loop << " 1 0\n2.0 0 0 0 125 "
+                                 << loop << " 0 0\n2.5 0 0 0 125 0 0 0\n";
+    const CommandOutput run = run_resecto("run --headless --triangles 1296 --procedure " + (dir / "p.txt").string() + " --report " +
+                                          (dir / "r.json").string());
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    return nlohmann::json::parse(read_text(dir / "r.json")).at("metrics");
+  };
+  const auto retracted = violations(0.0);
+  EXPECT_EQ(retracted.at("verumontanum_violations").get<int>(), 0);
+  EXPECT_TRUE(retracted.at("distal_margin_mm").is_null()) << retracted.at("distal_margin_mm");
+  EXPECT_GT(retracted.at("cut_pedal_time_s").get<double>(), 0.9);
+  const auto out = violations(10.0);
+  EXPECT_GT(out.at("verumontanum_violations").get<int>(), 0);
+  EXPECT_LT(out.at("distal_margin_mm").get<double>(), 0.0);
 }
 
 TEST(Resection, AnUnknownSurfaceFormatIsRefusedBeforeTheRun) {

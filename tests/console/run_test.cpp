@@ -138,6 +138,31 @@ TEST(RunCommand, AToolThatOutrunsTheContactSearchIsWarnedOf) {
   EXPECT_EQ(calm.out.find("warning"), std::string::npos) << calm.out;
 }
 
+// Audit 9: a 25 degree yaw flick in 2 ms aliased in the emulated encoders (a jump of three counts reads
+// as one back), so the yaw read -28 degrees for the rest of the run, which said nothing. Such a
+// procedure is refused, naming the move; one at the decoding's limit runs, and its report counts the
+// board's fault flags (none here).
+TEST(RunCommand, AProcedureTurningFasterThanTheEncodersDecodeIsRefused) {
+  const auto dir = scratch_directory("run_encoder_speed");
+  std::ofstream(dir / "flick.txt") << "0 0 0 0 125 0 0 0\n0.5 0 0 0 125 0 0 0\n0.502 25 0 0 125 0 0 0\n1 0 0 0 125 0 0 0\n";
+  const CommandOutput flick = run_resecto("run --headless --triangles 1296 --procedure " + (dir / "flick.txt").string());
+  EXPECT_EQ(flick.exit_code, 1);
+  EXPECT_NE(flick.err.find("from 0.5 s to 0.502 s the yaw turns 25 deg (12500 deg/s)"), std::string::npos) << flick.err;
+  EXPECT_NE(flick.err.find("decoded up to 1758 deg/s"), std::string::npos) << flick.err;
+  EXPECT_NE(flick.err.find("give that move at least 0.0142 s"), std::string::npos) << flick.err;
+
+  // 1750 deg/s of roll, just inside: runs, and the encoders follow it.
+  std::ofstream(dir / "brisk.txt") << "0 0 0 0 125 0 0 0\n0.2 0 0 0 125 0 0 0\n0.4 0 0 350 125 0 0 0\n0.6 0 0 350 125 0 0 0\n";
+  const CommandOutput brisk =
+      run_resecto("run --headless --triangles 1296 --procedure " + (dir / "brisk.txt").string() + " --report " + (dir / "r.json").string());
+  ASSERT_EQ(brisk.exit_code, 0) << brisk.err;
+  const auto report = nlohmann::json::parse(read_text(dir / "r.json"));
+  const auto& flags = report.at("device").at("board_flags");
+  for (const char* joint : {"yaw", "pitch", "roll"}) EXPECT_EQ(flags.at("illegal_transitions").at(joint).get<int>(), 0) << joint;
+  EXPECT_EQ(flags.at("overruns").get<int>(), 0);
+  EXPECT_EQ(brisk.out.find("encoder flagged"), std::string::npos) << brisk.out;
+}
+
 TEST(RunCommand, TheContactMarginIsTheUsersToChooseWithinItsRange) {
   const auto dir = scratch_directory("run_contact_margin");
   // A wider margin keeps every pair the default keeps and more: the short run's state is the same.
