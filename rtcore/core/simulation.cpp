@@ -216,7 +216,8 @@ void Simulation::place_tool(const TickInput& input) {
   tissue_->tool().set_pose(loop_part_, placed_.poses.loop);
   // The energised loop cuts rather than pushes: while it cuts it takes no part in contact.
   cut_pedal_ = input.tool_present && input.cut;
-  tissue_->tool().set_enabled(loop_part_, !loop_cutting());
+  placed_.loop_in_contact = !loop_cutting();
+  tissue_->tool().set_enabled(loop_part_, placed_.loop_in_contact);
 }
 
 bool Simulation::loop_cutting() const {
@@ -456,11 +457,16 @@ void Simulation::update_metrics(const TickInput& input, bool collision_tick) {
   }
   if (placed_.present) metrics_.max_insertion_mm = std::max(metrics_.max_insertion_mm, units::m_to_mm(placed_joints_.insertion_m));
   // The candidates in use were searched with the tool where published_ has it; the sheath's tip
-  // and the loop's front move furthest.
+  // and the loop's front move furthest. The loop counts only while it takes part in contact, now and
+  // at that search, as the reuse of candidates reckons it: a cutting loop has none to outrun, and one
+  // just back in contact is searched at the next collision step (audit 9: a loop drawn back through
+  // a stroke was counted as outrunning candidates the run had rightly kept for the sheath).
   const ToolPoses& now = placed_.poses;
   const ToolPoses& searched = published_.poses;
-  const double travel_m = std::max(length(now.sheath.translation - searched.sheath.translation),
-                                   length(now.loop.apply_point(loop_front_tool_) - searched.loop.apply_point(loop_front_tool_)));
+  const double loop_travel_m = placed_.loop_in_contact && published_.loop_in_contact
+                                   ? length(now.loop.apply_point(loop_front_tool_) - searched.loop.apply_point(loop_front_tool_))
+                                   : 0.0;
+  const double travel_m = std::max(length(now.sheath.translation - searched.sheath.translation), loop_travel_m);
   if (placed_.present && published_.present) {
     metrics_.max_tool_travel_since_search_mm = std::max(metrics_.max_tool_travel_since_search_mm, units::m_to_mm(travel_m));
     if (travel_m > tissue_->tool().margin_m()) ++metrics_.contact_margin_exceeded_ticks;

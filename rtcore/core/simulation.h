@@ -314,6 +314,7 @@ class Simulation {
   struct ToolPlacement {
     ToolPoses poses;
     bool present = false;
+    bool loop_in_contact = true;  // false while the energised loop cuts (it pushes nothing then)
   };
   ToolPlacement placed_;     // this tick
   DeviceJoints placed_joints_;  // the smoothed joints placed_ was placed by
