@@ -401,9 +401,10 @@ std::string summarize_report(const ordered_json& r) {
       if (reports.get<std::uint64_t>() == 0) continue;
       std::snprintf(text, sizeof text,
                     "  warning    the %s encoder flagged an illegal transition in %llu reports: the joint turned faster than the board "
-                    "decodes (%u counts/s, %.0f deg/s at 4096 counts a turn), so its angle was wrong from the first one on\n",
+                    "decodes (%u counts/s, %.0f deg/s at %d counts a turn), so its angle was wrong from the first one on\n",
                     encoder.c_str(), static_cast<unsigned long long>(reports.get<std::uint64_t>()), LP3500_MAX_COUNT_RATE_HZ,
-                    LP3500_MAX_COUNT_RATE_HZ * 360.0 / 4096.0);
+                    LP3500_MAX_COUNT_RATE_HZ * 360.0 / firmware::SensorModel{}.counts_per_revolution,
+                    firmware::SensorModel{}.counts_per_revolution);
       summary += text;
     }
     if (const auto overruns = r.at("device").at("board_flags").at("overruns").get<std::uint64_t>(); overruns > 0) {

@@ -15,9 +15,4 @@ void BoardFlagCounts::count(std::uint16_t status) {
   if (status & LP3500_STATUS_NO_ADC_SAMPLE) ++no_adc_sample;
 }
 
-const char* encoder_name(std::size_t encoder) {
-  static constexpr const char* kNames[] = {"yaw", "pitch", "roll"};
-  return encoder < 3 ? kNames[encoder] : "?";
-}
-
 }  // namespace resecto

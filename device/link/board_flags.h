@@ -20,10 +20,6 @@ struct BoardFlagCounts {
 
   /// Counts one report's LP3500_STATUS_* bits.
   void count(std::uint16_t status);
-  std::uint64_t illegal_total() const { return illegal_transitions[0] + illegal_transitions[1] + illegal_transitions[2]; }
 };
-
-/// "yaw", "pitch" or "roll".
-const char* encoder_name(std::size_t encoder);
 
 }  // namespace resecto
