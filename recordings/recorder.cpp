@@ -97,8 +97,16 @@ void Recorder::note_error(const Status& status) {
   if (!status && counters_.write_error.empty()) counters_.write_error = status.error();
 }
 
+void Recorder::take_commands() {
+  ParameterCommand command;
+  while (commands_.try_pop(command)) pending_commands_.push_back(command);
+}
+
 void Recorder::write_ticks() {
   if (pending_ticks_.empty()) return;
+  // The core pushes a tick's commands before the tick: taken now, after the ticks, they include
+  // every command of every tick about to be written, and go out first.
+  take_commands();
   write_commands();
   // A lost tick breaks the run of consecutive ticks a block holds: split there.
   std::size_t begin = 0;
@@ -112,16 +120,24 @@ void Recorder::write_ticks() {
     }
   }
   counters_.ticks += pending_ticks_.size();
+  last_tick_written_ = pending_ticks_.back().tick;
   pending_ticks_.clear();
 }
 
-void Recorder::write_steps() {
-  if (pending_steps_.empty()) return;
-  encode_step_block(pending_steps_, payload_);
-  writer_.add_chunk(ChunkType::kSteps, payload_, pending_steps_.front().tick);
+void Recorder::write_steps(std::size_t count) {
+  count = std::min(count, pending_steps_.size());
+  if (count == 0) return;
+  const std::span<const StepRecord> block(pending_steps_.data(), count);
+  encode_step_block(block, payload_);
+  writer_.add_chunk(ChunkType::kSteps, payload_, block.front().tick);
   ++counters_.chunks;
-  counters_.steps += pending_steps_.size();
-  pending_steps_.clear();
+  counters_.steps += count;
+  pending_steps_.erase(pending_steps_.begin(), pending_steps_.begin() + static_cast<std::ptrdiff_t>(count));
+}
+
+void Recorder::write_covered_step_blocks() {
+  const std::size_t block = settings_.steps_per_chunk;
+  while (pending_steps_.size() >= block && last_tick_written_ && pending_steps_[block - 1].tick <= *last_tick_written_) write_steps(block);
 }
 
 void Recorder::write_commands() {
@@ -170,11 +186,14 @@ void Recorder::write_keyframe(int slot) {
 }
 
 bool Recorder::drain() {
+  // A killed run leaves whatever prefix of the file was written, so a hash must never go out before
+  // the ticks that lead to it, nor a tick before its commands. The core pushes commands, then the
+  // tick, then the step: taking them in the reverse order means every step taken has its tick
+  // taken too, and write_ticks() takes the commands last.
   bool took = false;
-  // Commands before ticks: a command popped here was pushed before any tick popped below.
-  ParameterCommand command;
-  while (commands_.try_pop(command)) {
-    pending_commands_.push_back(command);
+  StepRecord step;
+  while (steps_.try_pop(step)) {
+    pending_steps_.push_back(step);
     took = true;
   }
   TickRecord tick;
@@ -183,12 +202,10 @@ bool Recorder::drain() {
     took = true;
     if (pending_ticks_.size() >= settings_.ticks_per_chunk) write_ticks();
   }
-  StepRecord step;
-  while (steps_.try_pop(step)) {
-    pending_steps_.push_back(step);
-    took = true;
-    if (pending_steps_.size() >= settings_.steps_per_chunk) write_steps();
-  }
+  const std::size_t commands_before = pending_commands_.size();
+  take_commands();
+  took = took || pending_commands_.size() != commands_before;
+  write_covered_step_blocks();
   int slot = -1;
   while (filled_slots_.try_pop(slot)) {
     write_keyframe(slot);
@@ -212,7 +229,7 @@ void Recorder::run() {
       // one flush interval behind the core.
       write_commands();
       write_ticks();
-      write_steps();
+      write_steps(pending_steps_.size());
       note_error(writer_.flush());
       last_flush = now;
       if (now - last_sync >= std::chrono::seconds(1)) {

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <span>
 #include <thread>
 #include <vector>
@@ -72,8 +73,10 @@ class Recorder {
   Recorder(const RecorderSettings& settings, const Simulation& sim);
   void run();
   bool drain();  ///< one pass over the rings; true if anything was taken
+  void take_commands();  ///< from the ring into pending_commands_
   void write_ticks();
-  void write_steps();
+  void write_steps(std::size_t count);  ///< the first `count` pending steps, as one chunk
+  void write_covered_step_blocks();     ///< whole step chunks whose ticks are all written
   void write_commands();
   void write_keyframe(int slot);
   void note_error(const Status& status);
@@ -94,6 +97,7 @@ class Recorder {
   std::vector<TickRecord> pending_ticks_;
   std::vector<StepRecord> pending_steps_;
   std::vector<ParameterCommand> pending_commands_;
+  std::optional<std::uint64_t> last_tick_written_;  ///< a steps chunk waits for the ticks it covers
   std::vector<std::uint8_t> payload_, draco_;
   std::vector<bool> used_nodes_;
   std::uint64_t last_topology_version_ = UINT64_MAX;
