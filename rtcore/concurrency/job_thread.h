@@ -11,6 +11,7 @@
 #include <thread>
 #include <utility>
 
+#include "rtcore/base/flush_denormals.h"
 #include "rtcore/concurrency/futex.h"
 
 namespace resecto {
@@ -57,6 +58,7 @@ class JobThread {
 
  private:
   void run() {
+    flush_denormals_on_this_thread();  // the core's arithmetic, on whichever thread it runs
     std::uint32_t seen = 0;
     for (;;) {
       while (launched_.load(std::memory_order_acquire) == seen) futex_sleep_while_equal(launched_, seen);

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <thread>
 
+#include "rtcore/base/flush_denormals.h"
 #include "rtcore/concurrency/futex.h"
 #include "rtcore/concurrency/spin_pause.h"
 
@@ -142,6 +143,7 @@ class LoopHelper {
   }
 
   void run() {
+    flush_denormals_on_this_thread();  // the core's arithmetic, on whichever thread it runs
     std::uint32_t seen = 0;
     std::uint32_t idle_spins = 0;
     std::chrono::steady_clock::time_point idle_since{};

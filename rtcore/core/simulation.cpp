@@ -10,6 +10,7 @@
 #include <thread>
 #include <utility>
 
+#include "rtcore/base/flush_denormals.h"
 #include "rtcore/base/units.h"
 #include "rtcore/core/thread_priority.h"
 #include "rtcore/scenes/prostate_tissue.h"
@@ -243,6 +244,7 @@ void Simulation::prepare_cut() {
 }
 
 void Simulation::step(const TickInput& input, std::span<const ParameterCommand> commands, FrameProfiler* profiler) {
+  const FlushDenormals flush;  // part of the core's arithmetic: rtcore/base/flush_denormals.h
   const std::uint64_t tick = tick_;
   const bool collision_tick = is_collision_tick(tick);
   // Commands apply in the order they were queued: the console's order, the same on replay. (The
