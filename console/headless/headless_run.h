@@ -19,6 +19,9 @@
 
 namespace resecto {
 
+/// The trace's default ring: 2^22 stage timings, 134 MB, the last ~13 minutes of a run at 960 Hz.
+inline constexpr std::uint64_t kDefaultTraceEvents = 1u << 22;
+
 struct HeadlessOptions {
   Procedure procedure;
   double seconds = 0.0;          ///< 0: the procedure's length
@@ -26,6 +29,7 @@ struct HeadlessOptions {
   SimulationConfig simulation;
   std::uint64_t seed = 1;        ///< the emulator's sensor noise
   std::string trace_path;        ///< empty: no trace
+  std::uint64_t trace_events = kDefaultTraceEvents;  ///< the trace keeps the run's last this many stage timings
   std::string record_path;       ///< empty: no recording (recordings/: the session file replay reads)
   /// Writes the remaining tissue's surface here at the end, at rest positions, in millimetres
   /// (format by extension: .off, .obj, .ply, .stl); empty: none.

@@ -5,8 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
-#include <sstream>
+#include <string>
 
 #include "rtcore/base/atomic_file.h"
 
@@ -59,29 +58,47 @@ StageStatistics FrameProfiler::statistics(Stage stage) const {
   return {h.quantile(0.5), h.quantile(0.95), h.quantile(0.99), h.max(), budgets_us_[s], h.count(), over_budget_[s]};
 }
 
+std::uint64_t FrameProfiler::trace_first_tick() const {
+  // The least tick, not the first recorded: the collision thread's stages are recorded when its job
+  // ends, after the core's stages of later ticks.
+  const std::uint64_t kept = std::min<std::uint64_t>(trace_written_, trace_.size());
+  std::uint64_t first = kept ? UINT64_MAX : 0;
+  for (std::uint64_t i = trace_written_ - kept; i < trace_written_; ++i) first = std::min(first, trace_[i % trace_.size()].tick);
+  return first;
+}
+
 Status FrameProfiler::write_chrome_trace(const std::filesystem::path& path) const {
   const std::uint64_t kept = std::min<std::uint64_t>(trace_written_, trace_.size());
   const std::uint64_t first = trace_written_ - kept;
   std::int64_t origin_ns = kept ? trace_[first % trace_.size()].begin_ns : 0;
   for (std::uint64_t i = first; i < trace_written_; ++i) origin_ns = std::min(origin_ns, trace_[i % trace_.size()].begin_ns);
 
-  std::ostringstream out(std::ios::out | std::ios::binary);
-  out << "{\"displayTimeUnit\":\"ms\",\"traceEvents\":[\n";
-  out << R"({"name":"process_name","ph":"M","pid":1,"tid":1,"args":{"name":"resecto core"}},)" << "\n";
-  out << R"json({"name":"thread_name","ph":"M","pid":1,"tid":1,"args":{"name":"core (fixed step)"}},)json" << "\n";
-  out << R"json({"name":"thread_name","ph":"M","pid":1,"tid":2,"args":{"name":"collision (topology + refit + query)"}})json";
+  AtomicFile file;
+  if (Status opened = file.open(path); !opened) return opened;
+  std::string block;
+  constexpr std::size_t kBlockBytes = 1 << 20;
+  block.reserve(kBlockBytes + 256);
+  block += "{\"displayTimeUnit\":\"ms\",\"traceEvents\":[\n";
+  block += R"({"name":"process_name","ph":"M","pid":1,"tid":1,"args":{"name":"resecto core"}},)" "\n";
+  block += R"json({"name":"thread_name","ph":"M","pid":1,"tid":1,"args":{"name":"core (fixed step)"}},)json" "\n";
+  block += R"json({"name":"thread_name","ph":"M","pid":1,"tid":2,"args":{"name":"collision (topology + refit + query)"}})json";
   char line[256];
   // Oldest first: the order the stages ran in.
   for (std::uint64_t i = first; i < trace_written_; ++i) {
     const StageTiming& t = trace_[i % trace_.size()];
-    std::snprintf(line, sizeof line,
-                  ",\n{\"name\":\"%s\",\"cat\":\"core\",\"ph\":\"X\",\"pid\":1,\"tid\":%d,\"ts\":%.3f,\"dur\":%.3f,\"args\":{\"tick\":%llu}}",
-                  stage_name(t.stage), runs_on_collision_thread(t.stage) ? 2 : 1, static_cast<double>(t.begin_ns - origin_ns) * 1e-3, static_cast<double>(t.duration_ns) * 1e-3,
-                  static_cast<unsigned long long>(t.tick));
-    out << line;
+    const int length = std::snprintf(
+        line, sizeof line, ",\n{\"name\":\"%s\",\"cat\":\"core\",\"ph\":\"X\",\"pid\":1,\"tid\":%d,\"ts\":%.3f,\"dur\":%.3f,\"args\":{\"tick\":%llu}}",
+        stage_name(t.stage), runs_on_collision_thread(t.stage) ? 2 : 1, static_cast<double>(t.begin_ns - origin_ns) * 1e-3,
+        static_cast<double>(t.duration_ns) * 1e-3, static_cast<unsigned long long>(t.tick));
+    block.append(line, static_cast<std::size_t>(std::clamp(length, 0, static_cast<int>(sizeof line) - 1)));
+    if (block.size() >= kBlockBytes) {
+      if (Status written = file.write(block); !written) return written;
+      block.clear();
+    }
   }
-  out << "\n]}\n";
-  return write_file_atomically(path, out.view());
+  block += "\n]}\n";
+  if (Status written = file.write(block); !written) return written;
+  return file.commit();
 }
 
 }  // namespace resecto

@@ -62,8 +62,13 @@ class FrameProfiler {
   double last_us(Stage stage) const { return last_us_[static_cast<int>(stage)]; }
   /// Stage timings recorded so far that the trace ring no longer holds.
   std::uint64_t trace_dropped() const { return trace_written_ > trace_.size() ? trace_written_ - trace_.size() : 0; }
+  /// How many stage timings the trace ring holds at most.
+  std::uint64_t trace_capacity() const { return trace_.size(); }
+  /// The least tick of the stage timings the trace ring holds (0 before any).
+  std::uint64_t trace_first_tick() const;
 
-  /// Writes the trace ring as Chrome trace-event JSON (complete "X" events, microseconds).
+  /// Writes the trace ring as Chrome trace-event JSON (complete "X" events, microseconds), streamed
+  /// to the file in blocks: a full ring is ~470 MB of text, which a string would hold twice.
   Status write_chrome_trace(const std::filesystem::path& path) const;
 
  private:

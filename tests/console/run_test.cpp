@@ -138,6 +138,44 @@ TEST(RunCommand, AToolThatOutrunsTheContactSearchIsWarnedOf) {
   EXPECT_EQ(calm.out.find("warning"), std::string::npos) << calm.out;
 }
 
+// Audit 10, finding 3: a 20-minute run's trace silently began at 6.3 minutes (its ring keeps the last
+// 2^22 stage timings); only an undocumented report key said so. Finding 4: the ring was allocated and
+// zeroed without a trace to write, sized by --seconds (120 MB more for --seconds 3600).
+TEST(RunCommand, ATraceThatKeepsOnlyTheRunsEndSaysWhereItStarts) {
+  const auto dir = scratch_directory("run_trace_ring");
+  const auto report_path = dir / "r.json";
+  const auto trace_path = dir / "t.json";
+  const CommandOutput run = run_resecto(std::string(kShortRun) + " --trace " + trace_path.string() + " --trace-events 3000 --report " + report_path.string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto report = nlohmann::json::parse(read_text(report_path));
+  const auto trace = nlohmann::json::parse(read_text(trace_path));
+  int events = 0;
+  std::uint64_t first_tick = UINT64_MAX;
+  for (const auto& event : trace.at("traceEvents")) {
+    if (event.at("ph") != "X") continue;
+    ++events;
+    first_tick = std::min(first_tick, event.at("args").at("tick").get<std::uint64_t>());
+  }
+  EXPECT_EQ(events, 3000);
+  EXPECT_EQ(report.at("trace_kept_events"), 3000);
+  EXPECT_GT(report.at("trace_dropped_events").get<int>(), 8000);  // 2.5 s at 960 Hz, ~5 stages a tick
+  EXPECT_DOUBLE_EQ(report.at("trace_first_s").get<double>(), static_cast<double>(first_tick) / 960.0);
+  char where[128];
+  std::snprintf(where, sizeof where, "the trace holds the run from %.1f s to its end at 2.5 s: it keeps the last 3000 stage timings",
+                report.at("trace_first_s").get<double>());
+  EXPECT_NE(run.out.find(where), std::string::npos) << run.out;
+  // A whole trace, and no trace: neither warns nor reports dropped timings.
+  for (const std::string& extra : {std::string(" --trace ") + trace_path.string(), std::string()}) {
+    const CommandOutput whole = run_resecto(std::string(kShortRun) + extra + " --report " + report_path.string());
+    ASSERT_EQ(whole.exit_code, 0) << whole.err;
+    EXPECT_EQ(whole.out.find("warning"), std::string::npos) << whole.out;
+    EXPECT_FALSE(nlohmann::json::parse(read_text(report_path)).contains("trace_dropped_events")) << extra;
+  }
+  const CommandOutput sized_alone = run_resecto(std::string(kShortRun) + " --trace-events 3000");
+  EXPECT_EQ(sized_alone.exit_code, 2);
+  EXPECT_NE(sized_alone.err.find("--trace-events sizes the trace: give --trace FILE too"), std::string::npos) << sized_alone.err;
+}
+
 // Audit 9: how far the tool outran the contact candidates is the tool's, not the tissue's: the loop
 // counted while it cut (when it takes no part in contact), so soft tissue, whose candidates the sheath
 // rightly kept through a stroke, showed 449 ticks past the margin (up to 5.3 mm) where the default

@@ -47,6 +47,8 @@ TEST(FrameProfiler, CountsOverBudgetAndWritesATrace) {
   EXPECT_NEAR(physics.median_us, 50.0, 0.6);
   EXPECT_DOUBLE_EQ(physics.max_us, 150.0);
   EXPECT_EQ(profiler.trace_dropped(), 12u);  // 20 recorded, 8 kept
+  EXPECT_EQ(profiler.trace_capacity(), 8u);
+  EXPECT_EQ(profiler.trace_first_tick(), 6u);  // ticks 6 to 9, two stages each
 
   const auto path = std::filesystem::temp_directory_path() / ("resecto_trace_" + std::to_string(::getpid()) + ".json");
   ASSERT_TRUE(profiler.write_chrome_trace(path));
@@ -61,6 +63,26 @@ TEST(FrameProfiler, CountsOverBudgetAndWritesATrace) {
     EXPECT_GT(event.at("dur").get<double>(), 0.0);
   }
   EXPECT_EQ(complete, 8);
+  std::filesystem::remove(path);
+}
+
+TEST(FrameProfiler, ATraceOfManyBlocksIsWrittenWhole) {
+  // About 100 bytes an event: 40,000 events are four of the writer's 1 MB blocks.
+  std::array<double, kStageCount> budgets{};
+  budgets.fill(100.0);
+  FrameProfiler profiler(budgets, 40'000);
+  for (std::uint64_t tick = 0; tick < 40'000; ++tick) profiler.record(Stage::kTick, tick, 1'000 * static_cast<std::int64_t>(tick), 1'000 * static_cast<std::int64_t>(tick) + 500);
+  const auto path = std::filesystem::temp_directory_path() / ("resecto_long_trace_" + std::to_string(::getpid()) + ".json");
+  ASSERT_TRUE(profiler.write_chrome_trace(path));
+  EXPECT_GT(std::filesystem::file_size(path), 3u << 20);
+  const auto trace = nlohmann::json::parse(std::ifstream(path));
+  std::uint64_t expected_tick = 0;
+  for (const auto& event : trace.at("traceEvents")) {
+    if (event.at("ph") != "X") continue;
+    EXPECT_EQ(event.at("args").at("tick").get<std::uint64_t>(), expected_tick);
+    ++expected_tick;
+  }
+  EXPECT_EQ(expected_tick, 40'000u);
   std::filesystem::remove(path);
 }
 
