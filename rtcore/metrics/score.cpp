@@ -19,6 +19,10 @@ constexpr int kGridXY = 26, kGridZ = 6;
 // Until the device reports, the core parks the tool a metre away (withdrawn_pose()); a sheath tip
 // further than this from the gland's origin is parked, and its jump in and out is not path.
 constexpr double kParkedBeyondM = 0.5;
+// The path counts the wire's moves of at least this from where it was last counted: the device's
+// filtered sensor noise (~0.02 mm RMS at the wire) summed step by step made a still tool travel
+// 47 mm a minute (audit 10, finding 2). A deliberate move is counted in 0.5 mm chords.
+constexpr double kPathDeadbandM = 0.5e-3;
 
 std::size_t cell_of(const ResectionHeatMap& grid, const Vec3& p) {
   auto index = [](double v, double o, double c, int n) { return std::clamp(static_cast<int>(std::floor((v - o) / c)), 0, n - 1); };
@@ -122,9 +126,15 @@ void ScoreTracker::observe(const Simulation& sim) {
   const ToolPoses& poses = sim.tool_poses();
   const Vec3 tip = poses.loop.apply_point(wire_middle_tool_);
   const bool placed = length(poses.sheath.translation) < kParkedBeyondM;
-  if (placed && have_tip_) path_m_ += length(tip - last_tip_);
-  last_tip_ = tip;
-  have_tip_ = placed;
+  if (!placed) {
+    have_tip_ = false;
+  } else if (!have_tip_) {
+    counted_tip_ = tip;
+    have_tip_ = true;
+  } else if (const double moved = length(tip - counted_tip_); moved >= kPathDeadbandM) {
+    path_m_ += moved;
+    counted_tip_ = tip;
+  }
 
   // Adenoma removed in this step goes to the lobe whose crest lies nearest the wire in angle around the
   // channel axis (the lobes differ by side: median posterior, laterals left and right; along the

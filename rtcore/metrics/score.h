@@ -107,7 +107,7 @@ class ScoreTracker {
   double verumontanum_z_m_ = 0.0;
   double tick_s_ = 0.0;
   std::uint64_t period_ticks_ = 1;
-  Vec3 last_tip_{0.0};
+  Vec3 counted_tip_{0.0};  // where the wire was when its path last grew
   bool have_tip_ = false;
   double path_m_ = 0.0;
   double last_adenoma_g_ = 0.0;

@@ -176,6 +176,24 @@ TEST(RunCommand, ATraceThatKeepsOnlyTheRunsEndSaysWhereItStarts) {
   EXPECT_NE(sized_alone.err.find("--trace-events sizes the trace: give --trace FILE too"), std::string::npos) << sized_alone.err;
 }
 
+// Audit 10, finding 2: the wire's path summed the device's filtered sensor noise step by step, so a
+// tool held still travelled 47 mm a minute and its economy of motion worsened while the trainee rested.
+TEST(RunCommand, AToolHeldStillTravelsNoFurther) {
+  const auto dir = scratch_directory("run_still_path");
+  std::ofstream(dir / "still.txt") << "0 0 0 0 125 0 0 0\n1.5 0 0 0 157 0 0 0\n";
+  const auto path_after = [&](const char* seconds) {
+    const CommandOutput run = run_resecto("run --headless --triangles 1296 --procedure " + (dir / "still.txt").string() + " --seconds " + seconds +
+                                          " --report " + (dir / "r.json").string());
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    return nlohmann::json::parse(read_text(dir / "r.json")).at("score").at("tool_path_mm").get<double>();
+  };
+  const double early = path_after("3");
+  const double late = path_after("20");
+  // The sheath went in 32 mm; the wire travelled that, counted in moves of at least 0.5 mm.
+  EXPECT_NEAR(early, 32.0, 1.0);
+  EXPECT_NEAR(late, early, 0.5) << "17 s held still";
+}
+
 // Audit 9: how far the tool outran the contact candidates is the tool's, not the tissue's: the loop
 // counted while it cut (when it takes no part in contact), so soft tissue, whose candidates the sheath
 // rightly kept through a stroke, showed 449 ticks past the margin (up to 5.3 mm) where the default
