@@ -332,7 +332,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
                                 {"keyframes", recorded->keyframes_lost}}},
                       {"keyframe_encode_ms", {{"mean", recorded->keyframe_encode_ms_mean}, {"max", recorded->keyframe_encode_ms_max}}}};
   }
-  if (!options.trace_path.empty() && profiler.trace_dropped() > 0) {
+  if (profiler.trace_dropped() > 0) {
     r["trace_dropped_events"] = profiler.trace_dropped();
     r["trace_kept_events"] = profiler.trace_capacity();
     r["trace_first_s"] = static_cast<double>(profiler.trace_first_tick()) * tick_s;

@@ -35,7 +35,7 @@ const char* stage_name(Stage stage) {
 }
 
 FrameProfiler::FrameProfiler(const std::array<double, kStageCount>& budgets_us, std::size_t trace_capacity)
-    : budgets_us_(budgets_us), trace_(std::max<std::size_t>(trace_capacity, 1)) {}
+    : budgets_us_(budgets_us), trace_(trace_capacity) {}
 
 std::int64_t FrameProfiler::now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -48,6 +48,7 @@ void FrameProfiler::record(Stage stage, std::uint64_t tick, std::int64_t begin_n
   last_us_[s] = us;
   total_us_[s] += us;
   if (us > budgets_us_[s]) ++over_budget_[s];
+  if (trace_.empty()) return;  // no trace asked for
   trace_[trace_written_ % trace_.size()] = {begin_ns, end_ns - begin_ns, tick, stage};
   ++trace_written_;
 }
@@ -61,16 +62,14 @@ StageStatistics FrameProfiler::statistics(Stage stage) const {
 std::uint64_t FrameProfiler::trace_first_tick() const {
   // The least tick, not the first recorded: the collision thread's stages are recorded when its job
   // ends, after the core's stages of later ticks.
-  const std::uint64_t kept = std::min<std::uint64_t>(trace_written_, trace_.size());
-  std::uint64_t first = kept ? UINT64_MAX : 0;
-  for (std::uint64_t i = trace_written_ - kept; i < trace_written_; ++i) first = std::min(first, trace_[i % trace_.size()].tick);
+  std::uint64_t first = trace_oldest() < trace_written_ ? UINT64_MAX : 0;
+  for (std::uint64_t i = trace_oldest(); i < trace_written_; ++i) first = std::min(first, trace_[i % trace_.size()].tick);
   return first;
 }
 
 Status FrameProfiler::write_chrome_trace(const std::filesystem::path& path) const {
-  const std::uint64_t kept = std::min<std::uint64_t>(trace_written_, trace_.size());
-  const std::uint64_t first = trace_written_ - kept;
-  std::int64_t origin_ns = kept ? trace_[first % trace_.size()].begin_ns : 0;
+  const std::uint64_t first = trace_oldest();
+  std::int64_t origin_ns = first < trace_written_ ? trace_[first % trace_.size()].begin_ns : 0;
   for (std::uint64_t i = first; i < trace_written_; ++i) origin_ns = std::min(origin_ns, trace_[i % trace_.size()].begin_ns);
 
   AtomicFile file;
@@ -86,11 +85,11 @@ Status FrameProfiler::write_chrome_trace(const std::filesystem::path& path) cons
   // Oldest first: the order the stages ran in.
   for (std::uint64_t i = first; i < trace_written_; ++i) {
     const StageTiming& t = trace_[i % trace_.size()];
-    const int length = std::snprintf(
-        line, sizeof line, ",\n{\"name\":\"%s\",\"cat\":\"core\",\"ph\":\"X\",\"pid\":1,\"tid\":%d,\"ts\":%.3f,\"dur\":%.3f,\"args\":{\"tick\":%llu}}",
-        stage_name(t.stage), runs_on_collision_thread(t.stage) ? 2 : 1, static_cast<double>(t.begin_ns - origin_ns) * 1e-3,
-        static_cast<double>(t.duration_ns) * 1e-3, static_cast<unsigned long long>(t.tick));
-    block.append(line, static_cast<std::size_t>(std::clamp(length, 0, static_cast<int>(sizeof line) - 1)));
+    std::snprintf(line, sizeof line,
+                  ",\n{\"name\":\"%s\",\"cat\":\"core\",\"ph\":\"X\",\"pid\":1,\"tid\":%d,\"ts\":%.3f,\"dur\":%.3f,\"args\":{\"tick\":%llu}}",
+                  stage_name(t.stage), runs_on_collision_thread(t.stage) ? 2 : 1, static_cast<double>(t.begin_ns - origin_ns) * 1e-3,
+                  static_cast<double>(t.duration_ns) * 1e-3, static_cast<unsigned long long>(t.tick));
+    block += line;
     if (block.size() >= kBlockBytes) {
       if (Status written = file.write(block); !written) return written;
       block.clear();

@@ -45,7 +45,8 @@ struct StageTiming {
 
 class FrameProfiler {
  public:
-  /// Budgets per stage in microseconds; the trace keeps the last `trace_capacity` stage timings.
+  /// Budgets per stage in microseconds; the trace keeps the last `trace_capacity` stage timings
+  /// (0: no trace, only the statistics).
   FrameProfiler(const std::array<double, kStageCount>& budgets_us, std::size_t trace_capacity);
 
   /// Monotonic clock for timings, nanoseconds (never used by the simulation itself).
@@ -60,8 +61,8 @@ class FrameProfiler {
   double budget_us(Stage stage) const { return budgets_us_[static_cast<int>(stage)]; }
   /// The stage's most recent duration, microseconds (what a live plot samples).
   double last_us(Stage stage) const { return last_us_[static_cast<int>(stage)]; }
-  /// Stage timings recorded so far that the trace ring no longer holds.
-  std::uint64_t trace_dropped() const { return trace_written_ > trace_.size() ? trace_written_ - trace_.size() : 0; }
+  /// Stage timings recorded so far that the trace ring no longer holds (none without a ring).
+  std::uint64_t trace_dropped() const { return trace_oldest(); }
   /// How many stage timings the trace ring holds at most.
   std::uint64_t trace_capacity() const { return trace_.size(); }
   /// The least tick of the stage timings the trace ring holds (0 before any).
@@ -77,6 +78,9 @@ class FrameProfiler {
   std::array<TimingHistogram, kStageCount> histograms_;
   std::array<std::uint64_t, kStageCount> over_budget_{};
   std::array<double, kStageCount> last_us_{};
+  /// The count of timings written before the oldest one the ring holds.
+  std::uint64_t trace_oldest() const { return trace_written_ > trace_.size() ? trace_written_ - trace_.size() : 0; }
+
   std::vector<StageTiming> trace_;
   std::uint64_t trace_written_ = 0;
 };

@@ -17,6 +17,15 @@ namespace {
 
 const char* kShortRun = "run --headless --triangles 1296 --seconds 2.5";
 
+/// The report of a headless run on the small gland of the procedure file `procedure` (in `dir`) with
+/// `options` added.
+nlohmann::json report_of_procedure(const std::filesystem::path& dir, const std::filesystem::path& procedure, const std::string& options) {
+  const CommandOutput run =
+      run_resecto("run --headless --triangles 1296 --procedure " + procedure.string() + options + " --report " + (dir / "r.json").string());
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  return nlohmann::json::parse(read_text(dir / "r.json"));
+}
+
 // A build of minutes and gigabytes is announced before it starts; a model of seconds is not.
 TEST(RunCommand, ALargeModelIsAnnouncedBeforeItsBuild) {
   ::testing::internal::CaptureStderr();
@@ -182,10 +191,7 @@ TEST(RunCommand, AToolHeldStillTravelsNoFurther) {
   const auto dir = scratch_directory("run_still_path");
   std::ofstream(dir / "still.txt") << "0 0 0 0 125 0 0 0\n1.5 0 0 0 157 0 0 0\n";
   const auto path_after = [&](const char* seconds) {
-    const CommandOutput run = run_resecto("run --headless --triangles 1296 --procedure " + (dir / "still.txt").string() + " --seconds " + seconds +
-                                          " --report " + (dir / "r.json").string());
-    EXPECT_EQ(run.exit_code, 0) << run.err;
-    return nlohmann::json::parse(read_text(dir / "r.json")).at("score").at("tool_path_mm").get<double>();
+    return report_of_procedure(dir, dir / "still.txt", std::string(" --seconds ") + seconds).at("score").at("tool_path_mm").get<double>();
   };
   const double early = path_after("3");
   const double late = path_after("20");
@@ -204,10 +210,7 @@ TEST(RunCommand, HowFarTheToolOutranItsCandidatesDoesNotDependOnTheTissue) {
                                         "3.55 0 0 90 157 23 1 0\n4.75 0 0 90 157 1 1 0\n4.8 0 0 90 157 1 0 0\n5.5 1 0 90 157 23 0 0\n"
                                         "5.55 1 0 90 157 23 1 0\n6.75 1 0 90 157 1 1 0\n6.8 1 0 90 157 1 0 0\n7.5 0 0 90 157 0 0 0\n";
   const auto outran = [&](const std::string& tissue) {
-    const CommandOutput run = run_resecto("run --headless --triangles 1296 --procedure " + (dir / "strokes.txt").string() + tissue +
-                                          " --report " + (dir / "r.json").string());
-    EXPECT_EQ(run.exit_code, 0) << run.err;
-    const auto m = nlohmann::json::parse(read_text(dir / "r.json")).at("metrics");
+    const auto m = report_of_procedure(dir, dir / "strokes.txt", tissue).at("metrics");
     return std::make_pair(m.at("contact_margin_exceeded_ticks").get<int>(), m.at("max_tool_travel_since_search_mm").get<double>());
   };
   const auto firm = outran("");
