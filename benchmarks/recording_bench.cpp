@@ -46,7 +46,7 @@ Surfaces& surfaces() {
     out.grid = rec.header().grid;
     out.minutes = rec.duration_s() / 60.0;
     const auto bytes = rec.bytes_by_type();
-    out.other_bytes_per_min = static_cast<double>(rec.bytes().size() - bytes[static_cast<int>(ChunkType::kKeyframe)]) / out.minutes;
+    out.other_bytes_per_min = static_cast<double>(rec.file_bytes() - bytes[static_cast<int>(ChunkType::kKeyframe)]) / out.minutes;
     Result<std::unique_ptr<Replayer>> replayer = Replayer::create(rec);
     if (!replayer) std::exit(2);
     const std::size_t count = rec.keyframes().size();
@@ -141,7 +141,7 @@ void print_demo_size() {
     std::printf("%-10s %12llu %12.3f\n", std::string(chunk_type_name(static_cast<std::uint16_t>(type))).c_str(),
                 static_cast<unsigned long long>(bytes[static_cast<std::size_t>(type)]), static_cast<double>(bytes[static_cast<std::size_t>(type)]) / minutes / 1e6);
   }
-  std::printf("%-10s %12zu %12.3f\n", "file", r.bytes().size(), static_cast<double>(r.bytes().size()) / minutes / 1e6);
+  std::printf("%-10s %12zu %12.3f\n", "file", r.file_bytes(), static_cast<double>(r.file_bytes()) / minutes / 1e6);
 }
 
 }  // namespace

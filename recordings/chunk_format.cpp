@@ -23,9 +23,11 @@ std::uint32_t load_u32(const std::uint8_t* p) {
 enum class ChunkCheck { kNoMarker, kFrameCrcFails, kTooLong, kCutShort, kPayloadCrcFails, kIntact };
 
 /// Checks the chunk whose marker may be at `pos`; `chunk` is filled from kTooLong on.
-ChunkCheck check_chunk_at(std::span<const std::uint8_t> file, std::uint64_t limit, std::uint64_t pos, ChunkLocation& chunk) {
+ChunkCheck check_chunk_at(ByteWindow& file, std::uint64_t limit, std::uint64_t pos, ChunkLocation& chunk) {
   if (pos >= limit || limit - pos < kChunkFrameBytes) return ChunkCheck::kNoMarker;
-  const std::uint8_t* frame = file.data() + pos;
+  const std::span<const std::uint8_t> frame_bytes = file.at(pos, kChunkFrameBytes);
+  if (frame_bytes.empty()) return ChunkCheck::kNoMarker;  // unreadable: as if the file ended
+  const std::uint8_t* frame = frame_bytes.data();
   if (load_u32(frame) != kChunkMarker) return ChunkCheck::kNoMarker;
   if (crc32_of(std::span<const std::uint8_t>(frame, 16)) != load_u32(frame + 16)) return ChunkCheck::kFrameCrcFails;
   ByteReader reader(std::span<const std::uint8_t>(frame + 4, 12));
@@ -36,14 +38,16 @@ ChunkCheck check_chunk_at(std::span<const std::uint8_t> file, std::uint64_t limi
   chunk.payload_bytes = reader.get<std::uint32_t>();
   if (chunk.payload_bytes > kMaxChunkPayloadBytes) return ChunkCheck::kTooLong;
   if (limit - pos < kChunkFrameBytes + std::uint64_t{chunk.payload_bytes} + kChunkTrailerBytes) return ChunkCheck::kCutShort;
-  const std::span<const std::uint8_t> payload(file.data() + chunk.payload_offset(), chunk.payload_bytes);
-  return crc32_of(payload) == load_u32(file.data() + chunk.payload_offset() + chunk.payload_bytes) ? ChunkCheck::kIntact
-                                                                                                  : ChunkCheck::kPayloadCrcFails;
+  const std::span<const std::uint8_t> payload_and_crc = file.at(chunk.payload_offset(), std::size_t{chunk.payload_bytes} + kChunkTrailerBytes);
+  if (payload_and_crc.empty()) return ChunkCheck::kCutShort;
+  return crc32_of(payload_and_crc.first(chunk.payload_bytes)) == load_u32(payload_and_crc.data() + chunk.payload_bytes)
+             ? ChunkCheck::kIntact
+             : ChunkCheck::kPayloadCrcFails;
 }
 
 /// The chunk whose marker is at `pos`, if its frame is intact (CRC, plausible length, inside the
 /// file); `payload_ok` tells whether the payload's CRC holds too.
-bool parse_chunk_at(std::span<const std::uint8_t> file, std::uint64_t limit, std::uint64_t pos, ChunkLocation& chunk,
+bool parse_chunk_at(ByteWindow& file, std::uint64_t limit, std::uint64_t pos, ChunkLocation& chunk,
                     bool& payload_ok) {
   const ChunkCheck check = check_chunk_at(file, limit, pos, chunk);
   payload_ok = check == ChunkCheck::kIntact;
@@ -82,8 +86,9 @@ void append_chunk(std::vector<std::uint8_t>& out, ChunkType type, std::uint32_t 
   w.put(crc32_of(payload));
 }
 
-std::string describe_chunk_at(std::span<const std::uint8_t> file, std::uint64_t pos) {
-  if (pos >= file.size()) return "the end of the file";
+std::string describe_chunk_at(const RecordingBytes& bytes, std::uint64_t pos) {
+  if (pos >= bytes.size()) return "the end of the file";
+  ByteWindow file(bytes);
   ChunkLocation chunk;
   const ChunkCheck check = check_chunk_at(file, file.size(), pos, chunk);
   const std::string a_chunk = "a " + std::string(chunk_type_name(chunk.type)) + " chunk";
@@ -112,20 +117,23 @@ std::string describe(const DamagedRange& range) {
   return text;
 }
 
-ChunkScan scan_chunks(std::span<const std::uint8_t> file) {
+ChunkScan scan_chunks(const RecordingBytes& bytes, std::size_t window_bytes) {
+  ByteWindow file(bytes, window_bytes);
   ChunkScan scan;
   scan.file_bytes = file.size();
   std::uint64_t pos = 0;
-  if (file.size() >= sizeof kFileSignature && std::memcmp(file.data(), kFileSignature, sizeof kFileSignature) == 0) {
+  if (const auto signature = file.at(0, sizeof kFileSignature);
+      !signature.empty() && std::memcmp(signature.data(), kFileSignature, sizeof kFileSignature) == 0) {
     scan.signature_ok = true;
     pos = sizeof kFileSignature;
   }
   // A clean close leaves a trailer naming the index chunk; the scan then stops before the trailer.
   std::uint64_t limit = file.size();
-  if (file.size() >= sizeof kFileSignature + kFileTrailerBytes &&
-      std::memcmp(file.data() + file.size() - 8, kTrailerMagic, sizeof kTrailerMagic) == 0) {
+  const std::span<const std::uint8_t> trailer =
+      file.size() >= sizeof kFileSignature + kFileTrailerBytes ? file.at(file.size() - kFileTrailerBytes, kFileTrailerBytes) : std::span<const std::uint8_t>();
+  if (!trailer.empty() && std::memcmp(trailer.data() + 8, kTrailerMagic, sizeof kTrailerMagic) == 0) {
     std::uint64_t index_at = 0;
-    std::memcpy(&index_at, file.data() + file.size() - kFileTrailerBytes, 8);
+    std::memcpy(&index_at, trailer.data(), 8);
     ChunkLocation index;
     bool payload_ok = false;
     const std::uint64_t body = file.size() - kFileTrailerBytes;
@@ -163,10 +171,18 @@ ChunkScan scan_chunks(std::span<const std::uint8_t> file) {
       in_garbage = true;
       garbage_from = pos;
     }
-    // Resynchronise: the next byte that could start a marker.
-    const auto* next = static_cast<const std::uint8_t*>(
-        std::memchr(file.data() + pos + 1, kChunkMarker & 0xff, static_cast<std::size_t>(limit - pos - 1)));
-    pos = next ? static_cast<std::uint64_t>(next - file.data()) : limit;
+    // Resynchronise: the next byte that could start a marker, searched a block at a time.
+    std::uint64_t from = pos + 1;
+    pos = limit;
+    while (from < limit) {
+      const std::span<const std::uint8_t> block = file.at(from, static_cast<std::size_t>(std::min<std::uint64_t>(file.block_bytes(), limit - from)));
+      if (block.empty()) break;  // unreadable: as if the file ended
+      if (const auto* next = static_cast<const std::uint8_t*>(std::memchr(block.data(), kChunkMarker & 0xff, block.size()))) {
+        pos = from + static_cast<std::uint64_t>(next - block.data());
+        break;
+      }
+      from += block.size();
+    }
   }
   close_garbage(limit);
   scan.tail_bytes = limit - last_end;

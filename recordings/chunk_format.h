@@ -11,6 +11,8 @@
 #include <string_view>
 #include <vector>
 
+#include "recordings/recording_bytes.h"
+
 namespace resecto::rec {
 
 /// The file's first 8 bytes, "RSREC\r\n\x1a": the CR LF catches a text-mode transfer and the ^Z
@@ -71,11 +73,11 @@ struct DamagedRange {
   bool frame_intact = false;
 };
 
-/// What the bytes at `pos` of `file` hold, for a reader that expected a chunk there: "a ticks chunk
+/// What the bytes at `pos` of `bytes` hold, for a reader that expected a chunk there: "a ticks chunk
 /// (3601 bytes)", "a header chunk whose frame claims 2335 bytes, but the file ends at byte 1000 (cut
 /// short)", "a header chunk whose payload CRC fails", "a chunk frame whose own CRC fails", "no chunk
 /// marker", or "the end of the file".
-std::string describe_chunk_at(std::span<const std::uint8_t> file, std::uint64_t pos);
+std::string describe_chunk_at(const RecordingBytes& bytes, std::uint64_t pos);
 
 /// One line saying what a damaged range is and where ("keyframe chunk 80 at byte 223687 (3601 bytes):
 /// payload CRC mismatch"), as `rec info`, `rec verify` and the keyframe lookup print it.
@@ -93,9 +95,14 @@ struct ChunkScan {
   std::uint64_t tail_bytes = 0;
 };
 
-/// Walks `file` chunk by chunk, checking both CRCs of each; on a bad frame it searches forward for
+/// Walks the file chunk by chunk, checking both CRCs of each; on a bad frame it searches forward for
 /// the next marker, on a bad payload it skips the chunk by its (CRC-checked) length. Never reads
-/// outside `file`, never allocates from a length field.
-ChunkScan scan_chunks(std::span<const std::uint8_t> file);
+/// outside the file, never allocates from a length field beyond kMaxChunkPayloadBytes; holds
+/// `window_bytes` of the file (or the chunk, when larger) at a time.
+ChunkScan scan_chunks(const RecordingBytes& bytes, std::size_t window_bytes = ByteWindow::kDefaultBlockBytes);
+/// The same over bytes in memory (tests, fuzzing; copied).
+inline ChunkScan scan_chunks(std::span<const std::uint8_t> file) {
+  return scan_chunks(RecordingBytes(std::vector<std::uint8_t>(file.begin(), file.end())));
+}
 
 }  // namespace resecto::rec

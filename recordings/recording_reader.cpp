@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <optional>
@@ -77,21 +78,28 @@ Result<Recording> Recording::open(const std::filesystem::path& path) {
   // read for ever (/dev/zero filled the memory).
   std::error_code error;
   if (std::filesystem::is_directory(path, error)) return Error{path.string() + ": is a folder, not a recording"};
-  Result<std::vector<std::uint8_t>> bytes = read_regular_file<std::vector<std::uint8_t>>(path, " the recording", kMaxBinaryFileBytes);
+  Result<RecordingBytes> bytes = RecordingBytes::open(path);
   if (!bytes) return Error{bytes.error()};
-  return from_bytes(std::move(*bytes), path.string());
+  return from_source(std::move(*bytes), path.string());
 }
 
 Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::string name) {
+  return from_source(RecordingBytes(std::move(bytes)), std::move(name));
+}
+
+Result<Recording> Recording::from_source(RecordingBytes bytes, std::string name) {
   Recording r;
   r.name_ = name;
   r.bytes_ = std::move(bytes);
   r.scan_ = scan_chunks(r.bytes_);
   if (!r.scan_.signature_ok) {
     // An empty file, or one cut inside the signature, is a recording cut short, not some other file.
-    if (r.bytes_.empty()) return Error{name + ": the file is empty (a recording cut off before its first byte)"};
-    if (r.bytes_.size() < sizeof kFileSignature && std::equal(r.bytes_.begin(), r.bytes_.end(), kFileSignature)) {
-      return Error{name + ": truncated: " + std::to_string(r.bytes_.size()) + " bytes, cut inside the recording's " +
+    const std::uint64_t size = r.bytes_.size();
+    if (size == 0) return Error{name + ": the file is empty (a recording cut off before its first byte)"};
+    std::uint8_t start[sizeof kFileSignature] = {};
+    if (size < sizeof kFileSignature && r.bytes_.read(0, std::span(start, static_cast<std::size_t>(size))) &&
+        std::equal(start, start + size, kFileSignature)) {
+      return Error{name + ": truncated: " + std::to_string(size) + " bytes, cut inside the recording's " +
                    std::to_string(sizeof kFileSignature) + "-byte signature"};
     }
     return Error{name + ": not a Resecto recording (bad signature)"};
@@ -109,8 +117,13 @@ Result<Recording> Recording::from_bytes(std::vector<std::uint8_t> bytes, std::st
       break;
     }
     const ChunkLocation& chunk = r.scan_.chunks[c];
-    const std::span<const std::uint8_t> payload = r.payload(chunk);
     const std::string where = std::string(chunk_type_name(chunk.type)) + " chunk " + std::to_string(chunk.sequence) + " at byte " + std::to_string(chunk.offset);
+    const Result<std::vector<std::uint8_t>> read = r.read_payload(chunk, false);
+    if (!read) {
+      // Cut or overwritten between the scan and this read: what is left cannot be trusted.
+      return Error{read.error()};
+    }
+    const std::span<const std::uint8_t> payload = *read;
     switch (static_cast<ChunkType>(chunk.type)) {
       case ChunkType::kHeader: {
         Result<SessionHeader> header = header_from_json(std::string_view(reinterpret_cast<const char*>(payload.data()), payload.size()));
@@ -236,8 +249,9 @@ void Recording::check_index(std::span<const IndexEntry> entries, const std::stri
       problem = "points where no chunk starts";
     } else if (at_chunk) {
       // The first tick is what a reader seeking by time trusts the index for.
-      const std::uint64_t first_tick = first_tick_of(chunk->type, payload(*chunk));
-      if (first_tick != entry.first_tick) {
+      const Result<std::vector<std::uint8_t>> read = read_payload(*chunk, false);
+      const std::uint64_t first_tick = read ? first_tick_of(chunk->type, *read) : 0;
+      if (read && first_tick != entry.first_tick) {
         problem = "gives the " + std::string(chunk_type_name(entry.type)) + " chunk's first tick as " + std::to_string(entry.first_tick) +
                   ", the chunk starts at tick " + std::to_string(first_tick);
       }
@@ -369,8 +383,18 @@ std::optional<std::uint64_t> Recording::summary_count(std::string_view key) cons
 
 std::uint64_t Recording::recovered_damaged_ranges() const { return summary_count("recovered.damaged_ranges").value_or(0); }
 
-std::span<const std::uint8_t> Recording::payload(const ChunkLocation& chunk) const {
-  return std::span<const std::uint8_t>(bytes_).subspan(chunk.payload_offset(), chunk.payload_bytes);
+Result<std::vector<std::uint8_t>> Recording::payload(const ChunkLocation& chunk) const { return read_payload(chunk, true); }
+
+Result<std::vector<std::uint8_t>> Recording::read_payload(const ChunkLocation& chunk, bool check_crc) const {
+  std::vector<std::uint8_t> payload(std::size_t{chunk.payload_bytes} + kChunkTrailerBytes);
+  const std::string where = name_ + ": " + std::string(chunk_type_name(chunk.type)) + " chunk " + std::to_string(chunk.sequence) + " at byte " +
+                            std::to_string(chunk.offset);
+  if (!bytes_.read(chunk.payload_offset(), payload)) return Error{where + " can no longer be read (the file was cut shorter since it was opened?)"};
+  std::uint32_t crc = 0;
+  std::memcpy(&crc, payload.data() + chunk.payload_bytes, sizeof crc);
+  payload.resize(chunk.payload_bytes);
+  if (check_crc && crc32_of(payload) != crc) return Error{where + " changed since the recording was opened (its CRC no longer holds)"};
+  return payload;
 }
 
 std::optional<std::size_t> Recording::keyframe_at_time(double time_s) const {
@@ -379,9 +403,13 @@ std::optional<std::size_t> Recording::keyframe_at_time(double time_s) const {
   return static_cast<std::size_t>(after - keyframes_.begin() - 1);
 }
 
-std::span<const std::uint8_t> Recording::keyframe_draco(std::size_t k) const {
-  Result<KeyframeRecord> record = decode_keyframe_payload(payload(scan_.chunks[keyframes_.at(k).chunk]));
-  return record ? record->draco : std::span<const std::uint8_t>();
+Result<std::vector<std::uint8_t>> Recording::keyframe_draco(std::size_t k) const {
+  const Result<std::vector<std::uint8_t>> bytes = payload(scan_.chunks[keyframes_.at(k).chunk]);
+  if (!bytes) return Error{bytes.error()};
+  // The record decoded at open; its Draco bytes are the payload's tail.
+  Result<KeyframeRecord> record = decode_keyframe_payload(*bytes);
+  if (!record) return Error{keyframe_place(k) + ": " + record.error()};
+  return std::vector<std::uint8_t>(record->draco.begin(), record->draco.end());
 }
 
 std::string Recording::keyframe_place(std::size_t k) const {
@@ -394,7 +422,9 @@ Result<SurfaceFrame> Recording::decode_keyframe(std::size_t k) const {
   if (k >= keyframes_.size()) {
     return Error{name_ + ": keyframe " + std::to_string(k) + " does not exist (" + std::to_string(keyframes_.size()) + " recorded)"};
   }
-  Result<SurfaceFrame> frame = rec::decode_keyframe(keyframe_draco(k));
+  const Result<std::vector<std::uint8_t>> draco = keyframe_draco(k);
+  if (!draco) return Error{draco.error()};
+  Result<SurfaceFrame> frame = rec::decode_keyframe(*draco);
   if (!frame) return Error{keyframe_place(k) + ": " + frame.error()};
   if (frame->positions.size() != keyframes_[k].vertex_count || frame->triangles.size() != keyframes_[k].triangle_count) {
     return Error{keyframe_place(k) + ": decoded " + std::to_string(frame->positions.size()) + " vertices and " +

@@ -1,8 +1,9 @@
 // Recording: a recording file opened for reading, replay and browsing (the console's replay panel
-// uses this API; see recordings/README.md). Opening reads the file, scans every chunk (a file with
-// no index, cut or killed, reads the same way as a closed one: every whole chunk is kept, a damaged
-// chunk is lost alone), parses the header and decodes the ticks, steps and commands. Keyframes are
-// indexed at open and decoded on demand. A Recording is immutable once open.
+// uses this API; see recordings/README.md). Opening scans every chunk (a file with no index, cut or
+// killed, reads the same way as a closed one: every whole chunk is kept, a damaged chunk is lost
+// alone), parses the header and decodes the ticks, steps and commands. The file's bytes stay on
+// disk: keyframes are indexed at open and read and decoded on demand. A Recording is immutable once
+// open.
 #pragma once
 
 #include <array>
@@ -19,6 +20,7 @@
 
 #include "recordings/chunk_format.h"
 #include "recordings/keyframe_codec.h"
+#include "recordings/recording_bytes.h"
 #include "recordings/recording_writer.h"
 #include "recordings/records.h"
 #include "recordings/session_header.h"
@@ -95,7 +97,7 @@ class Recording {
   /// over the positions.
   Result<SurfaceFrame> decode_keyframe(std::size_t k) const;
   /// The keyframe's Draco bytes as stored (a valid .drc file).
-  std::span<const std::uint8_t> keyframe_draco(std::size_t k) const;
+  Result<std::vector<std::uint8_t>> keyframe_draco(std::size_t k) const;
   /// The summary chunk's JSON (null when the run did not close the file).
   const nlohmann::ordered_json& summary() const { return summary_; }
   /// A count the recorder wrote in its summary (`ticks`, `steps`, `commands`, `keyframes`, or
@@ -127,12 +129,16 @@ class Recording {
   /// Bytes of intact chunks (frames included) by chunk type (index = ChunkType value).
   std::array<std::uint64_t, kChunkTypeCount> bytes_by_type() const;
   std::array<std::uint64_t, kChunkTypeCount> chunks_by_type() const;
-  std::span<const std::uint8_t> payload(const ChunkLocation& chunk) const;
-  std::span<const std::uint8_t> bytes() const { return bytes_; }
+  /// A chunk's payload, read from the file; an error if the file no longer holds it as the scan found
+  /// it (its CRC is checked again: the file may have been cut or overwritten since it was opened).
+  Result<std::vector<std::uint8_t>> payload(const ChunkLocation& chunk) const;
+  /// The file's size when it was opened.
+  std::uint64_t file_bytes() const { return scan_.file_bytes; }
   /// The name errors give the recording by (its path when opened from a file).
   const std::string& name() const { return name_; }
 
  private:
+  static Result<Recording> from_source(RecordingBytes bytes, std::string name);
   /// Where keyframe k's errors point: the file, the keyframe and its chunk's place in the file.
   std::string keyframe_place(std::size_t k) const;
   /// Index entries that do not match the chunks (index_problems()).
@@ -144,8 +150,11 @@ class Recording {
   /// find_keyframe's error for a number the file lacks; `next` indexes the first keyframe numbered after it.
   std::string why_keyframe_missing(std::uint64_t number, std::size_t next) const;
 
+  /// The payload as the scan found it, read without checking its CRC again (the scan just did).
+  Result<std::vector<std::uint8_t>> read_payload(const ChunkLocation& chunk, bool check_crc) const;
+
   std::string name_;
-  std::vector<std::uint8_t> bytes_;
+  RecordingBytes bytes_{std::vector<std::uint8_t>()};
   ChunkScan scan_;
   SessionHeader header_;
   std::vector<TickRecord> ticks_;

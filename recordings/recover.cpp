@@ -22,20 +22,34 @@ Status write_bytes_atomically(const std::filesystem::path& out, std::span<const 
 
 }  // namespace
 
-std::vector<std::uint8_t> recovered_bytes(const Recording& recording, RecoverReport& report) {
+namespace {
+
+/// Writes the recovered file's bytes to `write` a chunk at a time, so a recovery holds one chunk of
+/// the recording, not the whole file twice.
+template <class Write>
+Status write_recovered(const Recording& recording, RecoverReport& report, Write write) {
   report = {};
   std::vector<std::uint8_t> out(std::begin(kFileSignature), std::end(kFileSignature));
+  std::uint64_t written = 0;
+  auto flush = [&]() -> Status {
+    Status status = write(std::span<const std::uint8_t>(out));
+    written += out.size();
+    out.clear();
+    return status;
+  };
   std::vector<IndexEntry> index;
-  auto add = [&](ChunkType type, std::span<const std::uint8_t> payload, std::uint64_t first_tick) {
+  auto add = [&](ChunkType type, std::span<const std::uint8_t> payload, std::uint64_t first_tick) -> Status {
     const auto sequence = static_cast<std::uint32_t>(index.size());
-    index.push_back({out.size(), static_cast<std::uint16_t>(type), sequence, first_tick, static_cast<std::uint32_t>(payload.size())});
+    index.push_back({written + out.size(), static_cast<std::uint16_t>(type), sequence, first_tick, static_cast<std::uint32_t>(payload.size())});
     append_chunk(out, type, sequence, payload);
     ++report.chunks_kept;
+    return flush();
   };
   for (const ChunkLocation& chunk : recording.chunks()) {
     if (chunk.type == static_cast<std::uint16_t>(ChunkType::kIndex) || chunk.type == static_cast<std::uint16_t>(ChunkType::kSummary)) continue;
-    const std::span<const std::uint8_t> payload = recording.payload(chunk);
-    add(static_cast<ChunkType>(chunk.type), payload, first_tick_of(chunk.type, payload));
+    const Result<std::vector<std::uint8_t>> payload = recording.payload(chunk);
+    if (!payload) return Error{payload.error()};
+    if (Status added = add(static_cast<ChunkType>(chunk.type), *payload, first_tick_of(chunk.type, *payload)); !added) return added;
   }
   nlohmann::ordered_json summary = recording.summary().is_object() ? recording.summary() : nlohmann::ordered_json::object();
   // A recovery of a recovered file keeps the count of what earlier recoveries left out: replay and
@@ -45,17 +59,37 @@ std::vector<std::uint8_t> recovered_bytes(const Recording& recording, RecoverRep
                           {"replayable_ticks", recording.replayable_ticks()},
                           {"index_was_present", recording.index_present()}};
   const std::string text = summary.dump();
-  add(ChunkType::kSummary, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()), 0);
-  append_index_and_trailer(out, 0, index, static_cast<std::uint32_t>(index.size()));
+  if (Status added = add(ChunkType::kSummary, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()), 0); !added) return added;
+  append_index_and_trailer(out, written, index, static_cast<std::uint32_t>(index.size()));
   report.damaged_ranges = recording.damaged().size();
   report.replayable_ticks = recording.replayable_ticks();
-  return out;
+  return flush();
+}
+
+}  // namespace
+
+Result<std::vector<std::uint8_t>> recovered_bytes(const Recording& recording, RecoverReport& report) {
+  std::vector<std::uint8_t> bytes;
+  const Status made = write_recovered(recording, report, [&](std::span<const std::uint8_t> chunk) -> Status {
+    bytes.insert(bytes.end(), chunk.begin(), chunk.end());
+    return Ok{};
+  });
+  if (!made) return Error{made.error()};
+  return bytes;
 }
 
 Result<RecoverReport> recover(const Recording& recording, const std::filesystem::path& out) {
   RecoverReport report;
-  const std::vector<std::uint8_t> bytes = recovered_bytes(recording, report);
-  if (Status written = write_bytes_atomically(out, bytes); !written) return Error{written.error()};
+  AtomicFile file;
+  if (Status opened = file.open(out); !opened) return Error{opened.error()};
+  const Status made = write_recovered(recording, report, [&](std::span<const std::uint8_t> chunk) {
+    return file.write(std::string_view(reinterpret_cast<const char*>(chunk.data()), chunk.size()));
+  });
+  if (!made) {
+    file.discard();
+    return Error{made.error()};
+  }
+  if (Status committed = file.commit(); !committed) return Error{committed.error()};
   return report;
 }
 
@@ -63,7 +97,11 @@ Status export_keyframe(const Recording& recording, std::size_t k, const std::fil
   if (k >= recording.keyframes().size()) {
     return Error{recording.name() + ": keyframe " + std::to_string(k) + " does not exist (" + std::to_string(recording.keyframes().size()) + " recorded)"};
   }
-  if (lower_extension(out) == ".drc") return write_bytes_atomically(out, recording.keyframe_draco(k));
+  if (lower_extension(out) == ".drc") {
+    const Result<std::vector<std::uint8_t>> draco = recording.keyframe_draco(k);
+    if (!draco) return Error{draco.error()};
+    return write_bytes_atomically(out, *draco);
+  }
   Result<SurfaceFrame> frame = recording.decode_keyframe(k);
   if (!frame) return Error{frame.error()};
   TriangleMesh mesh;
@@ -75,8 +113,11 @@ Status export_keyframe(const Recording& recording, std::size_t k, const std::fil
 Status export_inputs_csv(const Recording& recording, const std::filesystem::path& out) {
   // The edges' units (DESIGN.md): degrees and millimetres, in a procedure file's column order and
   // names, so a recorded hand can be read beside (or turned into) a procedure. 17 digits: a double's
-  // every bit of the converted value.
+  // every bit of the converted value. Written in blocks: an hour at 960 Hz is half a gigabyte of text.
+  AtomicFile file;
+  if (Status opened = file.open(out); !opened) return opened;
   std::string text = "tick,time_s,yaw_deg,pitch_deg,roll_deg,insertion_mm,loop_mm,cut,coagulate,tool_present\n";
+  constexpr std::size_t kBlockBytes = std::size_t{1} << 20;
   const double tick_s = recording.header().simulation.tick_s();
   char line[512];
   for (const TickRecord& t : recording.ticks()) {
@@ -86,8 +127,12 @@ Status export_inputs_csv(const Recording& recording, const std::filesystem::path
                   units::m_to_mm(j.insertion_m), units::m_to_mm(j.loop_travel_m), t.input.cut ? 1 : 0, t.input.coagulate ? 1 : 0,
                   t.input.tool_present ? 1 : 0);
     text += line;
+    if (text.size() < kBlockBytes) continue;
+    if (Status wrote = file.write(text); !wrote) return wrote;  // the temporary is removed with `file`
+    text.clear();
   }
-  return write_file_atomically(out, text);
+  if (Status wrote = file.write(text); !wrote) return wrote;
+  return file.commit();
 }
 
 }  // namespace resecto::rec

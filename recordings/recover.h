@@ -19,10 +19,10 @@ struct RecoverReport {
 
 /// A complete recording made of every intact chunk of `recording` except its old index and summary,
 /// renumbered, then a summary (the original's if it had one, noting the recovery), a new index and
-/// the trailer.
-std::vector<std::uint8_t> recovered_bytes(const Recording& recording, RecoverReport& report);
+/// the trailer. An error when a chunk can no longer be read (the file changed since it was opened).
+Result<std::vector<std::uint8_t>> recovered_bytes(const Recording& recording, RecoverReport& report);
 
-/// recovered_bytes() written to `out` (through a temporary file, renamed).
+/// The same file written to `out` a chunk at a time (through a temporary file, renamed).
 Result<RecoverReport> recover(const Recording& recording, const std::filesystem::path& out);
 
 /// Writes keyframe `k`: `.drc` as stored (Draco's own tools read it), or `.ply`, `.obj`, `.off`,

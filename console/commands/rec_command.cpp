@@ -41,7 +41,7 @@ std::string index_state(const rec::Recording& r) {
   const rec::ChunkLocation* index = r.index_chunk();
   if (index == nullptr) return "absent: the recording was not closed";
   // Cut right after the index, or bytes after it (appended, or a damaged trailer): said as it is.
-  if (index->end() >= r.bytes().size()) {
+  if (index->end() >= r.file_bytes()) {
     return "intact at byte " + std::to_string(index->offset) + ", but the file ends with it, at byte " + std::to_string(index->end()) +
            ", without the trailer that follows it (the file was cut short): the recording was closed";
   }
@@ -60,7 +60,7 @@ void info(const InfoOptions& o) {
     byte_counts[name] = bytes[static_cast<std::size_t>(type)];
   }
   chunk_counts["total"] = r.chunks().size();
-  byte_counts["file"] = r.bytes().size();
+  byte_counts["file"] = r.file_bytes();
   ordered_json damaged = ordered_json::array();
   for (const rec::DamagedRange& d : r.damaged()) {
     damaged.push_back({{"offset", d.offset}, {"bytes", d.bytes}, {"description", rec::describe(d)}});
@@ -118,7 +118,7 @@ void info(const InfoOptions& o) {
   for (const auto& [name, count] : chunk_counts.items()) {
     if (name != "total" && count.get<std::uint64_t>() > 0) std::printf(" %s %llu", name.c_str(), static_cast<unsigned long long>(count.get<std::uint64_t>()));
   }
-  std::printf("\n  bytes      %zu:", r.bytes().size());
+  std::printf("\n  bytes      %zu:", r.file_bytes());
   for (const auto& [name, count] : byte_counts.items()) {
     if (name != "file" && count.get<std::uint64_t>() > 0) std::printf(" %s %llu", name.c_str(), static_cast<unsigned long long>(count.get<std::uint64_t>()));
   }

@@ -25,11 +25,9 @@ inline constexpr std::uintmax_t kMaxTextFileBytes = std::uintmax_t{64} << 20;
 /// The largest binary input (a recording) read whole: 8 GiB, a third of a large workstation's memory.
 inline constexpr std::uintmax_t kMaxBinaryFileBytes = std::uintmax_t{8} << 30;
 
-/// The file's bytes in `Bytes` (std::string, std::vector<std::uint8_t>), or an error "<path>: <why>"
-/// (missing, a folder, not a regular file, over `max_bytes`, unreadable). `what` names the file's
-/// role in the open error, e.g. " the procedure file".
-template <class Bytes>
-Result<Bytes> read_regular_file(const std::filesystem::path& path, const std::string& what, std::uintmax_t max_bytes) {
+/// The size of the regular file at `path`, or why it is not one to read: missing (or a link to
+/// nothing), a folder, a device or pipe, over `max_bytes`. `what` as read_regular_file's.
+inline Result<std::uintmax_t> regular_file_size(const std::filesystem::path& path, const std::string& what, std::uintmax_t max_bytes) {
   const std::string name = path.string();
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(path, ec);
@@ -49,6 +47,18 @@ Result<Bytes> read_regular_file(const std::filesystem::path& path, const std::st
   if (size > max_bytes) {
     return Error{name + ": " + std::to_string(size) + " bytes, more than the " + std::to_string(max_bytes) + "-byte limit for this input"};
   }
+  return size;
+}
+
+/// The file's bytes in `Bytes` (std::string, std::vector<std::uint8_t>), or an error "<path>: <why>"
+/// (missing, a folder, not a regular file, over `max_bytes`, unreadable). `what` names the file's
+/// role in the open error, e.g. " the procedure file".
+template <class Bytes>
+Result<Bytes> read_regular_file(const std::filesystem::path& path, const std::string& what, std::uintmax_t max_bytes) {
+  const std::string name = path.string();
+  const Result<std::uintmax_t> checked = regular_file_size(path, what, max_bytes);
+  if (!checked) return Error{checked.error()};
+  const std::uintmax_t size = *checked;
   std::FILE* file = std::fopen(name.c_str(), "rb");
   if (file == nullptr) return Error{name + ": cannot open" + what + ": " + std::strerror(errno)};  // e.g. "Permission denied"
   // Read at most one byte past the size seen: a file that grows meanwhile is cut, never read forever.

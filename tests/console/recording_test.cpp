@@ -59,7 +59,7 @@ void rewrite(const rec::Recording& r, const std::filesystem::path& out, Edit edi
   ASSERT_TRUE(writer.open(out));
   for (const rec::ChunkLocation& chunk : r.chunks()) {
     if (is(chunk, rec::ChunkType::kIndex)) continue;
-    std::vector<std::uint8_t> payload(r.payload(chunk).begin(), r.payload(chunk).end());
+    std::vector<std::uint8_t> payload = r.payload(chunk).value();
     // Each entry's first tick as the recorder writes it: `rec verify` checks it against the chunk.
     if (edit(chunk, payload)) writer.add_chunk(static_cast<rec::ChunkType>(chunk.type), payload, rec::first_tick_of(chunk.type, payload));
   }
@@ -68,7 +68,9 @@ void rewrite(const rec::Recording& r, const std::filesystem::path& out, Edit edi
 
 /// A copy of `r` at `out` with `mask` flipped in the middle byte of `victim`'s payload: its CRC fails.
 void write_with_a_bit_flipped(const rec::Recording& r, const rec::ChunkLocation& victim, std::uint8_t mask, const std::filesystem::path& out) {
-  std::vector<std::uint8_t> bytes(r.bytes().begin(), r.bytes().end());
+  std::ifstream in(r.name(), std::ios::binary);
+  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_EQ(bytes.size(), r.file_bytes()) << r.name();
   bytes[victim.payload_offset() + victim.payload_bytes / 2] ^= mask;
   std::ofstream(out, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
 }
@@ -250,7 +252,7 @@ TEST(RecordingCommands, TicksRecordedTwiceWithDifferentInputsAreAProblemForEvery
     std::vector<std::uint8_t> copy;
     for (const rec::ChunkLocation& chunk : r->chunks()) {
       if (is(chunk, rec::ChunkType::kIndex)) continue;
-      const std::span<const std::uint8_t> payload = r->payload(chunk);
+      const std::vector<std::uint8_t> payload = r->payload(chunk).value();
       writer.add_chunk(static_cast<rec::ChunkType>(chunk.type), payload, rec::first_tick_of(chunk.type, payload));
       if (!is(chunk, rec::ChunkType::kTicks) || !copy.empty()) continue;
       // Right after the first ticks chunk, its ticks again with the sheath 20 mm deeper from tick 100.
@@ -516,7 +518,10 @@ TEST(RecordingCommands, AFileCutInsideItsHeaderSaysWhereAndWhat) {
   const auto [dir, file, r] = record_and_open("recording_cut_header", "--seconds 1");
   ASSERT_TRUE(r);
   const auto cut = dir / "cut.rsrec";
-  std::ofstream(cut, std::ios::binary).write(reinterpret_cast<const char*>(r->bytes().data()), 200);
+  std::ifstream in(file, std::ios::binary);
+  std::vector<char> start(200);
+  ASSERT_TRUE(in.read(start.data(), static_cast<std::streamsize>(start.size())));
+  std::ofstream(cut, std::ios::binary).write(start.data(), static_cast<std::streamsize>(start.size()));
   for (const std::string command : {"rec verify ", "replay ", "score "}) {
     const testing::CommandOutput out = run_resecto(command + cut.string());
     EXPECT_NE(out.exit_code, 0) << command;

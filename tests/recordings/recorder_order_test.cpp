@@ -30,7 +30,7 @@ TEST(RecorderChunkOrder, EveryPrefixOfTheFileHoldsTheInputsOfItsHashesAndTheComm
   std::vector<ParameterCommand> commands_written;
   std::size_t steps_chunks = 0;
   for (const ChunkLocation& chunk : recording->chunks()) {
-    const auto payload = recording->payload(chunk);
+    const std::vector<std::uint8_t> payload = recording->payload(chunk).value();
     if (chunk.type == static_cast<std::uint16_t>(ChunkType::kCommands)) {
       Result<std::vector<ParameterCommand>> block = decode_command_block(payload);
       ASSERT_TRUE(block) << block.error();

@@ -148,12 +148,12 @@ TEST(RecordingFile, CutAtEveryByteKeepsExactlyTheWholeChunksBeforeTheCutAndRecov
     ASSERT_TRUE(r) << r.error();
     EXPECT_TRUE(r->content_errors().empty());
     RecoverReport report;
-    Result<Recording> back = Recording::from_bytes(recovered_bytes(*r, report));
+    const std::vector<std::uint8_t> bytes = recovered_bytes(*r, report).value();
+    Result<Recording> back = Recording::from_bytes(bytes);
     ASSERT_TRUE(back);
     EXPECT_TRUE(back->index_present()) << "cut at " << cut;
     EXPECT_TRUE(back->damaged().empty()) << "cut at " << cut;
     EXPECT_EQ(back->replayable_ticks(), r->replayable_ticks());
-    std::vector<std::uint8_t> bytes(back->bytes().begin(), back->bytes().end());
     auto [it, first] = recovered_by_whole_chunks.try_emplace(std::tuple(expected.size(), !r->damaged().empty(), r->index_present()), bytes);
     if (!first) {
       EXPECT_EQ(it->second, bytes) << "cut at " << cut;
@@ -220,7 +220,7 @@ TEST(RecordingFile, KeyframesAfterADamagedOneKeepTheirNumbers) {
   ASSERT_EQ(intact.chunks().back().type, static_cast<std::uint16_t>(ChunkType::kIndex));
   const std::vector<std::uint8_t> no_index(damaged.begin(), damaged.begin() + static_cast<std::ptrdiff_t>(intact.chunks().back().offset));
   RecoverReport report;
-  const std::vector<std::uint8_t> recovered = recovered_bytes(open_bytes(damaged), report);
+  const std::vector<std::uint8_t> recovered = recovered_bytes(open_bytes(damaged), report).value();
   for (const auto& [bytes, name] :
        {std::pair{&damaged, "damaged.rsrec"}, std::pair{&no_index, "no_index.rsrec"}, std::pair{&recovered, "recovered.rsrec"}}) {
     Result<Recording> r = Recording::from_bytes(*bytes, name);
@@ -281,7 +281,7 @@ TEST(RecordingFile, ARecoveredCutOrGappedRecordingDoesNotVerifyAsWhole) {
   ASSERT_NE(summary, intact.chunks().end());
   const std::vector<std::uint8_t> cut(live.file.begin(), live.file.begin() + static_cast<std::ptrdiff_t>(summary->offset + 30));
   RecoverReport report;
-  const std::vector<std::uint8_t> recovered = recovered_bytes(open_bytes(cut), report);
+  const std::vector<std::uint8_t> recovered = recovered_bytes(open_bytes(cut), report).value();
   ASSERT_EQ(report.damaged_ranges, 1u);
   const Result<Recording> once = Recording::from_bytes(recovered, "recovered.rsrec");
   ASSERT_TRUE(once);
@@ -291,22 +291,22 @@ TEST(RecordingFile, ARecoveredCutOrGappedRecordingDoesNotVerifyAsWhole) {
             "recovered.rsrec: `resecto rec recover` made it from a damaged recording that was never closed (1 "
             "damaged ranges left out): how many hashes those held is unknown: all " +
                 std::to_string(intact.steps().size()) + " collision steps' hashes in the file matched, which vouches for those alone");
-  const Result<Recording> twice = Recording::from_bytes(recovered_bytes(*once, report), "twice.rsrec");
+  const Result<Recording> twice = Recording::from_bytes(recovered_bytes(*once, report).value(), "twice.rsrec");
   ASSERT_TRUE(twice);
   EXPECT_EQ(twice->recovered_damaged_ranges(), 1u) << "a recovery of a recovery keeps the count";
   EXPECT_NE(unverified_after_replay(*twice), "");
 
   // A ticks chunk from the middle of the run lost: the replay stops there.
   const auto ticks = std::find_if(intact.chunks().begin(), intact.chunks().end(), [&](const ChunkLocation& c) {
-    return is(c, ChunkType::kTicks) && first_tick_of(c.type, intact.payload(c)) >= live.inputs.size() / 2;
+    return is(c, ChunkType::kTicks) && first_tick_of(c.type, intact.payload(c).value()) >= live.inputs.size() / 2;
   });
   ASSERT_NE(ticks, intact.chunks().end());
   const Result<Recording> gapped =
-      Recording::from_bytes(recovered_bytes(open_bytes(with_payload_damaged(live.file, *ticks)), report), "gapped.rsrec");
+      Recording::from_bytes(recovered_bytes(open_bytes(with_payload_damaged(live.file, *ticks)), report).value(), "gapped.rsrec");
   ASSERT_TRUE(gapped);
   const std::string gap = unverified_after_replay(*gapped);
   EXPECT_NE(gap.find("recorded hashes are of collision steps at or past tick " +
-                     std::to_string(first_tick_of(ticks->type, intact.payload(*ticks)))),
+                     std::to_string(first_tick_of(ticks->type, intact.payload(*ticks).value()))),
             std::string::npos)
       << gap;
 }
@@ -524,8 +524,10 @@ TEST(RecordingFile, AKeyframeThatDoesNotDecodeIsNamedByFileAndChunk) {
   ASSERT_GE(intact->keyframes().size(), 3u);
   EXPECT_EQ(intact->decode_keyframe(999).error(), "session.rsrec: keyframe 999 does not exist (" + std::to_string(intact->keyframes().size()) + " recorded)");
   const std::size_t k = 1;
-  const std::span<const std::uint8_t> draco = intact->keyframe_draco(k);
-  const auto draco_at = static_cast<std::size_t>(draco.data() - intact->bytes().data());
+  const std::vector<std::uint8_t> draco = intact->keyframe_draco(k).value();
+  // A keyframe's Draco bytes end its chunk's payload.
+  const ChunkLocation& keyframe_chunk = intact->chunks()[intact->keyframes()[k].chunk];
+  const std::size_t draco_at = keyframe_chunk.payload_offset() + keyframe_chunk.payload_bytes - draco.size();
   const std::vector<std::uint8_t> rebuilt = with_payloads_rewritten(file, [&](const ChunkLocation& chunk, std::vector<std::uint8_t>& payload) {
     if (draco_at < chunk.payload_offset() || draco_at >= chunk.payload_offset() + chunk.payload_bytes) return;
     const std::size_t from = draco_at - chunk.payload_offset();
@@ -641,7 +643,7 @@ TEST(RecordingFile, ASecondRecordingJoinedOnIsLeftOutAndNamed) {
   EXPECT_EQ(r->chunks().size(), original->chunks().size());
   EXPECT_EQ(r->ticks().size(), original->ticks().size());
   RecoverReport report;
-  Result<Recording> recovered = Recording::from_bytes(recovered_bytes(*r, report));
+  Result<Recording> recovered = Recording::from_bytes(recovered_bytes(*r, report).value());
   ASSERT_TRUE(recovered);
   EXPECT_TRUE(recovered->content_errors().empty());
   EXPECT_EQ(recovered->ticks().size(), original->ticks().size());
@@ -657,7 +659,7 @@ TEST(RecordingFile, TicksRecordedTwiceWithDifferentInputsAreNamedWithTheirChunks
     if (c.type == static_cast<std::uint16_t>(ChunkType::kTicks) && !copied) copied = &c;
   }
   ASSERT_NE(copied, nullptr);
-  Result<std::vector<TickRecord>> ticks = decode_tick_block(original.payload(*copied));
+  Result<std::vector<TickRecord>> ticks = decode_tick_block(original.payload(*copied).value());
   ASSERT_TRUE(ticks && ticks->size() > 20);
   // Every chunk but the index again, then a copy of the first ticks chunk: alike, or with ticks 5-9 moved.
   auto with_copy = [&](std::span<const TickRecord> copy) {
@@ -665,7 +667,7 @@ TEST(RecordingFile, TicksRecordedTwiceWithDifferentInputsAreNamedWithTheirChunks
     std::uint32_t sequence = 0;
     for (const ChunkLocation& c : original.chunks()) {
       if (c.type != static_cast<std::uint16_t>(ChunkType::kIndex))
-        append_chunk(bytes, static_cast<ChunkType>(c.type), sequence++, original.payload(c));
+        append_chunk(bytes, static_cast<ChunkType>(c.type), sequence++, original.payload(c).value());
     }
     encode_tick_block(copy, payload);
     append_chunk(bytes, ChunkType::kTicks, sequence, payload);
