@@ -133,7 +133,7 @@ void print_demo_size() {
   const auto bytes = r.bytes_by_type();
   const double minutes = r.duration_s() / 60.0;
   std::printf("\n%s: %s recording of '%s', %.2f s, %zu ticks, %zu keyframes (%.1f Hz), %d-bit grid (%.1f um)\n", recording_path(),
-              r.header().mode.c_str(), r.header().procedure.c_str(), r.duration_s(), r.ticks().size(), r.keyframes().size(),
+              r.header().mode.c_str(), r.header().procedure.c_str(), r.duration_s(), r.tick_count(), r.keyframes().size(),
               r.keyframes().size() > 1 ? static_cast<double>(r.keyframes().size() - 1) / (r.keyframes().back().time_s - r.keyframes().front().time_s) : 0.0,
               r.header().grid.bits, r.header().grid.step_m() * 1e6);
   std::printf("%-10s %12s %12s\n", "content", "bytes", "MB/min");

@@ -120,7 +120,9 @@ Status export_inputs_csv(const Recording& recording, const std::filesystem::path
   constexpr std::size_t kBlockBytes = std::size_t{1} << 20;
   const double tick_s = recording.header().simulation.tick_s();
   char line[512];
-  for (const TickRecord& t : recording.ticks()) {
+  TickReader ticks(recording);
+  while (const TickRecord* record = ticks.next()) {
+    const TickRecord& t = *record;
     const DeviceJoints& j = t.input.joints;
     std::snprintf(line, sizeof line, "%llu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%d,%d,%d\n", static_cast<unsigned long long>(t.tick),
                   static_cast<double>(t.tick) * tick_s, units::rad_to_deg(j.yaw_rad), units::rad_to_deg(j.pitch_rad), units::rad_to_deg(j.roll_rad),

@@ -32,19 +32,19 @@ Result<std::unique_ptr<Replayer>> Replayer::create(const Recording& recording) {
 }
 
 std::uint64_t Replayer::run_to(std::uint64_t tick) {
-  const std::span<const TickRecord> ticks = recording_.ticks();
   const std::span<const StepRecord> steps = recording_.steps();
   const std::span<const ParameterCommand> commands = recording_.commands();
   const std::uint64_t stop = std::min(tick, end_tick_);
   while (sim_->tick() < stop) {
     const std::uint64_t t = sim_->tick();
-    const TickRecord& record = ticks[next_tick_record_++];  // replayable ticks are ticks[0..end_tick_)
+    const TickRecord* record = ticks_.next();  // the replayable ticks are the first end_tick_ recorded
+    if (record == nullptr) break;
     tick_commands_.clear();
     while (next_command_ < commands.size() && commands[next_command_].apply_tick <= static_cast<std::int64_t>(t)) {
       if (commands[next_command_].apply_tick == static_cast<std::int64_t>(t)) tick_commands_.push_back(commands[next_command_]);
       ++next_command_;
     }
-    sim_->step(record.input, tick_commands_);
+    sim_->step(record->input, tick_commands_);
     if (!sim_->is_collision_tick(t)) continue;
     while (next_step_ < steps.size() && steps[next_step_].tick < t) ++next_step_;
     if (next_step_ < steps.size() && steps[next_step_].tick == t) {

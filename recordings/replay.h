@@ -38,10 +38,11 @@ class Replayer {
   std::uint64_t end_tick() const { return end_tick_; }
 
  private:
-  explicit Replayer(const Recording& recording) : recording_(recording) {}
+  explicit Replayer(const Recording& recording) : recording_(recording), ticks_(recording) {}
   const Recording& recording_;
+  TickReader ticks_;
   std::unique_ptr<Simulation> sim_;
-  std::size_t next_tick_record_ = 0, next_step_ = 0, next_command_ = 0;
+  std::size_t next_step_ = 0, next_command_ = 0;
   std::uint64_t end_tick_ = 0;
   std::uint64_t verified_ = 0, mismatches_ = 0;
   std::optional<std::uint64_t> first_mismatch_;

@@ -86,7 +86,7 @@ void info(const InfoOptions& o) {
                       {"procedure", h.procedure},
                       {"mode", h.mode},
                       {"duration_s", r.duration_s()},
-                      {"ticks", r.ticks().size()},
+                      {"ticks", r.tick_count()},
                       {"start_tick", h.start_tick},
                       {"replayable_ticks", replayable},
                       {"collision_steps", r.steps().size()},
@@ -106,7 +106,7 @@ void info(const InfoOptions& o) {
     return;
   }
   std::printf("%s: %s recording of '%s' by %s\n", o.file.c_str(), h.mode.c_str(), h.procedure.c_str(), h.build.c_str());
-  std::printf("  duration   %.2f s, %zu ticks (%llu replayable%s), %zu collision steps, %zu commands\n", r.duration_s(), r.ticks().size(),
+  std::printf("  duration   %.2f s, %zu ticks (%llu replayable%s), %zu collision steps, %zu commands\n", r.duration_s(), r.tick_count(),
               static_cast<unsigned long long>(replayable),
               mid_session           ? ("; recorded from mid-session, from tick " + std::to_string(h.start_tick)).c_str()
               : r.missing_ticks() > 0 ? ("; " + std::to_string(r.missing_ticks()) + " missing in a gap a recovery left").c_str()
@@ -158,9 +158,9 @@ void verify(const std::string& file) {
     ++problems;
   }
   const std::uint64_t start = static_cast<std::uint64_t>(r.header().start_tick);
-  if (r.replayable_ticks() == 0 && !r.ticks().empty()) {
+  if (r.replayable_ticks() == 0 && r.tick_count() > 0) {
     std::fprintf(stderr, "%s: no tick replays: the header starts at tick %llu, the first recorded tick is %llu\n", file.c_str(),
-                 static_cast<unsigned long long>(start), static_cast<unsigned long long>(r.ticks().front().tick));
+                 static_cast<unsigned long long>(start), static_cast<unsigned long long>(r.first_recorded_tick()));
     ++problems;
   }
   if (problems > 0) {
@@ -176,9 +176,9 @@ void verify(const std::string& file) {
                             " chunks, every CRC matches, every keyframe decodes, index present; but ";
   // A gap a recovery left: not the whole procedure replays (audit 25, F8: it said "ok" for a file
   // whose last 39% of ticks cannot be replayed).
-  if (r.replayable_ticks() < r.ticks().size()) {
+  if (r.replayable_ticks() < r.tick_count()) {
     std::printf("%sonly %llu of %zu recorded ticks replay: the inputs break at tick %llu (%llu ticks missing), and the rest cannot be replayed\n",
-                sound.c_str(), static_cast<unsigned long long>(r.replayable_ticks()), r.ticks().size(),
+                sound.c_str(), static_cast<unsigned long long>(r.replayable_ticks()), r.tick_count(),
                 static_cast<unsigned long long>(start + r.replayable_ticks()), static_cast<unsigned long long>(r.missing_ticks()));
     return;
   }
@@ -186,10 +186,10 @@ void verify(const std::string& file) {
   // how many it wrote (audit 30, F3: "ok" for a file that had lost its last quarter).
   const char* why_fewer =
       r.recovered_damaged_ranges() > 0 ? "`rec recover` left out the damaged chunks that held the rest" : "chunks were removed";
-  if (const std::optional<std::uint64_t> written = r.summary_count("ticks"); written && *written > r.ticks().size()) {
+  if (const std::optional<std::uint64_t> written = r.summary_count("ticks"); written && *written > r.tick_count()) {
     std::printf("%sit holds only %zu of the %llu ticks its recorder wrote (%s): the procedure's last %llu ticks are lost\n", sound.c_str(),
-                r.ticks().size(), static_cast<unsigned long long>(*written), why_fewer,
-                static_cast<unsigned long long>(*written - r.ticks().size()));
+                r.tick_count(), static_cast<unsigned long long>(*written), why_fewer,
+                static_cast<unsigned long long>(*written - r.tick_count()));
     return;
   }
   // Steps' hashes lost the same way: every tick replays, but `replay --verify` cannot vouch for the
@@ -215,7 +215,7 @@ void verify(const std::string& file) {
     return;
   }
   std::printf("%s: ok, %zu chunks, every CRC matches, every keyframe decodes, index present; all %zu recorded ticks replay\n", file.c_str(),
-              r.chunks().size(), r.ticks().size());
+              r.chunks().size(), r.tick_count());
 }
 
 void recover(const std::string& in, const std::string& out) {
@@ -252,7 +252,7 @@ void export_recording(const ExportOptions& o) {
   const rec::Recording r = open_recording(o.file);
   if (o.inputs) {
     if (Status written = rec::export_inputs_csv(r, o.out); !written) throw std::runtime_error(written.error());
-    std::printf("%s: %zu ticks' inputs\n", o.out.c_str(), r.ticks().size());
+    std::printf("%s: %zu ticks' inputs\n", o.out.c_str(), r.tick_count());
     // Written, since what the file holds is the user's, but not passed off as the whole procedure
     // (audit 31, F1: a CSV jumping from tick 719 to 1440, exit 0).
     if (const std::string lost = r.describe_tick_gaps(); !lost.empty()) {

@@ -37,7 +37,7 @@ void replay(const ReplayOptions& o) {
   const std::string unverified = rec::unverified_hashes(*recording, r);
   // Complete: the whole run the recorder closed, every tick of it replayed. A file never closed
   // (a killed run, or one cut short) replays up to where it stops, but is not the whole run.
-  const bool complete = ticks == recording->ticks().size() && recording->damaged().empty() && recording->closed();
+  const bool complete = ticks == recording->tick_count() && recording->damaged().empty() && recording->closed();
 
   nlohmann::ordered_json out = {
       {"file", o.file},
@@ -59,9 +59,9 @@ void replay(const ReplayOptions& o) {
     std::printf("replayed %llu ticks (%.2f s) of %s, final state hash %s\n", static_cast<unsigned long long>(ticks),
                 out["simulated_s"].get<double>(), o.file.c_str(), out["state_hash"].get<std::string>().c_str());
     if (out.contains("recorded_state_hash")) std::printf("  the run ended with state hash %s\n", out["recorded_state_hash"].get<std::string>().c_str());
-    if (ticks < recording->ticks().size()) {
+    if (ticks < recording->tick_count()) {
       std::printf("  the recording's inputs end or break at tick %llu (%llu ticks recorded, %zu damaged ranges)\n",
-                  static_cast<unsigned long long>(ticks), static_cast<unsigned long long>(recording->ticks().size()), recording->damaged().size());
+                  static_cast<unsigned long long>(ticks), static_cast<unsigned long long>(recording->tick_count()), recording->damaged().size());
     } else if (!recording->damaged().empty()) {
       std::printf("  every recorded tick replayed; the file has %zu damaged ranges (`resecto rec verify` names them)\n", recording->damaged().size());
     }

@@ -64,7 +64,7 @@ bool has_value(const ScoreMetrics& m, const char* name) { return has_grams_per_c
 /// commands the file holds: whatever else was lost (keyframes, hashes), the procedure is whole.
 bool holds_every_tick_and_command(const rec::Recording& recording) {
   const std::optional<std::uint64_t> ticks = recording.summary_count("ticks"), commands = recording.summary_count("commands");
-  return ticks && commands && *ticks == recording.ticks().size() && *commands == recording.commands().size();
+  return ticks && commands && *ticks == recording.tick_count() && *commands == recording.commands().size();
 }
 
 /// What a sound file (no damage left in it) lacks of the procedure it was recorded from, or empty:
@@ -76,14 +76,14 @@ std::string lost_part_of_procedure(const rec::Recording& recording) {
   const std::uint64_t dropped = recording.recovered_damaged_ranges();
   const std::optional<std::uint64_t> ticks = recording.summary_count("ticks"), commands = recording.summary_count("commands");
   const auto held_of_written = [&] {
-    return std::to_string(recording.ticks().size()) + " of the " + std::to_string(*ticks) + " ticks and " + std::to_string(recording.commands().size()) +
+    return std::to_string(recording.tick_count()) + " of the " + std::to_string(*ticks) + " ticks and " + std::to_string(recording.commands().size()) +
            " of the " + std::to_string(commands.value_or(0)) + " commands";
   };
   // Cut between two chunks, a file looks whole up to its end; only the recorder's summary, written
   // when it closes the file, says the procedure ended there.
   if (dropped == 0) {
     if (ticks) return "it holds " + held_of_written() + " its recorder wrote";  // closed, yet chunks are gone
-    return "the recorder never closed it (the run was killed or the file cut after " + std::to_string(recording.ticks().size()) +
+    return "the recorder never closed it (the run was killed or the file cut after " + std::to_string(recording.tick_count()) +
            " ticks), so how much of the procedure it lacks is unknown";
   }
   return "recovered (`rec recover`) from a damaged recording, " + std::to_string(dropped) + " damaged ranges left out" +
@@ -160,7 +160,7 @@ Result<RecordingScore> score_recording(const std::filesystem::path& path, const 
     const std::string damaged = "damaged (" + std::to_string(recording->damaged().size()) + " damaged byte ranges, the first at byte " +
                                 std::to_string(d.offset) + ")";
     const bool whole = holds_every_tick_and_command(*recording) && recording->content_errors().empty() &&
-                       recording->replayable_ticks() == recording->ticks().size();
+                       recording->replayable_ticks() == recording->tick_count();
     if (!whole) return Error{name + ": " + damaged + "; a score from part of a procedure would mislead"};
     note_fault(damaged);
   }
@@ -189,7 +189,7 @@ Result<RecordingScore> score_recording(const std::filesystem::path& path, const 
     const std::string cut = "the run was interrupted by " + interrupted + ": scored as far as it went, not as a finished procedure";
     note = note.empty() ? name + ": " + cut : note + "; " + cut;
   }
-  if (recording->replayable_ticks() != recording->ticks().size()) {
+  if (recording->replayable_ticks() != recording->tick_count()) {
     return Error{name + ": recorded input breaks at tick " + std::to_string(recording->replayable_ticks())};
   }
   Result<std::unique_ptr<rec::Replayer>> created = rec::Replayer::create(*recording);
