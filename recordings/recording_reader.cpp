@@ -15,6 +15,9 @@
 namespace resecto::rec {
 namespace {
 
+/// The last tick number a ticks chunk may hold.
+constexpr std::uint64_t kLastPlausibleTick = std::uint64_t{1} << 63;
+
 /// The ticks one ticks or steps chunk holds, for naming the chunks a tick is recorded in.
 struct ChunkTicks {
   std::uint64_t first = 0, last = 0;
@@ -139,6 +142,12 @@ Result<Recording> Recording::from_source(RecordingBytes bytes, std::string name)
           r.content_errors_.push_back(where + ": " + ticks.error());
           break;
         }
+        // Numbers no run reaches (2^63 ticks at 960 Hz are 3e8 years) are damage that passed the CRCs,
+        // and would wrap the tick arithmetic.
+        if (!ticks->empty() && ticks->front().tick > kLastPlausibleTick - ticks->size()) {
+          r.content_errors_.push_back(where + ": ticks numbered from " + std::to_string(ticks->front().tick) + ", past any run");
+          break;
+        }
         // Decoded to be checked; kept as the file deflated them (a fifth of their decoded size).
         if (!ticks->empty()) tick_blocks.push_back({ticks->front().tick, ticks->size(), std::vector<std::uint8_t>(payload.begin(), payload.end()), {}, c});
         break;
@@ -234,7 +243,7 @@ void Recording::keep_tick_blocks(std::vector<TickBlock> blocks) {
   bool overlap = false;
   for (std::size_t i = 0; i < order.size(); ++i) {
     const TickBlock& b = sorted[order[i]];
-    overlap = overlap || b.first + b.count < b.first || (i > 0 && b.first < sorted[order[i - 1]].first + sorted[order[i - 1]].count);
+    overlap = overlap || (i > 0 && b.first < sorted[order[i - 1]].first + sorted[order[i - 1]].count);
   }
   if (!overlap) {
     tick_blocks_.reserve(sorted.size());

@@ -690,6 +690,17 @@ TEST(RecordingFile, TicksRecordedTwiceWithDifferentInputsAreNamedWithTheirChunks
   EXPECT_NE(differing.content_errors()[0].find(expected), std::string::npos) << differing.content_errors()[0];
   // The first copy in the file is the one kept, as before.
   EXPECT_EQ(differing.all_ticks()[5].input.joints.insertion_m, original.all_ticks()[5].input.joints.insertion_m);
+
+  // Numbered where no run reaches (damage the CRCs were recomputed over): named, never counted, and
+  // the tick arithmetic (duration, gaps) does not wrap.
+  std::vector<TickRecord> far = *ticks;
+  for (std::size_t i = 0; i < far.size(); ++i) far[i].tick = ~std::uint64_t{0} - 5 + i;
+  const Recording wrapped = with_copy(far);
+  ASSERT_EQ(wrapped.content_errors().size(), 1u);
+  EXPECT_NE(wrapped.content_errors()[0].find("past any run"), std::string::npos) << wrapped.content_errors()[0];
+  EXPECT_EQ(wrapped.tick_count(), original.tick_count());
+  EXPECT_EQ(wrapped.duration_s(), original.duration_s());
+  EXPECT_EQ(wrapped.missing_ticks(), 0u);
 }
 
 }  // namespace
