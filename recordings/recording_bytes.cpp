@@ -36,13 +36,11 @@ Result<RecordingBytes> RecordingBytes::open(const std::filesystem::path& path) {
   if (::fstat(file->fd, &status) != 0 || !S_ISREG(status.st_mode)) {
     return Error{path.string() + ": not a regular file (a device or pipe is never read whole)"};
   }
+  // The size as opened, within the limit regular_file_size checked: a file still growing is read as
+  // far as it was then.
   RecordingBytes bytes;
   bytes.file_ = std::move(file);
-  bytes.size_ = static_cast<std::uint64_t>(std::max<off_t>(status.st_size, 0));
-  if (bytes.size_ > kMaxBinaryFileBytes) {
-    return Error{path.string() + ": " + std::to_string(bytes.size_) + " bytes, more than the " + std::to_string(kMaxBinaryFileBytes) +
-                 "-byte limit for this input"};
-  }
+  bytes.size_ = std::min<std::uint64_t>(static_cast<std::uint64_t>(std::max<off_t>(status.st_size, 0)), *checked);
   return bytes;
 }
 

@@ -122,7 +122,7 @@ Result<Recording> Recording::from_source(RecordingBytes bytes, std::string name)
     }
     const ChunkLocation& chunk = r.scan_.chunks[c];
     const std::string where = std::string(chunk_type_name(chunk.type)) + " chunk " + std::to_string(chunk.sequence) + " at byte " + std::to_string(chunk.offset);
-    const Result<std::vector<std::uint8_t>> read = r.read_payload(chunk, false);
+    Result<std::vector<std::uint8_t>> read = r.read_payload(chunk, false);
     if (!read) {
       // Cut or overwritten between the scan and this read: what is left cannot be trusted.
       return Error{read.error()};
@@ -149,7 +149,7 @@ Result<Recording> Recording::from_source(RecordingBytes bytes, std::string name)
           break;
         }
         // Decoded to be checked; kept as the file deflated them (a fifth of their decoded size).
-        if (!ticks->empty()) tick_blocks.push_back({ticks->front().tick, ticks->size(), std::vector<std::uint8_t>(payload.begin(), payload.end()), {}, c});
+        if (!ticks->empty()) tick_blocks.push_back({ticks->front().tick, ticks->size(), std::move(*read), {}, c});
         break;
       }
       case ChunkType::kSteps: {
@@ -235,26 +235,24 @@ Result<Recording> Recording::from_source(RecordingBytes bytes, std::string name)
 }
 
 void Recording::keep_tick_blocks(std::vector<TickBlock> blocks) {
-  std::vector<TickBlock> sorted = std::move(blocks);
   // Stable: blocks of one first tick stay in file order (the first copy is the one kept).
-  std::vector<std::size_t> order(sorted.size());
+  std::vector<std::size_t> order(blocks.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return sorted[a].first < sorted[b].first; });
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return blocks[a].first < blocks[b].first; });
   bool overlap = false;
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    const TickBlock& b = sorted[order[i]];
-    overlap = overlap || (i > 0 && b.first < sorted[order[i - 1]].first + sorted[order[i - 1]].count);
+  for (std::size_t i = 1; i < order.size(); ++i) {
+    overlap = overlap || blocks[order[i]].first < blocks[order[i - 1]].first + blocks[order[i - 1]].count;
   }
   if (!overlap) {
-    tick_blocks_.reserve(sorted.size());
-    for (std::size_t i : order) tick_blocks_.push_back(std::move(sorted[i]));
+    tick_blocks_.reserve(blocks.size());
+    for (std::size_t i : order) tick_blocks_.push_back(std::move(blocks[i]));
   } else {
     // Never written so, but a copied chunk could be: every tick decoded, sorted by tick with each
     // tick's copies in file order, kept once, and copies that differ named (audit 7, F4: two ticks
     // chunks with different inputs for the same ticks read as "ok").
     std::vector<TickRecord> records;
     std::vector<ChunkTicks> chunks;
-    for (const TickBlock& b : sorted) {
+    for (const TickBlock& b : blocks) {
       Result<std::vector<TickRecord>> decoded = decode_tick_block(b.payload);
       if (!decoded) continue;  // decoded at open: cannot fail here
       note_chunk_ticks<TickRecord>(*decoded, b.chunk, chunks);

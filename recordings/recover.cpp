@@ -85,10 +85,7 @@ Result<RecoverReport> recover(const Recording& recording, const std::filesystem:
   const Status made = write_recovered(recording, report, [&](std::span<const std::uint8_t> chunk) {
     return file.write(std::string_view(reinterpret_cast<const char*>(chunk.data()), chunk.size()));
   });
-  if (!made) {
-    file.discard();
-    return Error{made.error()};
-  }
+  if (!made) return Error{made.error()};  // the temporary is removed with `file`
   if (Status committed = file.commit(); !committed) return Error{committed.error()};
   return report;
 }
