@@ -158,8 +158,11 @@ Result<Recording> Recording::from_source(RecordingBytes bytes, std::string name)
           r.content_errors_.push_back(where + ": " + steps.error());
           break;
         }
+        // Decoded to be checked; the tool's poses and metrics are read again when a StepReader asks.
         note_chunk_ticks<StepRecord>(*steps, c, step_chunks);
-        r.steps_.insert(r.steps_.end(), steps->begin(), steps->end());
+        for (std::size_t slot = 0; slot < steps->size(); ++slot) {
+          r.steps_.push_back({(*steps)[slot].tick, (*steps)[slot].state_hash, c, static_cast<std::uint32_t>(slot)});
+        }
         break;
       }
       case ChunkType::kCommands: {
@@ -217,7 +220,12 @@ Result<Recording> Recording::from_source(RecordingBytes bytes, std::string name)
   auto same_tick = [](const auto& a, const auto& b) { return a.tick == b.tick; };
   r.keep_tick_blocks(std::move(tick_blocks));
   std::stable_sort(r.steps_.begin(), r.steps_.end(), by_tick);
-  name_differing_copies<StepRecord>(r.steps_, step_chunks, r.scan_.chunks, "steps", encode_step_block, r.content_errors_);
+  if (std::adjacent_find(r.steps_.begin(), r.steps_.end(), same_tick) != r.steps_.end()) {
+    // Copies of a step (a copied chunk): their whole records compared, the first kept.
+    Result<std::vector<StepRecord>> records = r.all_steps();
+    if (!records) return Error{records.error()};
+    name_differing_copies<StepRecord>(*records, step_chunks, r.scan_.chunks, "steps", encode_step_block, r.content_errors_);
+  }
   r.steps_.erase(std::unique(r.steps_.begin(), r.steps_.end(), same_tick), r.steps_.end());
   std::stable_sort(r.keyframes_.begin(), r.keyframes_.end(), by_tick);
   r.keyframes_.erase(std::unique(r.keyframes_.begin(), r.keyframes_.end(), same_tick), r.keyframes_.end());
@@ -283,6 +291,34 @@ std::vector<TickRecord> Recording::all_ticks() const {
   TickReader reader(*this);
   while (const TickRecord* t = reader.next()) ticks.push_back(*t);
   return ticks;
+}
+
+Result<std::vector<StepRecord>> Recording::all_steps() const {
+  std::vector<StepRecord> steps;
+  steps.reserve(steps_.size());
+  StepReader reader(*this);
+  for (std::size_t i = 0; i < steps_.size(); ++i) {
+    Result<StepRecord> step = reader.at(i);
+    if (!step) return Error{step.error()};
+    steps.push_back(*step);
+  }
+  return steps;
+}
+
+Result<StepRecord> StepReader::at(std::size_t i) {
+  const StepEntry& entry = recording_->steps_.at(i);
+  if (chunk_ != entry.chunk) {
+    chunk_.reset();
+    Result<std::vector<std::uint8_t>> bytes = recording_->payload(recording_->scan_.chunks[entry.chunk]);
+    if (!bytes) return Error{bytes.error()};
+    Result<std::vector<StepRecord>> decoded = decode_step_block(*bytes);
+    if (!decoded) return Error{recording_->name() + ": steps chunk " + std::to_string(recording_->scan_.chunks[entry.chunk].sequence) + ": " + decoded.error()};
+    decoded_ = std::move(*decoded);
+    chunk_ = entry.chunk;
+  }
+  // The CRC held, so the chunk is the one decoded at open and the slot is in it.
+  if (entry.slot >= decoded_.size()) return Error{recording_->name() + ": a steps chunk holds fewer records than when it was opened"};
+  return decoded_[entry.slot];
 }
 
 const TickRecord* TickReader::next() {

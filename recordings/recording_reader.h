@@ -1,10 +1,11 @@
 // Recording: a recording file opened for reading, replay and browsing (the console's replay panel
 // uses this API; see recordings/README.md). Opening scans every chunk (a file with no index, cut or
 // killed, reads the same way as a closed one: every whole chunk is kept, a damaged chunk is lost
-// alone), parses the header and decodes the steps and commands. The file's bytes stay on disk:
-// keyframes are indexed at open and read and decoded on demand, and the ticks (16 for each step) are
-// kept as the file deflated them and decoded a chunk at a time by a TickReader. A Recording is
-// immutable once open.
+// alone), parses the header, decodes the commands and checks that every other chunk decodes. The
+// file's bytes stay on disk: keyframes are indexed at open and read and decoded on demand, the ticks
+// (16 for each step) are kept as the file deflated them and decoded a chunk at a time by a
+// TickReader, and of each collision step only its tick, hash and place are kept (a StepReader reads
+// its whole record). A Recording is immutable once open.
 #pragma once
 
 #include <array>
@@ -47,7 +48,17 @@ struct KeyframeInfo {
   std::uint64_t number = 0;
 };
 
+/// A collision step as the reader keeps it: what replay verifies, and where its whole record (the
+/// tool's poses and the metrics, ~530 bytes) lies for a StepReader.
+struct StepEntry {
+  std::uint64_t tick = 0;
+  std::uint64_t state_hash = 0;
+  std::size_t chunk = 0;    ///< into chunks()
+  std::uint32_t slot = 0;   ///< the record's place among that chunk's
+};
+
 class TickReader;
+class StepReader;
 
 class Recording {
  public:
@@ -89,7 +100,11 @@ class Recording {
   std::vector<TickRecord> all_ticks() const;
   /// The ticks replay can run: from the header's start tick up to the first missing one.
   std::uint64_t replayable_ticks() const { return replayable_ticks_; }
-  std::span<const StepRecord> steps() const { return steps_; }
+  /// The recorded collision steps, sorted by tick, each once: 32 bytes each (2.3 MB for 20 minutes
+  /// at 60 Hz). A StepReader reads their whole records.
+  std::span<const StepEntry> steps() const { return steps_; }
+  /// Every step's whole record, in steps() order, or the error of the first chunk that no longer reads.
+  Result<std::vector<StepRecord>> all_steps() const;
   std::span<const ParameterCommand> commands() const { return commands_; }
   /// The intact keyframes, by tick. Indices into this (`k` below) are not keyframe numbers once one
   /// is lost: find_keyframe() turns a number into an index.
@@ -147,6 +162,7 @@ class Recording {
 
  private:
   friend class TickReader;
+  friend class StepReader;
   /// Recorded ticks [first, first + count), as one ticks chunk's payload (deflated, decoded when read)
   /// or, when the file's ticks chunks overlap (a copied chunk), all of them decoded and kept once.
   struct TickBlock {
@@ -186,7 +202,7 @@ class Recording {
   std::vector<std::pair<std::uint64_t, std::uint64_t>> tick_runs_;
   std::uint64_t tick_count_ = 0;
   std::uint64_t replayable_ticks_ = 0;
-  std::vector<StepRecord> steps_;
+  std::vector<StepEntry> steps_;
   std::vector<ParameterCommand> commands_;
   std::vector<KeyframeInfo> keyframes_;
   /// Ticks from one scheduled keyframe to the next, and the schedule's slot of keyframe 0; a period
@@ -212,6 +228,21 @@ class TickReader {
   std::size_t block_ = 0, in_block_ = 0;
   std::vector<TickRecord> decoded_;
   bool block_decoded_ = false;
+};
+
+/// Whole collision-step records by their index in Recording::steps(), read and decoded a steps chunk
+/// (45 steps) at a time and the last one kept: what the console's replay panel scrubs through. One per
+/// thread; the Recording must outlive it.
+class StepReader {
+ public:
+  explicit StepReader(const Recording& recording) : recording_(&recording) {}
+  /// Step i's record; an error when the file no longer holds its chunk as it was opened.
+  Result<StepRecord> at(std::size_t i);
+
+ private:
+  const Recording* recording_;
+  std::optional<std::size_t> chunk_;  // the chunk decoded_ holds
+  std::vector<StepRecord> decoded_;
 };
 
 }  // namespace resecto::rec

@@ -32,7 +32,7 @@ Result<std::unique_ptr<Replayer>> Replayer::create(const Recording& recording) {
 }
 
 std::uint64_t Replayer::run_to(std::uint64_t tick) {
-  const std::span<const StepRecord> steps = recording_.steps();
+  const std::span<const StepEntry> steps = recording_.steps();
   const std::span<const ParameterCommand> commands = recording_.commands();
   const std::uint64_t stop = std::min(tick, end_tick_);
   while (sim_->tick() < stop) {
@@ -84,7 +84,7 @@ std::string uncompared_hashes(const Recording& recording, std::uint64_t reached)
   // lost, or the file cut after a steps chunk and before the ticks it covers).
   const auto steps = recording.steps();
   const auto past = static_cast<std::uint64_t>(
-      steps.end() - std::lower_bound(steps.begin(), steps.end(), reached, [](const StepRecord& s, std::uint64_t t) { return s.tick < t; }));
+      steps.end() - std::lower_bound(steps.begin(), steps.end(), reached, [](const StepEntry& s, std::uint64_t t) { return s.tick < t; }));
   if (past > 0) {
     return std::to_string(past) + " of the " + std::to_string(in_file) + " recorded hashes are of collision steps at or past tick " +
            std::to_string(reached) + ", where the recorded inputs end or break";

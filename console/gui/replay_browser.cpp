@@ -11,6 +11,7 @@ ReplayBrowser::~ReplayBrowser() { close(); }
 
 void ReplayBrowser::close() {
   if (verifier_.joinable()) verifier_.join();
+  steps_.reset();
   recording_.reset();
   verifying_.store(false);
   verified_.store(false);
@@ -30,6 +31,7 @@ Status ReplayBrowser::open(const std::filesystem::path& path) {
   }
   close();
   recording_ = std::make_unique<rec::Recording>(std::move(*opened));
+  steps_.emplace(*recording_);
   path_ = path.string();
   tick_s_ = recording_->header().simulation.tick_s();  // `config` went with *opened
   prostate_ = std::move(prostate);
@@ -99,14 +101,16 @@ const SimulationSnapshot& ReplayBrowser::snapshot() {
   // The tool and metrics of the collision step at or before the time (60 Hz, finer than keyframes).
   const auto steps = recording_->steps();
   const auto tick = static_cast<std::uint64_t>(std::max(0.0, time_s_ / tick_s_ - 1.0));
-  auto after = std::upper_bound(steps.begin(), steps.end(), tick, [](std::uint64_t t, const rec::StepRecord& s) { return t < s.tick; });
+  auto after = std::upper_bound(steps.begin(), steps.end(), tick, [](std::uint64_t t, const rec::StepEntry& s) { return t < s.tick; });
+  // A step whose chunk no longer reads (the file changed since it was opened) leaves the last one shown.
   if (after != steps.begin()) {
-    const rec::StepRecord& s = *(after - 1);
-    snapshot_.tool = s.tool;
-    snapshot_.metrics = s.metrics;
-    snapshot_.state_hash = s.state_hash;
-    snapshot_.tick = s.tick + 1;
-    step_tick_shown_ = s.tick;
+    if (Result<rec::StepRecord> s = steps_->at(static_cast<std::size_t>(after - 1 - steps.begin()))) {
+      snapshot_.tool = s->tool;
+      snapshot_.metrics = s->metrics;
+      snapshot_.state_hash = s->state_hash;
+      snapshot_.tick = s->tick + 1;
+      step_tick_shown_ = s->tick;
+    }
   }
   return snapshot_;
 }

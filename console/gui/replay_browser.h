@@ -92,6 +92,7 @@ class ReplayBrowser {
 
   std::string path_;
   std::unique_ptr<rec::Recording> recording_;
+  std::optional<rec::StepReader> steps_;  // reads recording_'s steps a chunk at a time
   ProstateModel prostate_;
   double tick_s_ = 1.0 / 960.0;
   double time_s_ = 0.0;

@@ -408,8 +408,10 @@ TEST(ConsoleWindow, RecordedSessionReplaysAtAScrubbedTimeWithTheRecordedToolPose
   // The tool shown is the recorded pose of the collision step at or before the scrubbed time.
   const double tick_s = opened->header().simulation.tick_s();
   const auto step_tick = replay.at("step_tick").get<std::uint64_t>();
+  Result<std::vector<rec::StepRecord>> steps = opened->all_steps();
+  ASSERT_TRUE(steps) << steps.error();
   const rec::StepRecord* step = nullptr;
-  for (const rec::StepRecord& s : opened->steps())
+  for (const rec::StepRecord& s : *steps)
     if (s.tick == step_tick) step = &s;
   ASSERT_NE(step, nullptr);
   EXPECT_LE(static_cast<double>(step_tick + 1) * tick_s, scrub_s + 1e-9);

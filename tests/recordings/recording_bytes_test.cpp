@@ -126,6 +126,19 @@ TEST_F(RecordingBytesTest, AFileChangedAfterItWasOpenedGivesErrorsNotItsNewBytes
   EXPECT_NE(overwritten.error().find(path.string() + ": keyframe chunk " + std::to_string(first.sequence)), std::string::npos) << overwritten.error();
   EXPECT_FALSE(r->decode_keyframe(0));
 
+  // A collision step's record: its chunk is read again, and checked.
+  const ChunkLocation& steps_chunk = r->chunks()[r->steps().front().chunk];
+  {
+    std::fstream file(path, std::ios::binary | std::ios::in | std::ios::out);
+    file.seekp(static_cast<std::streamoff>(steps_chunk.payload_offset() + steps_chunk.payload_bytes / 2));
+    file.put('\x5a').put('\xa5');
+  }
+  StepReader steps(*r);
+  const Result<StepRecord> step = steps.at(0);
+  ASSERT_FALSE(step);
+  EXPECT_NE(step.error().find(path.string() + ": steps chunk " + std::to_string(steps_chunk.sequence)), std::string::npos) << step.error();
+  EXPECT_NE(step.error().find("changed since the recording was opened"), std::string::npos) << step.error();
+
   // Cut shorter: the chunk is no longer there to read.
   std::filesystem::resize_file(path, last.offset + 10);
   const Result<SurfaceFrame> cut = r->decode_keyframe(r->keyframes().size() - 1);

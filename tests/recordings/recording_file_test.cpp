@@ -169,7 +169,7 @@ TEST(RecordingFile, CutAtEveryByteKeepsExactlyTheWholeChunksBeforeTheCutAndRecov
     EXPECT_EQ((*replayer)->run_to(UINT64_MAX), r.replayable_ticks());
     EXPECT_EQ((*replayer)->mismatches(), 0u) << std::get<0>(whole_chunks) << " whole chunks";
     std::uint64_t hashes_in_range = 0;
-    for (const StepRecord& s : r.steps()) hashes_in_range += s.tick < r.replayable_ticks() ? 1 : 0;
+    for (const StepEntry& s : r.steps()) hashes_in_range += s.tick < r.replayable_ticks() ? 1 : 0;
     EXPECT_EQ((*replayer)->verified_hashes(), hashes_in_range);
   }
 }
@@ -651,29 +651,84 @@ TEST(RecordingFile, ASecondRecordingJoinedOnIsLeftOutAndNamed) {
   EXPECT_EQ(recovered->tick_count(), original->tick_count());
 }
 
+/// Every steps chunk of `r` decoded whole, sorted by tick: what the reader kept before it read steps
+/// a chunk at a time.
+std::vector<StepRecord> steps_decoded_whole(const Recording& r) {
+  std::vector<StepRecord> steps;
+  for (const ChunkLocation& c : r.chunks()) {
+    if (c.type != static_cast<std::uint16_t>(ChunkType::kSteps)) continue;
+    Result<std::vector<StepRecord>> block = decode_step_block(r.payload(c).value());
+    EXPECT_TRUE(block) << block.error();
+    if (block) steps.insert(steps.end(), block->begin(), block->end());
+  }
+  std::stable_sort(steps.begin(), steps.end(), [](const StepRecord& a, const StepRecord& b) { return a.tick < b.tick; });
+  return steps;
+}
+
+std::vector<std::uint8_t> encoded(const StepRecord& step) {
+  std::vector<std::uint8_t> bytes;
+  encode_step_block(std::span(&step, 1), bytes);
+  return bytes;
+}
+
+// A reader keeps a step's tick, hash and place (32 bytes), not its ~530-byte record (audit 10,
+// finding 5: 38 MB of decoded steps in a 20-minute recording); the record comes from its chunk.
+TEST(RecordingFile, AStepReaderReadsEveryStepsWholeRecordInAnyOrder) {
+  const Recording r = open_bytes(testing::short_recording().file);
+  const std::vector<StepRecord> whole = steps_decoded_whole(r);
+  ASSERT_EQ(r.steps().size(), whole.size());
+  ASSERT_GT(r.chunks_by_type()[static_cast<std::size_t>(ChunkType::kSteps)], 2u) << "several steps chunks to move between";
+  Result<std::vector<StepRecord>> all = r.all_steps();
+  ASSERT_TRUE(all) << all.error();
+  ASSERT_EQ(all->size(), whole.size());
+  for (std::size_t i = 0; i < whole.size(); ++i) {
+    EXPECT_EQ(r.steps()[i].tick, whole[i].tick);
+    EXPECT_EQ(r.steps()[i].state_hash, whole[i].state_hash);
+    EXPECT_EQ(encoded((*all)[i]), encoded(whole[i])) << "step " << i;
+  }
+  // Backward, and jumping between chunks, as a scrubbed timeline reads them.
+  StepReader reader(r);
+  for (std::size_t n = 0; n < whole.size(); ++n) {
+    const std::size_t i = n % 2 == 0 ? whole.size() - 1 - n / 2 : n / 2;
+    Result<StepRecord> step = reader.at(i);
+    ASSERT_TRUE(step) << step.error();
+    EXPECT_EQ(encoded(*step), encoded(whole[i])) << "step " << i;
+  }
+}
+
+const ChunkLocation* first_chunk_of(const Recording& r, ChunkType type) {
+  for (const ChunkLocation& c : r.chunks()) {
+    if (c.type == static_cast<std::uint16_t>(type)) return &c;
+  }
+  return nullptr;
+}
+
+/// `original`'s chunks but its index again, then one more chunk of `type`: a copy of a chunk, as a
+/// file copied together by hand could hold it.
+Recording with_chunk_appended(const Recording& original, ChunkType type, std::span<const std::uint8_t> payload) {
+  std::vector<std::uint8_t> bytes(std::begin(kFileSignature), std::end(kFileSignature));
+  std::uint32_t sequence = 0;
+  for (const ChunkLocation& c : original.chunks()) {
+    if (c.type != static_cast<std::uint16_t>(ChunkType::kIndex)) append_chunk(bytes, static_cast<ChunkType>(c.type), sequence++, original.payload(c).value());
+  }
+  append_chunk(bytes, type, sequence, payload);
+  return open_bytes(bytes);
+}
+
 // The same ticks in two ticks chunks: a copy alike is harmless, but copies that differ leave a
 // reader keeping either replaying inputs the run may never have had. `rec verify` said "ok" of it and
 // readers kept the first silently (audit 7, F4).
 TEST(RecordingFile, TicksRecordedTwiceWithDifferentInputsAreNamedWithTheirChunks) {
   const Recording original = open_bytes(testing::short_recording().file);
-  const ChunkLocation* copied = nullptr;
-  for (const ChunkLocation& c : original.chunks()) {
-    if (c.type == static_cast<std::uint16_t>(ChunkType::kTicks) && !copied) copied = &c;
-  }
+  const ChunkLocation* copied = first_chunk_of(original, ChunkType::kTicks);
   ASSERT_NE(copied, nullptr);
   Result<std::vector<TickRecord>> ticks = decode_tick_block(original.payload(*copied).value());
   ASSERT_TRUE(ticks && ticks->size() > 20);
-  // Every chunk but the index again, then a copy of the first ticks chunk: alike, or with ticks 5-9 moved.
+  // A copy of the first ticks chunk: alike, or with ticks 5-9 moved.
   auto with_copy = [&](std::span<const TickRecord> copy) {
-    std::vector<std::uint8_t> bytes(std::begin(kFileSignature), std::end(kFileSignature)), payload;
-    std::uint32_t sequence = 0;
-    for (const ChunkLocation& c : original.chunks()) {
-      if (c.type != static_cast<std::uint16_t>(ChunkType::kIndex))
-        append_chunk(bytes, static_cast<ChunkType>(c.type), sequence++, original.payload(c).value());
-    }
+    std::vector<std::uint8_t> payload;
     encode_tick_block(copy, payload);
-    append_chunk(bytes, ChunkType::kTicks, sequence, payload);
-    return open_bytes(bytes);
+    return with_chunk_appended(original, ChunkType::kTicks, payload);
   };
   const Recording alike = with_copy(*ticks);
   EXPECT_TRUE(alike.content_errors().empty()) << alike.content_errors()[0];
@@ -701,6 +756,37 @@ TEST(RecordingFile, TicksRecordedTwiceWithDifferentInputsAreNamedWithTheirChunks
   EXPECT_EQ(wrapped.tick_count(), original.tick_count());
   EXPECT_EQ(wrapped.duration_s(), original.duration_s());
   EXPECT_EQ(wrapped.missing_ticks(), 0u);
+}
+
+// The same for steps: copies that differ are named, the first in the file is the one read.
+TEST(RecordingFile, StepsRecordedTwiceWithDifferentPosesAreNamedAndTheFirstIsRead) {
+  const Recording original = open_bytes(testing::short_recording().file);
+  const ChunkLocation* copied = first_chunk_of(original, ChunkType::kSteps);
+  ASSERT_NE(copied, nullptr);
+  Result<std::vector<StepRecord>> steps = decode_step_block(original.payload(*copied).value());
+  ASSERT_TRUE(steps && steps->size() == 2);  // the short recording's chunks hold two steps
+  auto with_copy = [&](std::span<const StepRecord> copy) {
+    std::vector<std::uint8_t> payload;
+    encode_step_block(copy, payload);
+    return with_chunk_appended(original, ChunkType::kSteps, payload);
+  };
+  const Recording alike = with_copy(*steps);
+  EXPECT_TRUE(alike.content_errors().empty()) << alike.content_errors()[0];
+  EXPECT_EQ(alike.steps().size(), original.steps().size());
+
+  std::vector<StepRecord> moved = *steps;
+  for (StepRecord& step : moved) step.tool.sheath.translation.z += 0.020;
+  const Recording differing = with_copy(moved);
+  // A collision step every 16 ticks: each step's ticks are a run of their own.
+  ASSERT_EQ(differing.content_errors().size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const std::string expected = "steps records of ticks " + std::to_string((*steps)[i].tick) + " are in the file twice, and differ (steps chunks " +
+                                 std::to_string(copied->sequence) + " at byte " + std::to_string(copied->offset) + ", ";
+    EXPECT_NE(differing.content_errors()[i].find(expected), std::string::npos) << differing.content_errors()[i];
+  }
+  ASSERT_EQ(differing.steps().size(), original.steps().size());
+  StepReader reader(differing);
+  for (std::size_t i = 0; i < 2; ++i) EXPECT_EQ(encoded(reader.at(i).value()), encoded((*steps)[i])) << "the first copy in the file";
 }
 
 }  // namespace
