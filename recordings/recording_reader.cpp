@@ -33,7 +33,8 @@ void note_chunk_ticks(std::span<const Record> records, std::size_t chunk, std::v
 }
 
 /// The same ticks recorded twice with different content, in `sorted` (by tick, each tick's copies in
-/// file order): each run of such ticks named with the chunks that hold its first. A copied chunk
+/// file order): each run of such ticks (no other recorded tick between them: consecutive ticks, or a
+/// steps chunk's collision ticks) named with the chunks that hold its first. A copied chunk
 /// repeats its records alike and is harmless; copies that differ mean a reader keeping either may
 /// replay inputs the run never had. `encode` writes one record as the file holds it (bit for bit).
 template <class Record, class Encode>
@@ -61,10 +62,12 @@ void name_differing_copies(std::span<const Record> sorted, std::span<const Chunk
                      holders + "): which the run had is unknown; readers keep the first");
   };
   std::optional<std::pair<std::uint64_t, std::uint64_t>> run;
+  std::optional<std::uint64_t> before;  // the recorded tick before sorted[i]'s
   for (std::size_t i = 1; i < sorted.size() && errors.size() < Recording::kMostProblemsListed; ++i) {
+    if (sorted[i].tick != sorted[i - 1].tick) before = sorted[i - 1].tick;
     if (sorted[i].tick != sorted[i - 1].tick || !differ(sorted[i - 1], sorted[i])) continue;
     const std::uint64_t tick = sorted[i].tick;
-    if (run && tick <= run->second + 1) {
+    if (run && (tick == run->second || before == run->second)) {
       run->second = tick;
       continue;
     }
