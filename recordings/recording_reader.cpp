@@ -309,7 +309,10 @@ Result<std::vector<StepRecord>> Recording::all_steps() const {
 }
 
 Result<StepRecord> StepReader::at(std::size_t i) {
-  const StepEntry& entry = recording_->steps_.at(i);
+  if (i >= recording_->steps_.size()) {
+    return Error{recording_->name() + ": no collision step " + std::to_string(i) + " (the recording holds " + std::to_string(recording_->steps_.size()) + ")"};
+  }
+  const StepEntry& entry = recording_->steps_[i];
   if (chunk_ != entry.chunk) {
     chunk_.reset();
     Result<std::vector<std::uint8_t>> bytes = recording_->payload(recording_->scan_.chunks[entry.chunk]);

@@ -694,6 +694,9 @@ TEST(RecordingFile, AStepReaderReadsEveryStepsWholeRecordInAnyOrder) {
     ASSERT_TRUE(step) << step.error();
     EXPECT_EQ(encoded(*step), encoded(whole[i])) << "step " << i;
   }
+  const Result<StepRecord> past = reader.at(whole.size());
+  ASSERT_FALSE(past);
+  EXPECT_NE(past.error().find("no collision step " + std::to_string(whole.size())), std::string::npos) << past.error();
 }
 
 const ChunkLocation* first_chunk_of(const Recording& r, ChunkType type) {
