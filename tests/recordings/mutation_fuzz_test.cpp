@@ -40,7 +40,7 @@ TEST(RecordingFuzz, MutatedFilesNeverCrashTheReader) {
   const ChunkScan scan = scan_chunks(original);
   std::mt19937_64 random(20261124);
   const std::uint64_t count = iterations();
-  std::uint64_t opened = 0, keyframes_decoded = 0;
+  std::uint64_t opened = 0, keyframes_decoded = 0, steps_read = 0;
   for (std::uint64_t i = 0; i < count; ++i) {
     std::vector<std::uint8_t> bytes = original;
     const int mutations = 1 + static_cast<int>(random() % 8);
@@ -86,9 +86,22 @@ TEST(RecordingFuzz, MutatedFilesNeverCrashTheReader) {
       if (r->decode_keyframe(k)) ++keyframes_decoded;
     }
     for (std::size_t k = 0; k < 3; ++k) (void)r->keyframe_at_time(0.1 * static_cast<double>(k));
+    // Every step and tick it kept reads back from its chunk as the open found it.
+    const Result<std::vector<StepRecord>> steps = r->all_steps();
+    ASSERT_TRUE(steps) << "mutation " << i << ": " << steps.error();
+    ASSERT_EQ(steps->size(), r->steps().size());
+    for (std::size_t s = 0; s < steps->size(); ++s) {
+      ASSERT_EQ((*steps)[s].tick, r->steps()[s].tick) << "mutation " << i;
+      ASSERT_EQ((*steps)[s].state_hash, r->steps()[s].state_hash) << "mutation " << i;
+    }
+    steps_read += steps->size();
+    TickReader ticks(*r);
+    std::uint64_t ticks_read = 0;
+    while (ticks.next() != nullptr) ++ticks_read;
+    ASSERT_EQ(ticks_read, r->tick_count()) << "mutation " << i;
   }
-  std::printf("%llu mutated recordings: %llu opened, %llu keyframes decoded\n", static_cast<unsigned long long>(count),
-              static_cast<unsigned long long>(opened), static_cast<unsigned long long>(keyframes_decoded));
+  std::printf("%llu mutated recordings: %llu opened, %llu keyframes decoded, %llu steps read\n", static_cast<unsigned long long>(count),
+              static_cast<unsigned long long>(opened), static_cast<unsigned long long>(keyframes_decoded), static_cast<unsigned long long>(steps_read));
   EXPECT_GT(opened, 0u);
 }
 
