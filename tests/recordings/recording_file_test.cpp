@@ -686,7 +686,7 @@ TEST(RecordingFile, AStepReaderReadsEveryStepsWholeRecordInAnyOrder) {
     EXPECT_EQ(r.steps()[i].state_hash, whole[i].state_hash);
     EXPECT_EQ(encoded((*all)[i]), encoded(whole[i])) << "step " << i;
   }
-  // Backward, and jumping between chunks, as a scrubbed timeline reads them.
+  // From both ends in turn, nearly every read in another chunk than the last: a timeline scrubbed back and forth.
   StepReader reader(r);
   for (std::size_t n = 0; n < whole.size(); ++n) {
     const std::size_t i = n % 2 == 0 ? whole.size() - 1 - n / 2 : n / 2;
