@@ -28,6 +28,8 @@ Recording open_bytes(const std::vector<std::uint8_t>& bytes) {
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
+bool is(const ChunkLocation& chunk, ChunkType type) { return chunk.type == static_cast<std::uint16_t>(type); }
+
 TEST(RecordingFile, ReadsBackEveryInputCommandAndHashBitExactly) {
   const testing::LiveRun& live = short_recording();
   EXPECT_EQ(live.counters.ticks_lost + live.counters.steps_lost + live.counters.keyframes_lost, 0u);
@@ -274,7 +276,6 @@ TEST(RecordingFile, ARecoveredCutOrGappedRecordingDoesNotVerifyAsWhole) {
   const testing::LiveRun& live = short_recording();
   const Recording intact = open_bytes(live.file);
   EXPECT_EQ(unverified_after_replay(intact), "");
-  const auto is = [](const ChunkLocation& c, ChunkType type) { return c.type == static_cast<std::uint16_t>(type); };
 
   // Cut in the summary: every tick and hash is kept, so only the unknown is left to fail it. (Where
   // a cut elsewhere falls, in ticks or steps, depends on the recorder thread's timing.)
@@ -656,7 +657,7 @@ TEST(RecordingFile, ASecondRecordingJoinedOnIsLeftOutAndNamed) {
 std::vector<StepRecord> steps_decoded_whole(const Recording& r) {
   std::vector<StepRecord> steps;
   for (const ChunkLocation& c : r.chunks()) {
-    if (c.type != static_cast<std::uint16_t>(ChunkType::kSteps)) continue;
+    if (!is(c, ChunkType::kSteps)) continue;
     Result<std::vector<StepRecord>> block = decode_step_block(r.payload(c).value());
     EXPECT_TRUE(block) << block.error();
     if (block) steps.insert(steps.end(), block->begin(), block->end());
@@ -700,10 +701,8 @@ TEST(RecordingFile, AStepReaderReadsEveryStepsWholeRecordInAnyOrder) {
 }
 
 const ChunkLocation* first_chunk_of(const Recording& r, ChunkType type) {
-  for (const ChunkLocation& c : r.chunks()) {
-    if (c.type == static_cast<std::uint16_t>(type)) return &c;
-  }
-  return nullptr;
+  const auto c = std::find_if(r.chunks().begin(), r.chunks().end(), [&](const ChunkLocation& chunk) { return is(chunk, type); });
+  return c == r.chunks().end() ? nullptr : &*c;
 }
 
 /// `original`'s chunks but its index again, then one more chunk of `type`: a copy of a chunk, as a
@@ -712,7 +711,7 @@ Recording with_chunk_appended(const Recording& original, ChunkType type, std::sp
   std::vector<std::uint8_t> bytes(std::begin(kFileSignature), std::end(kFileSignature));
   std::uint32_t sequence = 0;
   for (const ChunkLocation& c : original.chunks()) {
-    if (c.type != static_cast<std::uint16_t>(ChunkType::kIndex)) append_chunk(bytes, static_cast<ChunkType>(c.type), sequence++, original.payload(c).value());
+    if (!is(c, ChunkType::kIndex)) append_chunk(bytes, static_cast<ChunkType>(c.type), sequence++, original.payload(c).value());
   }
   append_chunk(bytes, type, sequence, payload);
   return open_bytes(bytes);
