@@ -220,10 +220,11 @@ void ConsoleWindow::draw_endoscope_window(const ImVec2& pos, const ImVec2& size)
   if (shown_ != &f.snapshot) {
     // The replay's pose, as the recording has it (the live core keeps running behind it).
     const Vec3 tip = shown_->tool.sheath.translation;
-    std::snprintf(text, sizeof text, "REPLAY %.2f s (keyframe %llu)   sheath tip %.1f %.1f %.1f mm", ui_.replay.time_s(),
-                  static_cast<unsigned long long>(ui_.replay.keyframe_number_shown().value_or(0)), units::m_to_mm(tip.x),
-                  units::m_to_mm(tip.y), units::m_to_mm(tip.z));
+    std::snprintf(text, sizeof text, "REPLAY %.2f s (keyframe %llu)  loop %.1f mm  sheath tip %.1f %.1f %.1f mm", ui_.replay.time_s(),
+                  static_cast<unsigned long long>(ui_.replay.keyframe_number_shown().value_or(0)),
+                  units::m_to_mm(ui_.replay.loop_travel_shown_m()), units::m_to_mm(tip.x), units::m_to_mm(tip.y), units::m_to_mm(tip.z));
     draw->AddText(ImVec2(origin.x + 8, origin.y + 6), IM_COL32(120, 220, 255, 255), text);
+    if (ui_.replay.cutting_shown()) draw->AddText(ImVec2(origin.x + 8, origin.y + 24), IM_COL32(255, 200, 40, 255), "CUT");
   } else {
     std::snprintf(text, sizeof text, "roll %+.0f deg  insertion %.1f mm  loop %.1f mm", units::rad_to_deg(f.status.joints.roll_rad),
                   units::m_to_mm(f.status.joints.insertion_m), units::m_to_mm(f.status.joints.loop_travel_m));
@@ -319,7 +320,10 @@ void ConsoleWindow::layout_and_draw() {
   if (ImGui::CollapsingHeader("Simulation", ImGuiTreeNodeFlags_DefaultOpen)) draw_simulation_panel(controller_);
   if (ImGui::CollapsingHeader("Tissue parameters", ImGuiTreeNodeFlags_DefaultOpen)) draw_parameter_panel(controller_);
   if (ImGui::CollapsingHeader("Device", ImGuiTreeNodeFlags_DefaultOpen)) draw_device_panel(controller_);
-  if (ImGui::CollapsingHeader("Procedure metrics", ImGuiTreeNodeFlags_DefaultOpen)) draw_metrics_panel(controller_);
+  // While a recording is shown the core goes on live behind it: the metrics are the live core's.
+  const char* metrics_title = ui_.show_replay && ui_.replay.is_open() ? "Procedure metrics: the live core, not the replay###metrics"
+                                                                      : "Procedure metrics###metrics";
+  if (ImGui::CollapsingHeader(metrics_title, ImGuiTreeNodeFlags_DefaultOpen)) draw_metrics_panel(controller_);
   if (ImGui::CollapsingHeader("Recording", ImGuiTreeNodeFlags_DefaultOpen)) draw_recording_panel(controller_);
   if (ImGui::CollapsingHeader("Replay", ImGuiTreeNodeFlags_DefaultOpen)) draw_replay_panel(controller_);
   ImGui::End();
@@ -335,7 +339,7 @@ Status ConsoleWindow::choose_shown(bool fresh_live_frame) {
       replay_renderer_path_ = ui_.replay.path();
     }
     const SimulationSnapshot& replayed = ui_.replay.snapshot();
-    replay_renderer_->update(replayed, false);
+    replay_renderer_->update(replayed, ui_.replay.cutting_shown());
     shown_ = &replayed;
     scene_ = replay_renderer_.get();
     return Ok{};
@@ -518,11 +522,18 @@ ordered_json make_report(CoreSession& session, ConsoleUi& ui, const ConsoleOptio
                     {"finished", status.recordings_finished}, {"bytes", status.recorded_bytes}, {"ticks", status.recorded_ticks},
                     {"keyframes", status.recorded_keyframes}, {"lost", status.recording_lost},
                     {"message", std::string(status.recording_message.data())}};
+  if (status.recording || status.recordings_finished > 0) {
+    // Only a recording from tick 0 can be re-simulated (scored, verified); said here and on the panel.
+    r["recording"]["start_tick"] = status.recording_start_tick;
+    r["recording"]["from_first_tick"] = status.recording_start_tick == 0;
+  }
   if (ui.replay.is_open()) {
     ordered_json replay = {{"path", ui.replay.path()}, {"time_s", ui.replay.time_s()}, {"step_tick", ui.replay.step_tick_shown()}};
     if (ui.replay.keyframe_number_shown()) replay["keyframe"] = *ui.replay.keyframe_number_shown();
     const RigidPose& sheath = ui.replay.shown_tool().sheath;
     replay["sheath_tip_m"] = {sheath.translation.x, sheath.translation.y, sheath.translation.z};
+    replay["loop_travel_mm"] = units::m_to_mm(ui.replay.loop_travel_shown_m());
+    replay["cutting"] = ui.replay.cutting_shown();
     if (const ReplayVerification* v = ui.replay.verification()) {
       replay["verification"] = {{"error", v->error},
                                 {"ticks", v->ticks},
@@ -659,6 +670,13 @@ std::string summarize_console_report(const ordered_json& r) {
                 core.at("max_late_us").get<double>(), core.at("state_hash").get<std::string>().c_str());
   std::string summary = text;
   if (core.contains("advice")) summary += "  advice           " + core.at("advice").get<std::string>() + "\n";
+  const auto& recording = r.at("recording");
+  if (recording.contains("from_first_tick") && !recording.at("from_first_tick").get<bool>()) {
+    summary += "  recording        " + recording.at("path").get<std::string>() + " from tick " +
+               std::to_string(recording.at("start_tick").get<std::uint64_t>()) +
+               " (mid-session): it replays in the console, but `resecto score` and `replay --verify` need a session recorded "
+               "from its first tick (--record FILE)\n";
+  }
   return summary;
 }
 

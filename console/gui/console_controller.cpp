@@ -165,23 +165,32 @@ void ConsoleController::resume() { send({CoreControlKind::kResume, {}, 0, 0, 1.0
 void ConsoleController::step(std::uint32_t ticks) { send({CoreControlKind::kStep, {}, 0, ticks, 1.0, {}}); }
 void ConsoleController::set_speed(double speed) { send({CoreControlKind::kSpeed, {}, 0, 0, speed, {}}); }
 
+TissueParameters ConsoleController::requested_parameters() const {
+  TissueParameters requested;
+  requested.values = ui_.slider_values;
+  return requested;
+}
+
 Status ConsoleController::save_preset(const std::string& path) {
   Status saved = check_output(path, OutputKind::kPreset);
-  if (saved) saved = gui::save_preset(path, frame().status.parameters);
+  // What the sliders were set to, changes not yet in force included: the frame a change first shows
+  // may run its actions before it reads that snapshot, and an instructor saves what they chose.
+  if (saved) saved = gui::save_preset(path, requested_parameters());
   if (saved) claim_output(path, OutputKind::kPreset);
   ui_.preset_message = saved ? "saved " + path : saved.error();
   return saved;
 }
 
 Status ConsoleController::load_preset(const std::string& path) {
-  Result<TissueParameters> loaded = gui::load_preset(path, frame().status.parameters);
+  const TissueParameters requested = requested_parameters();
+  Result<TissueParameters> loaded = gui::load_preset(path, requested);
   if (!loaded) {
     ui_.preset_message = loaded.error();
     return Error{loaded.error()};
   }
   // Every value that differs becomes a command, in table order.
   for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
-    if (loaded->get(spec.id) != frame().status.parameters.get(spec.id)) set_parameter(spec.id, loaded->get(spec.id));
+    if (loaded->get(spec.id) != requested.get(spec.id)) set_parameter(spec.id, loaded->get(spec.id));
   }
   settings_.parameters = *loaded;
   ui_.preset_message = "loaded " + path;

@@ -37,6 +37,9 @@ class ConsoleController {
   void resume();
   void step(std::uint32_t ticks);
   void set_speed(double speed);
+  /// The tissue the sliders ask for: every change sent, whether or not the core applied it yet.
+  TissueParameters requested_parameters() const;
+  /// Saves requested_parameters(); a load sends a change for each value that differs from them.
   Status save_preset(const std::string& path);
   Status load_preset(const std::string& path);
   /// Moves the hand-driven device's yaw and pitch as a mouse drag across the endoscope image would.

@@ -39,13 +39,34 @@ void row(const char* label, const char* format, Args... args) {
   ImGui::Text(format, args...);
 }
 
-/// Resection's figures, where this build's metrics carry them (a template so the panel compiles
-/// before and after resection joins the core).
-template <class Metrics>
-void resection_rows(const Metrics& m) {
-  if constexpr (requires { m.resected_total_g; m.resected_adenoma_g; m.resected_capsule_g; }) {
-    row("resected", "%.2f g (adenoma %.2f g, capsule %.2f g)", m.resected_total_g, m.resected_adenoma_g, m.resected_capsule_g);
-  }
+/// A message line in a colour, wrapped at the panel's edge rather than cut off there (audit 11).
+template <class... Args>
+void wrapped_colored(const ImVec4& colour, const char* format, Args... args) {
+  ImGui::PushStyleColor(ImGuiCol_Text, colour);
+  ImGui::TextWrapped(format, args...);
+  ImGui::PopStyleColor();
+}
+
+const ImVec4 kWarning(1.0f, 0.5f, 0.3f, 1.0f);
+
+/// A recording started after tick 0 holds no state to re-simulate from: said while it is made, not
+/// first when `resecto score` refuses it (audit 11).
+void mid_session_note(std::uint64_t start_tick) {
+  wrapped_colored(kWarning,
+                  "From mid-session (tick %" PRIu64 "): it replays here and its keyframes export, but `resecto score` and "
+                  "`replay --verify` re-simulate from tick 0 and refuse it. To score a session, start the console with --record FILE.",
+                  start_tick);
+}
+
+/// Resection's figures in the debrief's words and units (strokes, not collision steps), so the
+/// panel and the page a trainee reads later agree.
+void resection_rows(const ProcedureMetrics& m) {
+  const auto plural = [](std::uint64_t n) { return n == 1 ? "" : "s"; };
+  row("resected", "%.2f g (adenoma %.2f g, capsule %.2f g)", m.resected_total_g, m.resected_adenoma_g, m.resected_capsule_g);
+  row("cuts", "%" PRIu64 " stroke%s, %" PRIu64 " chip%s (%.2f g)", m.cuts, plural(m.cuts), m.chips, plural(m.chips), m.chips_g);
+  row("perforations", "%" PRIu64 " stroke%s", m.perforations, plural(m.perforations));
+  row("sphincter zone", "%" PRIu64 " stroke%s, %.2f s cutting distal to the verumontanum", m.sphincter_zone_violations,
+      plural(m.sphincter_zone_violations), m.sphincter_zone_cut_s);
 }
 
 }  // namespace
@@ -81,7 +102,7 @@ void draw_simulation_panel(ConsoleController& console) {
   if (ImGui::Combo("speed", &ui.speed_index, kSpeedNames, IM_ARRAYSIZE(kSpeedNames))) console.set_speed(kSpeeds[ui.speed_index]);
   ImGui::SameLine();
   ImGui::Text("core at %.3gx", s.speed);
-  if (!ui.message.empty()) ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.3f, 1.0f), "%s", ui.message.c_str());
+  if (!ui.message.empty()) wrapped_colored(kWarning, "%s", ui.message.c_str());
 }
 
 void draw_parameter_panel(ConsoleController& console) {
@@ -119,7 +140,7 @@ void draw_parameter_panel(ConsoleController& console) {
       if (s.parameters.get(spec.id) != spec.default_value) console.set_parameter(spec.id, spec.default_value);
     }
   }
-  if (!ui.preset_message.empty()) ImGui::TextDisabled("%s", ui.preset_message.c_str());
+  if (!ui.preset_message.empty()) wrapped_colored(ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled), "%s", ui.preset_message.c_str());
 }
 
 void draw_device_panel(ConsoleController& console) {
@@ -187,13 +208,13 @@ void draw_metrics_panel(ConsoleController& console) {
   row("contact now", "%d points, %.2f N", f.snapshot.penetrating_points, length(f.snapshot.reaction.force_n));
   row("contact time", "%.2f s", m.contact_time_s);
   row("force", "peak %.2f N, mean %.2f N", m.peak_reaction_force_n, m.mean_contact_force_n);
-  row("cut pedal", "%.2f s (%.2f s with the tool pressing tissue)", m.cut_pedal_time_s, m.cut_in_contact_time_s);
+  row("cut pedal", "%.2f s down, %.2f s of it cutting nothing", m.cut_pedal_time_s, m.loop_on_idle_s);
   row("tissue moved", "up to %.2f mm", m.max_tissue_displacement_mm);
   row("deepest insertion", "%.1f mm", m.max_insertion_mm);
   if (!m.distal_margin_mm) {
     row("verumontanum margin", "no cut yet");
   } else {
-    row("verumontanum margin", "%.1f mm (%" PRIu64 " violations)", *m.distal_margin_mm, m.verumontanum_violations);
+    row("verumontanum margin", "%.1f mm at the least (+ proximal)", *m.distal_margin_mm);
   }
   resection_rows(m);
   row("faults", "%" PRIu64 " non-finite, %" PRIu64 " contact overflows", m.non_finite_steps, m.contact_overflows);
@@ -268,6 +289,7 @@ void draw_recording_panel(ConsoleController& console) {
     ImGui::Text("%.2f MB, %.0f kB/s, %.1f s simulated since tick %" PRIu64 ", %" PRIu64 " records lost",
                 static_cast<double>(ui.recording_bytes_seen) / 1e6, seconds > 0 ? static_cast<double>(ui.recording_bytes_seen) / seconds / 1e3 : 0.0,
                 simulated_s, s.recording_start_tick, s.recording_lost);
+    if (s.recording_start_tick > 0) mid_session_note(s.recording_start_tick);
     if (ImGui::Button("Stop recording")) console.stop_recording();
   } else {
     char path[512];
@@ -280,13 +302,16 @@ void draw_recording_panel(ConsoleController& console) {
       const Status started = console.start_recording(ui.record_path);
       ui.record_message = started ? std::string() : started.error();
     }
-    if (!ui.record_message.empty()) ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.3f, 1.0f), "%s", ui.record_message.c_str());
+    if (!ui.record_message.empty()) wrapped_colored(kWarning, "%s", ui.record_message.c_str());
     if (s.recordings_finished > 0) {
       ImGui::TextDisabled("last: %s, %.2f MB, %" PRIu64 " ticks, %" PRIu64 " keyframes, %" PRIu64 " lost", s.recording_path.data(),
                           static_cast<double>(s.recorded_bytes) / 1e6, s.recorded_ticks, s.recorded_keyframes, s.recording_lost);
+      if (s.recording_start_tick > 0) mid_session_note(s.recording_start_tick);
+    } else if (s.next_tick > 0) {
+      wrapped_colored(ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled), "Record starts at the next tick; a session to be scored needs --record FILE, from tick 0");
     }
   }
-  if (s.recording_message[0] != '\0') ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.3f, 1.0f), "%s", s.recording_message.data());
+  if (s.recording_message[0] != '\0') wrapped_colored(kWarning, "%s", s.recording_message.data());
 }
 
 void draw_replay_panel(ConsoleController& console) {
@@ -298,10 +323,10 @@ void draw_replay_panel(ConsoleController& console) {
   if (ImGui::InputText("file##replay", path, sizeof path)) ui.replay_path = path;
   ImGui::SameLine();
   if (ImGui::Button("Open")) (void)console.open_replay(ui.replay_path);
-  if (!ui.replay_message.empty()) ImGui::TextDisabled("%s", ui.replay_message.c_str());
+  if (!ui.replay_message.empty()) wrapped_colored(ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled), "%s", ui.replay_message.c_str());
   if (!replay.is_open()) return;
   const rec::Recording& r = replay.recording();
-  ImGui::Text("%s: %s, %.1f s, %zu keyframes, %zu steps, procedure '%s'", replay.path().c_str(), r.header().mode.c_str(), replay.duration_s(),
+  ImGui::TextWrapped("%s: %s, %.1f s, %zu keyframes, %zu steps, procedure '%s'", replay.path().c_str(), r.header().mode.c_str(), replay.duration_s(),
               r.keyframes().size(), r.steps().size(), r.header().procedure.c_str());
   ImGui::Checkbox("show the replay in the views", &ui.show_replay);
   if (replay.playing()) {
@@ -338,10 +363,9 @@ void draw_replay_panel(ConsoleController& console) {
   }
   if (const ReplayVerification* v = replay.verification()) {
     if (!v->error.empty()) {
-      ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.3f, 1.0f), "verify: %s", v->error.c_str());
+      wrapped_colored(kWarning, "verify: %s", v->error.c_str());
     } else if (v->mismatches == 0 && !v->unverified.empty()) {
-      ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.3f, 1.0f), "%" PRIu64 " hashes match, but not the whole recording: %s", v->verified,
-                         v->unverified.c_str());
+      wrapped_colored(kWarning, "%" PRIu64 " hashes match, but not the whole recording: %s", v->verified, v->unverified.c_str());
     } else if (v->mismatches == 0) {
       ImGui::TextColored(ImVec4(0.4f, 1.0f, 0.4f, 1.0f), "verified: %" PRIu64 " of %" PRIu64 " hashes match (%" PRIu64 " ticks)", v->verified,
                          v->verified, v->ticks);

@@ -108,7 +108,7 @@ struct ConsoleUi {
   std::vector<std::string> screenshots;
   std::string message;  ///< the last error a person should see (bad preset file, ...)
   // Recording and replay.
-  std::string record_path = "session.resecto";
+  std::string record_path = "session.rsrec";
   std::string record_message;  ///< why the Record button's path was refused, until it is pressed again
   std::string replay_path;
   std::string replay_message;

@@ -104,15 +104,28 @@ const SimulationSnapshot& ReplayBrowser::snapshot() {
   auto after = std::upper_bound(steps.begin(), steps.end(), tick, [](std::uint64_t t, const rec::StepEntry& s) { return t < s.tick; });
   // A step whose chunk no longer reads (the file changed since it was opened) leaves the last one shown.
   if (after != steps.begin()) {
-    if (Result<rec::StepRecord> s = steps_->at(static_cast<std::size_t>(after - 1 - steps.begin()))) {
+    const auto index = static_cast<std::size_t>(after - 1 - steps.begin());
+    if (Result<rec::StepRecord> s = steps_->at(index)) {
       snapshot_.tool = s->tool;
       snapshot_.metrics = s->metrics;
       snapshot_.state_hash = s->state_hash;
       snapshot_.tick = s->tick + 1;
       step_tick_shown_ = s->tick;
+      const double pedal_s = s->metrics.cut_pedal_time_s;
+      // The step before is nearly always in the chunk just read (45 steps a chunk).
+      double before_s = 0.0;
+      if (index > 0) {
+        if (Result<rec::StepRecord> previous = steps_->at(index - 1)) before_s = previous->metrics.cut_pedal_time_s;
+      }
+      cutting_shown_ = pedal_s > before_s;
     }
   }
   return snapshot_;
+}
+
+double ReplayBrowser::loop_travel_shown_m() const {
+  const ToolPoses& tool = snapshot_.tool;
+  return dot(tool.loop.translation - tool.sheath.translation, tool.sheath.apply_vector(Vec3(0.0, 0.0, 1.0)));
 }
 
 void ReplayBrowser::start_verification() {

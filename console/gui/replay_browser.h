@@ -74,6 +74,12 @@ class ReplayBrowser {
   std::uint64_t step_tick_shown() const { return step_tick_shown_; }
   /// The tool as last shown by snapshot().
   const ToolPoses& shown_tool() const { return snapshot_.tool; }
+  /// Whether the cutting pedal was down in the collision step shown: its pedal time grew since the
+  /// step before (the steps record metrics, not pedals), so the loop glows as it did live.
+  bool cutting_shown() const { return cutting_shown_; }
+  /// The loop's travel out of the sheath in the step shown, metres: the loop pose's offset along the
+  /// sheath's axis, as the kinematics place it.
+  double loop_travel_shown_m() const;
   /// The gland the recording was made with (for the views' landmarks and colours).
   const ProstateModel& prostate() const { return prostate_; }
 
@@ -101,6 +107,7 @@ class ReplayBrowser {
   SimulationSnapshot snapshot_;
   std::optional<std::size_t> keyframe_shown_;
   std::uint64_t step_tick_shown_ = 0;
+  bool cutting_shown_ = false;
   std::uint64_t topology_counter_ = 0;
   std::atomic<bool> verifying_{false};
   std::atomic<bool> verified_{false};

@@ -99,7 +99,9 @@ std::vector<MetricRow> metric_rows() {
 
 /// A time plot: `value` of every sample (a min/max envelope per pixel column when there are more
 /// samples than columns), axes labelled with the range.
-std::string plot_svg(const std::vector<ScoreSample>& series, const char* title, const char* unit, const char* colour,
+/// `min_span`: the least range the vertical axis shows, in the plot's unit, so a trace that barely
+/// moves (a still hand's sensor noise, 0.1 mm) is drawn flat rather than stretched to the full height.
+std::string plot_svg(const std::vector<ScoreSample>& series, const char* title, const char* unit, const char* colour, double min_span,
                      const std::function<double(const ScoreSample&)>& value) {
   constexpr int kWidth = 460, kHeight = 130, kLeft = 48, kBottom = 20, kTop = 18;
   const int plot_w = kWidth - kLeft - 8, plot_h = kHeight - kTop - kBottom;
@@ -108,6 +110,12 @@ std::string plot_svg(const std::vector<ScoreSample>& series, const char* title, 
   if (series.empty()) return svg + "<text x=\"60\" y=\"60\">no samples</text></svg>";
   double lo = value(series.front()), hi = lo;
   for (const ScoreSample& s : series) lo = std::min(lo, value(s)), hi = std::max(hi, value(s));
+  if (hi - lo < min_span) {
+    // Centred on the trace, but a quantity that is never negative keeps its axis from zero up.
+    const double middle = 0.5 * (lo + hi);
+    lo = lo >= 0.0 ? std::max(0.0, middle - 0.5 * min_span) : middle - 0.5 * min_span;
+    hi = lo + min_span;
+  }
   if (hi - lo < 1e-12) hi = lo + 1.0;
   const double t0 = series.front().time_s, t1 = std::max(series.back().time_s, t0 + 1e-9);
   auto px = [&](double t) { return kLeft + (t - t0) / (t1 - t0) * plot_w; };
@@ -143,14 +151,16 @@ std::string section_for(const RecordingScore& s) {
   }
   html += "<h3>Plots over time</h3>";
   const std::vector<ScoreSample>& series = s.score.series;
-  html += plot_svg(series, "Reaction force, largest of each step", "N", "#1d3557", [](const ScoreSample& x) { return x.force_n; });
-  html += plot_svg(series, "Cutting pedal", "down = 1", "#d62828", [](const ScoreSample& x) { return x.cutting ? 1.0 : 0.0; });
-  html += plot_svg(series, "Insertion depth past the apex", "mm", "#2a9d8f", [](const ScoreSample& x) { return x.insertion_mm; });
-  html += plot_svg(series, "Resected tissue", "g", "#e76f51", [](const ScoreSample& x) { return x.resected_g; });
+  html += plot_svg(series, "Reaction force, largest of each step", "N", "#1d3557", 1.0, [](const ScoreSample& x) { return x.force_n; });
+  html += plot_svg(series, "Cutting pedal", "down = 1", "#d62828", 1.0, [](const ScoreSample& x) { return x.cutting ? 1.0 : 0.0; });
+  html += plot_svg(series, "Insertion depth past the apex", "mm", "#2a9d8f", 10.0, [](const ScoreSample& x) { return x.insertion_mm; });
+  html += plot_svg(series, "Resected tissue", "g", "#e76f51", 0.1, [](const ScoreSample& x) { return x.resected_g; });
   html += "<h3>Resection heat map</h3><p class=\"legend\"><span style=\"background:" + std::string(kRemovedAdenomaColour) +
           "\"></span>removed adenoma <span style=\"background:" + kRemainingAdenomaColour + "\"></span>remaining adenoma <span style=\"background:" +
           kRemovedCapsuleColour + "\"></span>removed capsule <span style=\"background:" + kRemainingCapsuleColour +
-          "\"></span>capsule</p>" + heat_map_svg(s.score.heat_map);
+          "\"></span>capsule<br>Slabs along the urethra by the tissue's rest position, z from the apex; a cell is removed when the loop "
+          "cut it or it left with a chip the cuts freed.</p>" +
+          heat_map_svg(s.score.heat_map);
   return html + "</section>";
 }
 
@@ -165,9 +175,11 @@ std::string heat_map_svg(const ResectionHeatMap& map) {
   const double cell_m3 = map.cell.x * map.cell.y * map.cell.z;
   for (int k = 0; k < map.nz; ++k) {
     const int x0 = k * (slice_w + kGap);
-    const double z_mm = (map.origin.z + (k + 0.5) * map.cell.z) * 1000.0;
-    svg += "<text x=\"" + std::to_string(x0) + "\" y=\"" + std::to_string(slice_h + 14) + "\" class=\"axis\">z " + number(z_mm, 0) +
-           " mm" + (k == 0 ? " (apex)" : k == map.nz - 1 ? " (bladder neck)" : "") + "</text>";
+    // The slab's extent, not its centre: a cut a few millimetres proximal of the verumontanum lands in
+    // the apex's slab, which its centre alone made read as apical resection (audit 11).
+    const double from_mm = (map.origin.z + k * map.cell.z) * 1000.0, to_mm = (map.origin.z + (k + 1) * map.cell.z) * 1000.0;
+    svg += "<text x=\"" + std::to_string(x0) + "\" y=\"" + std::to_string(slice_h + 14) + "\" class=\"axis\">z " + number(from_mm, 1) +
+           " to " + number(to_mm, 1) + " mm" + (k == 0 ? " (apex)" : k == map.nz - 1 ? " (bladder neck)" : "") + "</text>";
     for (int j = 0; j < map.ny; ++j) {
       for (int i = 0; i < map.nx; ++i) {
         const std::size_t c = (static_cast<std::size_t>(k) * static_cast<std::size_t>(map.ny) + static_cast<std::size_t>(j)) * static_cast<std::size_t>(map.nx) +
@@ -195,7 +207,7 @@ std::string debrief_html(std::span<const RecordingScore> scores) {
       "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>Resecto debrief</title><style>"
       "body{font-family:sans-serif;margin:16px;color:#222}table{border-collapse:collapse;margin-bottom:16px}"
       "td,th{border:1px solid #bbb;padding:3px 8px;font-size:13px;text-align:left}th{background:#eee}"
-      ".cols{display:flex;gap:24px}.cols section{flex:1}.plot{display:block;margin:4px 0}.title{font-size:12px;font-weight:bold}"
+      ".cols{display:flex;flex-wrap:wrap;gap:24px}.cols section{flex:1 1 480px;min-width:0;overflow-x:auto}.plot{display:block;margin:4px 0}.title{font-size:12px;font-weight:bold}"
       ".axis{font-size:10px;fill:#555}.legend span{display:inline-block;width:12px;height:12px;margin:0 4px 0 12px;vertical-align:middle}"
       ".ref{color:#555;font-size:12px}.warn{color:#9d0208;font-weight:bold}</style></head><body><h1>Resecto debrief</h1>";
   html += "<h2>Metrics</h2><table><tr><th>Metric</th><th>Unit</th>";

@@ -190,7 +190,10 @@ TEST(ConsoleWindow, StiffnessActionAppliesAtTheNextTickAndTheFirstFrameAfterShow
   REQUIRE_X_SERVER();
   const auto dir = scratch_directory("console_stiffness");
   const auto procedure = write_in_gland_procedure(dir);
+  // A preset saved in the frame that sends the change holds it (audit 11: it held the value the
+  // snapshot showed, the old one, when the change was not yet in force).
   std::ofstream(dir / "stiff.actions") << "frame 6 set stiffness 200\n"
+                                       << "frame 6 preset save " << (dir / "same_frame.json").string() << "\n"
                                        << "frame 40 preset save " << (dir / "preset.json").string() << "\n"
                                        << "frame 41 quit\n";
   const CommandOutput run = run_in_xvfb("console --lockstep --procedure " + procedure.string() + " --triangles 1296 --actions " +
@@ -212,6 +215,7 @@ TEST(ConsoleWindow, StiffnessActionAppliesAtTheNextTickAndTheFirstFrameAfterShow
   EXPECT_GT(change.at("shown_snapshot_tick").get<std::int64_t>(), applied);
   EXPECT_EQ(change.at("shown_value"), 200.0);
   EXPECT_NE(read_text(dir / "preset.json").find("\"stiffness\": 200"), std::string::npos);
+  EXPECT_NE(read_text(dir / "same_frame.json").find("\"stiffness\": 200"), std::string::npos);
 
   // The same procedure headless (batch): equal hashes before the change's tick, different after.
   const auto& hashes = report.at("collision_hashes");
@@ -329,7 +333,8 @@ TEST(ConsoleWindow, ReplayOfACutShowsTheCutAndScrubbedBackTheUncutLining) {
                                        << "frame 6 screenshot " << (dir / "cut.png").string() << "\n"
                                        << "frame 7 replay seek 0.45\n"
                                        << "frame 11 screenshot " << (dir / "back.png").string() << "\n"
-                                       << "frame 12 quit\n";
+                                       << "frame 12 replay seek 2.0\n"
+                                       << "frame 16 quit\n";
   const CommandOutput replayed = run_in_xvfb("console --triangles 1296 --width 1280 --height 800 --replay " + recording.string() +
                                                  " --actions " + (dir / "scrub.actions").string() + " --report " + (dir / "report.json").string(),
                                              dir);
@@ -342,6 +347,13 @@ TEST(ConsoleWindow, ReplayOfACutShowsTheCutAndScrubbedBackTheUncutLining) {
   EXPECT_GT(cut.adenoma_share(), 0.05);
   EXPECT_LT(back.adenoma_share(), 0.002) << "scrubbed back before the cut, the lining is lining again";
   EXPECT_LT(back.capsule_share(), 0.002);
+  // Mid-stroke the replay says what the hand did: the pedal down and the loop on its way in from
+  // 14 mm to 1 (audit 11: the overlay showed the time and the sheath tip only, the loop never glowed).
+  const nlohmann::json replay = load_json(dir / "report.json").at("replay");
+  EXPECT_NEAR(replay.at("time_s").get<double>(), 2.0, 0.05);
+  EXPECT_TRUE(replay.at("cutting").get<bool>());
+  EXPECT_GT(replay.at("loop_travel_mm").get<double>(), 2.0);
+  EXPECT_LT(replay.at("loop_travel_mm").get<double>(), 13.0);
 }
 
 TEST(ConsoleWindow, SlowFramesNeverHoldTheCoreBack) {
@@ -380,7 +392,7 @@ TEST(ConsoleWindow, RunWithoutHeadlessOpensTheConsole) {
 TEST(ConsoleWindow, RecordedSessionReplaysAtAScrubbedTimeWithTheRecordedToolPoseAndVerifies) {
   REQUIRE_X_SERVER();
   const auto dir = scratch_directory("console_replay");
-  const auto recording = dir / "session.resecto";
+  const auto recording = dir / "session.rsrec";
   const auto procedure = write_in_gland_procedure(dir);
   std::ofstream(dir / "record.actions") << "frame 3 set stiffness 90\nframe 20 quit\n";
   const CommandOutput recorded = run_in_xvfb("console --lockstep --procedure " + procedure.string() + " --triangles 1296 --record " +
@@ -391,6 +403,8 @@ TEST(ConsoleWindow, RecordedSessionReplaysAtAScrubbedTimeWithTheRecordedToolPose
   const nlohmann::json record_report = load_json(dir / "record.json");
   EXPECT_EQ(record_report.at("recording").at("finished"), 1);
   EXPECT_EQ(record_report.at("recording").at("lost"), 0);
+  EXPECT_TRUE(record_report.at("recording").at("from_first_tick").get<bool>());
+  EXPECT_EQ(recorded.out.find("mid-session"), std::string::npos) << recorded.out;
   Result<rec::Recording> opened = rec::Recording::open(recording);
   ASSERT_TRUE(opened) << opened.error();
   const double scrub_s = 0.6 * opened->duration_s();
@@ -496,8 +510,16 @@ TEST(ConsoleWindow, AMidSessionRecordingIsSoundButNotReplayable) {
   const auto dir = scratch_directory("console_mid_session");
   const auto recording = dir / "mid.rsrec";
   std::ofstream(dir / "m.actions") << "frame 5 record " << recording.string() << "\nframe 25 record stop\nframe 26 quit\n";
-  const CommandOutput made = run_in_xvfb("console --triangles 1296 --width 800 --height 600 --actions " + (dir / "m.actions").string(), dir);
+  const CommandOutput made = run_in_xvfb("console --triangles 1296 --width 800 --height 600 --actions " + (dir / "m.actions").string() +
+                                             " --report " + (dir / "m.json").string(),
+                                         dir);
   ASSERT_EQ(made.exit_code, 0) << made.err;
+  // Said when it is made, not first when `score` refuses it (audit 11).
+  EXPECT_NE(made.out.find("(mid-session): it replays in the console, but `resecto score` and `replay --verify` need"), std::string::npos)
+      << made.out;
+  const nlohmann::json report = load_json(dir / "m.json");
+  EXPECT_GT(report.at("recording").at("start_tick").get<std::uint64_t>(), 0u);
+  EXPECT_FALSE(report.at("recording").at("from_first_tick").get<bool>());
   const CommandOutput verify = run_resecto("rec verify " + recording.string());
   EXPECT_EQ(verify.exit_code, 0) << verify.err;
   EXPECT_EQ(verify.out.find(": ok,"), std::string::npos) << verify.out;

@@ -363,6 +363,25 @@ TEST(ScoreCommand, HtmlDebriefRendersInHeadlessChromiumWithTheCutOnTheHeatMap) {
   }
   // The heat map shows removed adenoma (the demo cut both lateral lobes).
   EXPECT_NE(html.find("fill=\"#d62828\""), std::string::npos);
+  // Its slabs are labelled by their extent (audit 11: a centre alone read as apical resection).
+  const std::size_t apex = html.find(" mm (apex)</text>");
+  ASSERT_NE(apex, std::string::npos);
+  EXPECT_NE(html.rfind(" to ", apex), std::string::npos);
+  EXPECT_GT(html.rfind(" to ", apex), html.rfind("class=\"axis\">z ", apex));
+  // A plot's axis spans at least its least range: the insertion's 10 mm, so the sensors' noise on a
+  // still hand is not stretched to the plot's height. Its top and bottom labels follow its title.
+  const std::size_t insertion = html.find("Insertion depth past the apex (mm)");
+  ASSERT_NE(insertion, std::string::npos);
+  const auto axis_number = [&](std::size_t from, std::size_t& after) {
+    const std::string mark = "class=\"axis\">";
+    const std::size_t at = html.find(mark, from) + mark.size();
+    after = at;
+    return std::stod(html.substr(at, html.find('<', at) - at));
+  };
+  std::size_t after = 0;
+  const double top = axis_number(insertion, after);
+  const double bottom = axis_number(after, after);
+  EXPECT_GE(top - bottom, 10.0 - 0.01) << top << " " << bottom;
 
   const CommandOutput compare = run_resecto("score --quiet --compare " + (dir / "demo.resecto").string() + " " + (dir / "demo.resecto").string() +
                                             " --html " + (dir / "compare.html").string());
