@@ -53,8 +53,8 @@ void add_console_options(CLI::App& cmd, ConsoleCliOptions& o, bool shared_with_r
   cmd.add_option("--insertion-mm", o.start_insertion_mm, "--device keyboard: where the sheath starts, mm past the pivot (the apex is at 150)")
       ->check(finite_range(0.0, 230.0))
       ->capture_default_str();
-  cmd.add_option("--width", o.width, "Window width, pixels")->transform(whole_in_range(640, 8192))->capture_default_str();
-  cmd.add_option("--height", o.height, "Window height, pixels")->transform(whole_in_range(480, 8192))->capture_default_str();
+  cmd.add_option("--width", o.width, "Window width, pixels (default 1600, or the screen's work area if narrower)")->transform(whole_in_range(640, 8192));
+  cmd.add_option("--height", o.height, "Window height, pixels (default 1000, or the screen's work area if lower)")->transform(whole_in_range(480, 8192));
   cmd.add_option("--slow-frame-ms", o.slow_frame_ms, "Make every frame this much slower (to show the core is never held back)")
       ->check(finite_range(0.0, 10000.0));
   cmd.add_option("--slow-frame-every", o.slow_frame_every,

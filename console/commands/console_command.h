@@ -27,8 +27,8 @@ struct ConsoleCliOptions {
   std::vector<std::string> sets;
   bool lockstep = false;
   double start_insertion_mm = 165.0;
-  int width = 1600;
-  int height = 1000;
+  int width = 0;   ///< 0: 1600, or the screen's work area if smaller
+  int height = 0;  ///< 0: 1000, or the screen's work area if smaller
   double slow_frame_ms = 0.0;
   std::uint64_t slow_frame_every = 1;
   bool no_vsync = false;

@@ -308,7 +308,9 @@ void ConsoleWindow::layout_and_draw() {
   const float views = std::floor(display.y * 0.60f);
   draw_endoscope_window(ImVec2(0, 0), ImVec2(std::floor(left * 0.5f), views));
   draw_outside_window(ImVec2(std::floor(left * 0.5f), 0), ImVec2(left - std::floor(left * 0.5f), views));
-  const ImGuiWindowFlags fixed = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse;
+  // A small window scrolls sideways rather than cutting off the panels' right-hand column.
+  const ImGuiWindowFlags fixed =
+      ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_HorizontalScrollbar;
   ImGui::SetNextWindowPos(ImVec2(0, views));
   ImGui::SetNextWindowSize(ImVec2(left, display.y - views));
   ImGui::Begin("Profiler", nullptr, fixed);
@@ -577,7 +579,13 @@ Result<ordered_json> run_console(const ConsoleOptions& options) {
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-  GLFWwindow* window = glfwCreateWindow(options.settings.window_width, options.settings.window_height, "Resecto operator console",
+  // A size not asked for fits the screen (audit 11: 1600 x 1000 on a 1024 x 700 screen); one asked for is kept.
+  int width = options.settings.window_width, height = options.settings.window_height;
+  int area_x = 0, area_y = 0, area_w = 0, area_h = 0;
+  if (GLFWmonitor* monitor = glfwGetPrimaryMonitor()) glfwGetMonitorWorkarea(monitor, &area_x, &area_y, &area_w, &area_h);
+  if (width == 0) width = area_w > 0 ? std::clamp(area_w, 640, ConsoleSettings::kDefaultWidth) : ConsoleSettings::kDefaultWidth;
+  if (height == 0) height = area_h > 0 ? std::clamp(area_h, 480, ConsoleSettings::kDefaultHeight) : ConsoleSettings::kDefaultHeight;
+  GLFWwindow* window = glfwCreateWindow(width, height, "Resecto operator console",
                                         nullptr, nullptr);
   if (!window) return Error{"cannot create an OpenGL 3.3 core window (" + g_glfw_error + ")"};
   glfwMakeContextCurrent(window);

@@ -22,8 +22,9 @@ namespace resecto::gui {
 /// Saved settings: what outlives a session.
 struct ConsoleSettings {
   TissueParameters parameters;  ///< the tissue the session starts with (a preset)
-  int window_width = 1600;
-  int window_height = 1000;
+  int window_width = 0;   ///< 0: kDefaultWidth, or the primary screen's work area if narrower
+  int window_height = 0;  ///< 0: kDefaultHeight, or the work area if lower
+  static constexpr int kDefaultWidth = 1600, kDefaultHeight = 1000;
 };
 
 /// One parameter change followed from the widget (or action) to the frame that shows it.

@@ -46,12 +46,12 @@ bool x_server_available() {
 /// `resecto ARGS` inside a fresh Xvfb with a screen larger than any window the tests open. resecto's
 /// own exit status is kept in a file: xvfb-run replaces it with 5 when it fails to clean up its
 /// temporary folder afterwards (seen once in CI, two xvfb-runs at once), whatever resecto returned.
-CommandOutput run_in_xvfb(const std::string& arguments, const std::filesystem::path& dir) {
+CommandOutput run_in_xvfb(const std::string& arguments, const std::filesystem::path& dir, const std::string& screen = "1920x1200x24") {
   const std::filesystem::path status_file = dir / "status.txt";
   std::filesystem::remove(status_file);
   const std::string inner = std::string(RESECTO_EXE) + " " + arguments + " >" + (dir / "stdout.txt").string() + " 2>" +
                             (dir / "stderr.txt").string() + " </dev/null; echo $? >" + status_file.string();
-  const std::string command = "xvfb-run -a -s '-screen 0 1920x1200x24' sh -c '" + inner + "' </dev/null";
+  const std::string command = "xvfb-run -a -s '-screen 0 " + screen + "' sh -c '" + inner + "' </dev/null";
   const int status = std::system(command.c_str());
   CommandOutput out;
   const std::string recorded = std::filesystem::exists(status_file) ? read_text(status_file) : std::string();
@@ -144,6 +144,21 @@ TEST(ConsoleWindow, RendersAndWritesAScreenshotOfTheSizeAsked) {
   const nlohmann::json report = load_json(dir / "report.json");
   EXPECT_EQ(report.at("frames"), 4);
   EXPECT_NE(run.out.find("input-to-photon"), std::string::npos) << run.out;
+}
+
+// Audit 11: without --width/--height the window was 1600 x 1000 on any screen, its panels off a
+// small one. A size not asked for now fits the screen's work area; one asked for is kept.
+TEST(ConsoleWindow, AWindowSizeNotAskedForFitsTheScreen) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_fits_screen");
+  const auto window_on = [&](const std::string& screen, const std::string& size) {
+    const CommandOutput run = run_in_xvfb("console --triangles 1296 --frames 2 " + size + " --report " + (dir / "report.json").string(), dir, screen);
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    return load_json(dir / "report.json").at("window");
+  };
+  EXPECT_EQ(window_on("1024x700x24", ""), nlohmann::json::array({1024, 700}));
+  EXPECT_EQ(window_on("1920x1200x24", ""), nlohmann::json::array({1600, 1000}));
+  EXPECT_EQ(window_on("1024x700x24", "--width 1280 --height 800"), nlohmann::json::array({1280, 800}));
 }
 
 // Audit 9: the console's emulator follows a procedure as a headless run's does, so it refuses one that
