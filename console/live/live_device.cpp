@@ -11,11 +11,13 @@
 namespace resecto {
 namespace {
 
-// Slew limits of the hand-driven board: well under the encoders' 1758 deg/s decoding limit and the
-// sheath's fastest plausible push, well over what ManualMotionLimits asks for, so the follower only
-// smooths a frame's step and never slows a person down.
+// Slew limits of the hand-driven board. Turning: well under the encoders' 1758 deg/s decoding limit,
+// well over what ManualMotionLimits asks for. Sliding (insertion, loop): a hand's pace, over the keys'
+// 40 and 30 mm/s and no faster than the contact search follows (its 1.5 mm margin over two collision
+// periods, 45 mm/s): a value typed into a joint field glides there as a hand would move, rather than
+// jumping 15 mm in 40 ms and leaving a 90 N set-up spike as the debrief's peak force (audit 11).
 constexpr double kFollowAngularRadPerS = 10.0;
-constexpr double kFollowLinearMmPerS = 400.0;
+constexpr double kFollowLinearMmPerS = 45.0;
 
 double approach(double from, double to, double max_step) { return from + std::clamp(to - from, -max_step, max_step); }
 

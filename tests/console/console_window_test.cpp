@@ -146,6 +146,23 @@ TEST(ConsoleWindow, RendersAndWritesAScreenshotOfTheSizeAsked) {
   EXPECT_NE(run.out.find("input-to-photon"), std::string::npos) << run.out;
 }
 
+// Audit 11: a joint typed into the panel jumped there at 400 mm/s (15 mm in 40 ms), and the set-up
+// jump's force spike became the debrief's peak force. It glides at a hand's pace now: the sheath can
+// have gone no further than 45 mm/s for the session's whole wall time, and it did set off.
+TEST(ConsoleWindow, ATypedInsertionGlidesThereAtAHandsPace) {
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_typed_glides");
+  std::ofstream(dir / "t.actions") << "frame 1 set insertion 200\nframe 4 quit\n";
+  const CommandOutput run = run_in_xvfb("console --device keyboard --insertion-mm 100 --triangles 1296 --width 800 --height 600 --actions " +
+                                            (dir / "t.actions").string() + " --report " + (dir / "t.json").string(),
+                                        dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json t = load_json(dir / "t.json");
+  const double moved_mm = t.at("metrics").at("max_insertion_mm").get<double>() - 100.0;
+  EXPECT_GT(moved_mm, 0.5) << "the sheath never set off";
+  EXPECT_LT(moved_mm, 45.0 * t.at("wall_s").get<double>() + 1.0) << "faster than a hand";
+}
+
 // Audit 11: without --width/--height the window was 1600 x 1000 on any screen, its panels off a
 // small one. A size not asked for now fits the screen's work area; one asked for is kept.
 TEST(ConsoleWindow, AWindowSizeNotAskedForFitsTheScreen) {
