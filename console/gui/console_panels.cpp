@@ -326,8 +326,8 @@ void draw_replay_panel(ConsoleController& console) {
   if (!ui.replay_message.empty()) wrapped_colored(ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled), "%s", ui.replay_message.c_str());
   if (!replay.is_open()) return;
   const rec::Recording& r = replay.recording();
-  ImGui::TextWrapped("%s: %s, %.1f s, %zu keyframes, %zu steps, procedure '%s'", replay.path().c_str(), r.header().mode.c_str(), replay.duration_s(),
-              r.keyframes().size(), r.steps().size(), r.header().procedure.c_str());
+  ImGui::TextWrapped("%s: %s, %.1f s, %zu keyframes, %zu steps, procedure '%s'", replay.path().c_str(), r.header().mode.c_str(),
+                     replay.duration_s(), r.keyframes().size(), r.steps().size(), r.header().procedure.c_str());
   ImGui::Checkbox("show the replay in the views", &ui.show_replay);
   if (replay.playing()) {
     if (ImGui::Button("Pause##replay")) replay.pause();
