@@ -680,10 +680,8 @@ std::string summarize_console_report(const ordered_json& r) {
   if (core.contains("advice")) summary += "  advice           " + core.at("advice").get<std::string>() + "\n";
   const auto& recording = r.at("recording");
   if (recording.contains("from_first_tick") && !recording.at("from_first_tick").get<bool>()) {
-    summary += "  recording        " + recording.at("path").get<std::string>() + " from tick " +
-               std::to_string(recording.at("start_tick").get<std::uint64_t>()) +
-               " (mid-session): it replays in the console, but `resecto score` and `replay --verify` need a session recorded "
-               "from its first tick (--record FILE)\n";
+    summary += "  recording        " + recording.at("path").get<std::string>() + " " +
+               mid_session_recording_note(recording.at("start_tick").get<std::uint64_t>()) + "\n";
   }
   return summary;
 }

@@ -171,6 +171,15 @@ TissueParameters ConsoleController::requested_parameters() const {
   return requested;
 }
 
+void ConsoleController::request_parameters(const TissueParameters& wanted) {
+  // Every value that differs from what the sliders ask for (a change not yet in force included)
+  // becomes a command, in table order.
+  const TissueParameters requested = requested_parameters();
+  for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
+    if (wanted.get(spec.id) != requested.get(spec.id)) set_parameter(spec.id, wanted.get(spec.id));
+  }
+}
+
 Status ConsoleController::save_preset(const std::string& path) {
   Status saved = check_output(path, OutputKind::kPreset);
   // What the sliders were set to, changes not yet in force included: the frame a change first shows
@@ -182,16 +191,12 @@ Status ConsoleController::save_preset(const std::string& path) {
 }
 
 Status ConsoleController::load_preset(const std::string& path) {
-  const TissueParameters requested = requested_parameters();
-  Result<TissueParameters> loaded = gui::load_preset(path, requested);
+  Result<TissueParameters> loaded = gui::load_preset(path, requested_parameters());
   if (!loaded) {
     ui_.preset_message = loaded.error();
     return Error{loaded.error()};
   }
-  // Every value that differs becomes a command, in table order.
-  for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
-    if (loaded->get(spec.id) != requested.get(spec.id)) set_parameter(spec.id, loaded->get(spec.id));
-  }
+  request_parameters(*loaded);
   settings_.parameters = *loaded;
   ui_.preset_message = "loaded " + path;
   return Ok{};

@@ -39,7 +39,10 @@ class ConsoleController {
   void set_speed(double speed);
   /// The tissue the sliders ask for: every change sent, whether or not the core applied it yet.
   TissueParameters requested_parameters() const;
-  /// Saves requested_parameters(); a load sends a change for each value that differs from them.
+  /// Sends a change for each value of `wanted` that differs from requested_parameters() (a preset
+  /// loaded, the Defaults button).
+  void request_parameters(const TissueParameters& wanted);
+  /// Saves requested_parameters(); a load goes through request_parameters().
   Status save_preset(const std::string& path);
   Status load_preset(const std::string& path);
   /// Moves the hand-driven device's yaw and pitch as a mouse drag across the endoscope image would.

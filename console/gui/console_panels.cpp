@@ -49,13 +49,9 @@ void wrapped_colored(const ImVec4& colour, const char* format, Args... args) {
 
 const ImVec4 kWarning(1.0f, 0.5f, 0.3f, 1.0f);
 
-/// A recording started after tick 0 holds no state to re-simulate from: said while it is made, not
-/// first when `resecto score` refuses it (audit 11).
+/// Said while the recording is made, not first when `resecto score` refuses it (audit 11).
 void mid_session_note(std::uint64_t start_tick) {
-  wrapped_colored(kWarning,
-                  "From mid-session (tick %" PRIu64 "): it replays here and its keyframes export, but `resecto score` and "
-                  "`replay --verify` re-simulate from tick 0 and refuse it. To score a session, start the console with --record FILE.",
-                  start_tick);
+  wrapped_colored(kWarning, "recorded %s", mid_session_recording_note(start_tick).c_str());
 }
 
 /// Resection's figures in the debrief's words and units (strokes, not collision steps), so the
@@ -70,6 +66,12 @@ void resection_rows(const ProcedureMetrics& m) {
 }
 
 }  // namespace
+
+std::string mid_session_recording_note(std::uint64_t start_tick) {
+  return "from tick " + std::to_string(start_tick) +
+         " (mid-session): it replays in the console, but `resecto score` and `replay --verify` need a session recorded from its "
+         "first tick (--record FILE)";
+}
 
 void draw_simulation_panel(ConsoleController& console) {
   const LiveFrame& f = console.frame();
@@ -135,11 +137,7 @@ void draw_parameter_panel(ConsoleController& console) {
   ImGui::SameLine();
   if (ImGui::Button("Load preset")) (void)console.load_preset(ui.preset_path);
   ImGui::SameLine();
-  if (ImGui::Button("Defaults")) {
-    for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
-      if (s.parameters.get(spec.id) != spec.default_value) console.set_parameter(spec.id, spec.default_value);
-    }
-  }
+  if (ImGui::Button("Defaults")) console.request_parameters(TissueParameters{});
   if (!ui.preset_message.empty()) wrapped_colored(ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled), "%s", ui.preset_message.c_str());
 }
 

@@ -3,6 +3,9 @@
 // changes things only through the ConsoleController.
 #pragma once
 
+#include <cstdint>
+#include <string>
+
 #include "console/gui/console_controller.h"
 
 namespace resecto::gui {
@@ -14,5 +17,9 @@ void draw_metrics_panel(ConsoleController& console);
 void draw_profiler_panel(ConsoleController& console);
 void draw_recording_panel(ConsoleController& console);
 void draw_replay_panel(ConsoleController& console);
+
+/// What a recording started at `start_tick` > 0 cannot do: a recording from mid-session holds no
+/// state to re-simulate from. Said on the Recording panel and in the console's exit summary.
+std::string mid_session_recording_note(std::uint64_t start_tick);
 
 }  // namespace resecto::gui
