@@ -17,9 +17,11 @@ constexpr int kWireSides = 5;
 constexpr int kArmSegments = 3;
 constexpr int kArcSegments = 26;
 /// The wire's half-ring hangs below the axis; its arms run back inside the sheath, long enough to
-/// stay inside at full travel, so the loop is one rigid object that translates with travel.
+/// stay inside at full travel, so the loop is one rigid object that translates with travel. The arms'
+/// height puts the ring's lowest wire just inside the sheath's outline (4.28 of 4.34 mm), so the
+/// retracted ring lies within the sheath and holds no tissue against it.
 constexpr double kArmLengthM = 0.042;
-constexpr double kArmHeightM = -0.0015;
+constexpr double kArmHeightM = -0.0011;
 
 TriangleMesh make_sheath(const ResectoscopeShape& s) {
   TriangleMesh mesh;
@@ -52,13 +54,13 @@ TriangleMesh make_sheath(const ResectoscopeShape& s) {
 Vec3 arc_point(const ResectoscopeShape& s, int i) {
   const double half_span = 0.5 * s.loop_span_m;
   const double angle = std::numbers::pi * (1.0 + static_cast<double>(i) / kArcSegments);
-  return {half_span * std::cos(angle), kArmHeightM + half_span * std::sin(angle), s.loop_stem_length_m + s.loop_travel_m};
+  return {half_span * std::cos(angle), kArmHeightM + half_span * std::sin(angle), s.retracted_loop_z_m + s.loop_travel_m};
 }
 
 /// Centre line of the wire: left arm forward, the half-ring below the axis, right arm back.
 std::vector<Vec3> loop_path(const ResectoscopeShape& s) {
   const double half_span = 0.5 * s.loop_span_m;
-  const double front = s.loop_stem_length_m + s.loop_travel_m;
+  const double front = s.retracted_loop_z_m + s.loop_travel_m;
   std::vector<Vec3> path;
   for (int i = 0; i <= kArmSegments; ++i) {
     path.push_back({-half_span, kArmHeightM, front - kArmLengthM * (1.0 - static_cast<double>(i) / kArmSegments)});

@@ -1,6 +1,8 @@
 // The resectoscope model of the paper's benchmark: a sheath of 158 triangles and a resecting loop of
 // 330 (488 in all). Tool frame: the sheath's axis is +z (the direction of insertion), its tip at the
-// origin, the shaft extending toward -z; the loop's wire hangs below the axis (-y) in front of the tip.
+// origin, the shaft extending toward -z; the loop's wire hangs below the axis (-y) and travels out in
+// front of the tip. Drawn fully back it lies just inside the tip, in the slot of the sheath's insulated
+// beak, so a loop closed against the sheath has passed through everything it held.
 #pragma once
 
 #include <vector>
@@ -15,8 +17,10 @@ struct ResectoscopeShape {
   double sheath_length_m = 0.120;      ///< the distal part that can reach the model
   double loop_span_m = 0.006;          ///< width of the half-ring of wire
   double wire_diameter_m = 0.00035;
-  double loop_travel_m = 0.0;          ///< 0 (retracted to the tip) .. 0.036
-  double loop_stem_length_m = 0.004;   ///< stem length between the tip and the half-ring at zero travel
+  double loop_travel_m = 0.0;          ///< 0 (retracted into the beak) .. 0.036
+  /// Where the half-ring's centre line sits along the axis at zero travel: half a millimetre inside
+  /// the tip. Its wire is out of the sheath from 0.5 mm of travel on.
+  double retracted_loop_z_m = -0.0005;
 };
 
 inline constexpr int kSheathTriangles = 158;

@@ -215,25 +215,37 @@ void Simulation::place_tool(const TickInput& input) {
   }
   tissue_->tool().set_pose(sheath_part_, placed_.poses.sheath);
   tissue_->tool().set_pose(loop_part_, placed_.poses.loop);
-  // The energised loop cuts rather than pushes: while it cuts it takes no part in contact.
+  // The energised loop cuts rather than pushes: while it cuts it takes no part in contact. Drawn
+  // into the beak it lies inside the sheath, which meets the tissue instead (the back of the retracted
+  // wire, a hair inside the sheath's outline, once towed tissue caught behind it out with the sheath).
   cut_pedal_ = input.tool_present && input.cut;
-  placed_.loop_in_contact = !loop_cutting();
+  placed_.loop_in_contact = loop_out_of_sheath() && !loop_cutting();
   tissue_->tool().set_enabled(loop_part_, placed_.loop_in_contact);
 }
 
-bool Simulation::loop_cutting() const {
-  // Retracted against the sheath's insulated beak (under half a millimetre of travel) it cannot cut.
+bool Simulation::loop_out_of_sheath() const {
+  // Under half a millimetre of travel the wire is inside the sheath's beak (ResectoscopeShape).
   constexpr double kBeakTravelM = 0.0005;
-  return cut_pedal_ && placed_.present && placed_joints_.loop_travel_m >= kBeakTravelM;
+  return placed_.present && placed_joints_.loop_travel_m >= kBeakTravelM;
 }
 
+bool Simulation::loop_cutting() const { return cut_pedal_ && loop_out_of_sheath(); }
+
 void Simulation::prepare_cut() {
-  cut_job_.cutting = loop_cutting();
+  // A wire drawn into the beak with the pedal still down makes one last sweep, from where it cut at
+  // the last collision step into the slot: that closes the stroke against the sheath and severs the
+  // chip. (Without it the stroke stopped up to a step short of the tip, and what the loop held stayed
+  // joined to the gland by a strand the withdrawn sheath then dragged out.)
+  const bool closing = !loop_cutting() && wire_from_valid_ && cut_pedal_ && placed_.present;
+  cut_job_.cutting = loop_cutting() || closing;
   if (cut_job_.cutting) {
-    for (std::size_t i = 0; i < wire_loop_.size(); ++i) wire_to_[i] = placed_.poses.loop.apply_point(wire_loop_[i]);
+    // The loop's frame is the sheath's moved out by the travel, so the sheath's pose places the
+    // wire fully retracted: a closing wire has passed the tip face whatever the filter still lags.
+    const RigidPose& wire_pose = closing ? placed_.poses.sheath : placed_.poses.loop;
+    for (std::size_t i = 0; i < wire_loop_.size(); ++i) wire_to_[i] = wire_pose.apply_point(wire_loop_[i]);
     sweep_.set(wire_from_valid_ ? wire_from_ : wire_to_, wire_to_, tissue_->parameters().si(TissueParameter::kCuttingRadius));
     std::copy(wire_to_.begin(), wire_to_.end(), wire_from_.begin());
-    wire_from_valid_ = true;
+    wire_from_valid_ = !closing;
   } else {
     wire_from_valid_ = false;
   }

@@ -265,7 +265,9 @@ class Simulation {
   void prepare_cut();
   /// The resection part of the metrics, from the last collected step's statistics.
   void update_resection_metrics();
-  /// Whether the loop cuts this tick: pedal down, tool placed, loop out of the sheath's beak.
+  /// Whether the tool is placed with the loop's wire out of the sheath's beak.
+  bool loop_out_of_sheath() const;
+  /// Whether the loop cuts this tick: pedal down and the wire out of the sheath's beak.
   bool loop_cutting() const;
 
   SimulationConfig config_;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <optional>
 
+#include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/base/checked_number.h"
 #include "rtcore/base/quoted_word.h"
 #include "rtcore/base/text_file.h"
@@ -13,7 +14,8 @@ namespace resecto {
 namespace {
 
 // The demo: insert through the apex to mid-gland, survey by rolling the sheath, swing the loop into
-// the left then the right lateral lobe and cut while retracting it (the resection stroke), then
+// the left then the right lateral lobe and cut while drawing it back into the sheath's beak (the
+// resection stroke: the pedal stays down until the loop has closed, which severs the chip), then
 // withdraw. With the default registration the apex is at insertion 150 mm, the bladder neck at 191.5.
 constexpr const char* kDemoProcedure = R"(# Resecto procedure v1: the built-in demo
 # time_s  yaw_deg  pitch_deg  roll_deg  insertion_mm  loop_mm  cut  coagulate
@@ -23,43 +25,49 @@ constexpr const char* kDemoProcedure = R"(# Resecto procedure v1: the built-in d
 3.0     0.0   0.0    25.0   172.0   0.0   0  0
 3.5     0.0   0.0   -25.0   172.0   0.0   0  0
 4.0     0.0   0.0    90.0   172.0   0.0   0  0
-4.6     0.6   0.0    90.0   168.0  12.0   0  0
-5.0     1.0   0.0    90.0   168.0  12.0   1  0
-6.0     1.0   0.0    90.0   168.0   1.0   1  0
-6.3     0.0   0.0    90.0   168.0   1.0   0  0
-6.8     0.0   0.0   -90.0   168.0   1.0   0  0
-7.3    -0.6   0.0   -90.0   168.0  12.0   0  0
-7.6    -1.0   0.0   -90.0   168.0  12.0   1  0
-8.6    -1.0   0.0   -90.0   168.0   1.0   1  0
-8.9     0.0   0.0   -90.0   168.0   0.0   0  0
-9.4     0.0   0.0     0.0   160.0   0.0   0  0
+4.6     0.6   0.0    90.0   168.0  16.0   0  0
+5.0     1.0   0.0    90.0   168.0  16.0   1  0
+6.0     1.0   0.0    90.0   168.0   0.0   1  0
+6.15    1.0   0.0    90.0   168.0   0.0   0  0
+6.4     0.0   0.0    90.0   168.0   0.0   0  0
+6.9     0.0   0.0   -90.0   168.0   0.0   0  0
+7.3    -0.6   0.0   -90.0   168.0  16.0   0  0
+7.6    -1.0   0.0   -90.0   168.0  16.0   1  0
+8.6    -1.0   0.0   -90.0   168.0   0.0   1  0
+8.75   -1.0   0.0   -90.0   168.0   0.0   0  0
+9.2     0.0   0.0     0.0   160.0   0.0   0  0
 10.0    0.0   0.0     0.0   125.0   0.0   0  0
 )";
 
 // The built-in full resection (`turp`), in the standard order: the median lobe at the bladder neck,
 // then each lateral lobe, by strokes at successive roll angles and depths. A stroke: with the pedal up
-// the loop goes out to the bladder end of the stroke; with the pedal down it is drawn back toward the
-// sheath (the cut); then the pedal comes up and the loop back in. Depth comes from tilting the sheath
-// (yaw and pitch) toward the side the loop hangs to, a layer further at each pass. Every stroke stays
-// proximal to the verumontanum (9.1 mm from the apex with the default gland) and short of the
-// bladder neck, and the deepest layer stops short of the capsule.
+// the sheath goes to where the stroke will end and the loop out to its bladder end; with the pedal
+// down the loop is drawn back into the sheath's beak (the cut), which closes the stroke against the
+// sheath and severs its chip; then the pedal comes up. Depth comes from tilting the sheath (yaw and
+// pitch) toward the side the loop hangs to, a layer further at each pass. Every stroke ends proximal
+// to the verumontanum (9.1 mm from the apex with the default gland) and starts short of the bladder
+// neck, and the deepest layer stops short of the capsule.
 struct TurpPlan {
-  double insertion_mm = 157.0;    // sheath tip 7 mm past the apex
-  double far_loop_mm = 23.0;      // loop front 34 mm from the apex: short of the bladder neck's rim
-  double near_loop_mm = 1.0;      // loop front 12 mm from the apex: proximal to the verumontanum
-  double median_far_loop_mm = 24.0;
-  double median_near_loop_mm = 15.0;  // the median lobe sits at the bladder neck
-  double stroke_s = 1.2;          // the cut: loop drawn back at ~22 mm/s
-  double move_s = 0.4;            // roll, tilt and loop out, pedal up: at least this long
+  double apex_insertion_mm = 150.0;  // the sheath's tip at the apex, with the default registration
+  double far_mm = 34.0;              // a lateral stroke's bladder end, from the apex: short of the neck's rim
+  double near_mm = 11.0;             // where it closes: 1.9 mm proximal to the verumontanum
+  double median_far_mm = 35.0;
+  double median_near_mm = 26.0;      // the median lobe sits at the bladder neck
+  double stroke_s = 1.2;             // the cut: loop drawn back at ~20 mm/s
+  double close_s = 0.15;             // the pedal held down once the loop is in, so the filtered loop closes
+  double move_s = 0.4;               // roll, tilt and loop out, pedal up: at least this long
   // A hand's pace between strokes, so that no move outruns the contact search's margin (1.5 mm over
-  // two collision periods): rolls, tilts and the loop's travel at most this fast.
+  // two collision periods): rolls, tilts, the sheath's and the loop's travel at most this fast.
   double roll_deg_s = 60.0;
   double tilt_deg_s = 3.0;
   double loop_mm_s = 40.0;
+  double insertion_mm_s = 20.0;
 };
 
 std::vector<ProcedureKeyframe> turp_keyframes() {
   const TurpPlan plan;
+  // How far inside the tip the wire lies at zero travel: a stroke from `far_mm` travels this much more.
+  const double retracted_mm = -1000.0 * ResectoscopeShape{}.retracted_loop_z_m;
   std::vector<ProcedureKeyframe> keys;
   double t = 0.0;
   auto add = [&](double dt, double yaw, double pitch, double roll, double insertion, double loop, bool cut) {
@@ -67,39 +75,42 @@ std::vector<ProcedureKeyframe> turp_keyframes() {
     keys.push_back({t, yaw, pitch, roll, insertion, loop, cut, false});
   };
   keys.push_back({0.0, 0.0, 0.0, 0.0, 125.0, 0.0, false, false});
-  add(1.5, 0.0, 0.0, 0.0, plan.insertion_mm, 0.0, false);  // in through the apex
+  add(1.5, 0.0, 0.0, 0.0, plan.apex_insertion_mm + plan.near_mm, 0.0, false);  // in through the apex
   // How long a move from the last keyframe to these joints takes at the plan's pace (at least `least_s`).
-  auto paced = [&](double least_s, double yaw, double pitch, double roll, double loop) {
+  auto paced = [&](double least_s, double yaw, double pitch, double roll, double insertion, double loop) {
     const ProcedureKeyframe& from = keys.back();
     return std::max({least_s, std::abs(roll - from.roll_deg) / plan.roll_deg_s, std::abs(yaw - from.yaw_deg) / plan.tilt_deg_s,
-                     std::abs(pitch - from.pitch_deg) / plan.tilt_deg_s, std::abs(loop - from.loop_mm) / plan.loop_mm_s});
+                     std::abs(pitch - from.pitch_deg) / plan.tilt_deg_s, std::abs(insertion - from.insertion_mm) / plan.insertion_mm_s,
+                     std::abs(loop - from.loop_mm) / plan.loop_mm_s});
   };
   // Tilting by `tilt_deg` toward where the loop hangs at `roll_deg` (roll 0: posterior, +90: the
   // patient's left): yaw swings the tip toward +x, pitch lifts it toward +y.
   auto stroke = [&](double roll_deg, double tilt_deg, double far_mm, double near_mm) {
     const double roll = roll_deg * 3.141592653589793 / 180.0;
     const double yaw = tilt_deg * std::sin(roll), pitch = -tilt_deg * std::cos(roll);
-    add(paced(plan.move_s * 0.5, yaw, pitch, roll_deg, 0.0), yaw, pitch, roll_deg, plan.insertion_mm, 0.0, false);
-    add(paced(plan.move_s * 0.5, yaw, pitch, roll_deg, far_mm), yaw, pitch, roll_deg, plan.insertion_mm, far_mm, false);
-    add(0.05, yaw, pitch, roll_deg, plan.insertion_mm, far_mm, true);
-    add(plan.stroke_s, yaw, pitch, roll_deg, plan.insertion_mm, near_mm, true);
-    add(0.05, yaw, pitch, roll_deg, plan.insertion_mm, near_mm, false);
-    add(paced(0.2, yaw, pitch, roll_deg, 0.0), yaw, pitch, roll_deg, plan.insertion_mm, 0.0, false);
+    const double insertion = plan.apex_insertion_mm + near_mm, loop = far_mm - near_mm + retracted_mm;
+    add(paced(plan.move_s * 0.5, yaw, pitch, roll_deg, insertion, 0.0), yaw, pitch, roll_deg, insertion, 0.0, false);
+    add(paced(plan.move_s * 0.5, yaw, pitch, roll_deg, insertion, loop), yaw, pitch, roll_deg, insertion, loop, false);
+    add(0.05, yaw, pitch, roll_deg, insertion, loop, true);
+    add(plan.stroke_s, yaw, pitch, roll_deg, insertion, 0.0, true);
+    add(plan.close_s, yaw, pitch, roll_deg, insertion, 0.0, false);
   };
   // Median lobe: posterior, at the bladder neck, three layers.
   for (double tilt : {0.0, 0.6, 1.2}) {
-    for (double roll : {-25.0, 0.0, 25.0}) stroke(roll, tilt, plan.median_far_loop_mm, plan.median_near_loop_mm);
+    for (double roll : {-25.0, 0.0, 25.0}) stroke(roll, tilt, plan.median_far_mm, plan.median_near_mm);
   }
   // Lateral lobes, left then right, layer by layer from the channel outward.
   for (double side : {1.0, -1.0}) {
     for (double tilt : {0.0, 1.0, 2.0, 3.0, 3.6}) {
-      // The deepest layer spares the anterolateral roll, where the capsule is nearest.
+      // The two deepest layers spare the anterolateral roll, where the capsule is nearest (closed at
+      // the sheath's tip, the 3-degree layer there perforated the 1296-triangle gland).
       for (double roll : {20.0, 45.0, 70.0, 95.0, 115.0}) {
-        if (tilt < 3.5 || roll < 100.0) stroke(side * roll, tilt, plan.far_loop_mm, plan.near_loop_mm);
+        if (tilt < 2.5 || roll < 100.0) stroke(side * roll, tilt, plan.far_mm, plan.near_mm);
       }
     }
   }
-  add(paced(0.5, 0.0, 0.0, 0.0, 0.0), 0.0, 0.0, 0.0, plan.insertion_mm, 0.0, false);
+  const double last_insertion = keys.back().insertion_mm;
+  add(paced(0.5, 0.0, 0.0, 0.0, last_insertion, 0.0), 0.0, 0.0, 0.0, last_insertion, 0.0, false);
   add(1.0, 0.0, 0.0, 0.0, 125.0, 0.0, false);  // out
   return keys;
 }

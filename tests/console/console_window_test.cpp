@@ -274,18 +274,18 @@ TEST(ConsoleWindow, StiffnessActionAppliesAtTheNextTickAndTheFirstFrameAfterShow
 }
 
 /// A stroke tilted through the lateral lobe into the capsule (the careless trainee's perforation of
-/// score_test, started inside the gland), then the loop in and the sheath drawn back, tilted toward
-/// the trough, to look at it. With `cut` false the same motion with the pedal up.
+/// score_test, started inside the gland) closed against the sheath, then the sheath drawn back,
+/// tilted toward the trough, to look at it. With `cut` false the same motion with the pedal up.
 std::filesystem::path write_deep_stroke_procedure(const std::filesystem::path& dir, bool cut) {
   const auto path = dir / (cut ? "deep_stroke.txt" : "deep_stroke_pedal_up.txt");
   const char* pedal = cut ? "1" : "0";
   std::ofstream(path) << "# time_s yaw pitch roll insertion loop cut coagulate\n"
                          "0.0  0 0   0 168  0 0 0\n"
                          "0.5  0 0 -90 168  0 0 0\n"
-                         "1.1 -6 0 -90 168 14 0 0\n"
-                         "1.2 -6 0 -90 168 14 " << pedal << " 0\n"
-                         "2.7 -6 0 -90 168  1 " << pedal << " 0\n"
-                         "2.8 -6 0 -90 168  1 0 0\n"
+                         "1.1 -6 0 -90 168 18.5 0 0\n"
+                         "1.2 -6 0 -90 168 18.5 " << pedal << " 0\n"
+                         "2.7 -6 0 -90 168  0 " << pedal << " 0\n"
+                         "2.85 -6 0 -90 168 0 0 0\n"
                          "3.6 -3 0 -90 162  0 0 0\n";
   return path;
 }

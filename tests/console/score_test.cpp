@@ -85,7 +85,7 @@ json expect_rescore_equals_live(const std::string& procedure, const std::string&
 
 TEST(ScoreCommand, RescoringTheDemoEqualsTheLiveRunsScore) { expect_rescore_equals_live("demo", ""); }
 
-// The whole `turp` (159 simulated seconds, nine median-lobe strokes and both lateral lobes), recorded
+// The whole `turp` (145 simulated seconds, nine median-lobe strokes and both lateral lobes), recorded
 // and re-simulated: about a minute of CPU each on the small gland. It is the expert's reference, so it
 // also holds issue 13's bar for it: most of the adenoma resected (at least 60%), no perforation, no
 // stroke into the sphincter zone, and no move faster than the contact search follows.

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "rtcore/anatomy/resectoscope.h"
 #include "rtcore/mesh/mesh_validation.h"
@@ -43,10 +44,25 @@ TEST(Resectoscope, DimensionsMatchTheDesign) {
   EXPECT_NEAR(sheath.min.z, -shape.sheath_length_m, 1e-12);
   const Aabb loop = bounding_box(tool.loop);
   EXPECT_NEAR(loop.size().x, shape.loop_span_m + shape.wire_diameter_m, 2e-4);  // about 6 mm across
-  EXPECT_LT(loop.min.y, -0.5 * shape.sheath_diameter_m);  // the wire reaches below the sheath to cut
-  EXPECT_GT(loop.max.z, 0.0);                              // in front of the tip
-  // Every arm point behind the tip stays inside the sheath, at any travel.
-  for (const Vec3& p : tool.loop.positions) {
+  // The wire hangs to within 0.1 mm of the sheath's outline, and never beyond it.
+  EXPECT_GT(loop.min.y, -0.5 * shape.sheath_diameter_m);
+  EXPECT_LT(loop.min.y, -0.5 * shape.sheath_diameter_m + 1e-4);
+  // Retracted, the whole loop lies inside the sheath, behind its tip (in the beak's slot), so a
+  // stroke drawn fully back has closed against the sheath.
+  EXPECT_LT(loop.max.z, 0.0);
+  for (const Vec3& p : tool.loop.positions) EXPECT_LT(std::hypot(p.x, p.y), 0.5 * shape.sheath_diameter_m);
+}
+
+TEST(Resectoscope, TheWireLeavesTheSheathAtHalfAMillimetreOfTravel) {
+  ResectoscopeShape shape;
+  for (double travel_m : {0.0, 0.0005, 0.012}) {
+    shape.loop_travel_m = travel_m;
+    const std::vector<Vec3> arc = loop_cutting_arc(shape);
+    for (const Vec3& p : arc) EXPECT_NEAR(p.z, travel_m - 0.0005, 1e-15) << "travel " << travel_m;
+  }
+  // Out of the sheath, every point of the loop behind the tip (its arms) stays inside it.
+  shape.loop_travel_m = 0.012;
+  for (const Vec3& p : generate_resectoscope(shape).loop.positions) {
     if (p.z < 0.0) {
       EXPECT_LT(std::hypot(p.x, p.y), 0.5 * shape.sheath_diameter_m);
     }

@@ -132,6 +132,52 @@ TEST(Resection, PedalUpOrLoopInTheSheathRemovesNothing) {
   EXPECT_EQ(sim->metrics().sphincter_zone_violations, 0u);
 }
 
+// The left-lobe stroke drawn back into the sheath's beak, the pedal held until the loop is in when
+// `closed` (let up at 1 mm of travel otherwise), then the sheath withdrawn out of the gland.
+constexpr const char* kStrokeThenWithdrawal = R"(
+0.0   0.0  0.0   0.0  125.0  0.0  0 0
+1.0   0.0  0.0   0.0  165.0  0.0  0 0
+1.4   0.0  0.0  90.0  165.0  0.0  0 0
+1.8   1.0  0.0  90.0  165.0 14.0  0 0
+1.9   1.0  0.0  90.0  165.0 14.0  1 0
+3.0   1.0  0.0  90.0  165.0  %s   1 0
+3.2   1.0  0.0  90.0  165.0  %s   0 0
+3.4   1.0  0.0  90.0  165.0  0.0  0 0
+3.8   0.0  0.0   0.0  165.0  0.0  0 0
+5.8   0.0  0.0   0.0  125.0  0.0  0 0
+7.8   0.0  0.0   0.0  125.0  0.0  0 0
+)";
+
+TEST(Resection, AStrokeClosedAgainstTheSheathSeversItsChipAndTheWithdrawnSheathDragsNothing) {
+  // Audit 11's worst finding: no stroke could close (the loop sat 4 mm ahead of the tip at zero
+  // travel), so what it held stayed joined by a strand, and the withdrawn sheath towed the urethral
+  // lining 19-22 mm out of the gland (largest displacement 56.5 mm on demo).
+  double resected_g[2], displacement_mm[2];
+  std::uint64_t chips[2];
+  for (int closed = 0; closed < 2; ++closed) {
+    char text[768];
+    std::snprintf(text, sizeof text, kStrokeThenWithdrawal, closed ? "0.0" : "1.0", closed ? "0.0" : "1.0");
+    auto sim = small_simulation();
+    const RunCheck check = run_checked(*sim, script(text));
+    const ProcedureMetrics& m = sim->metrics();
+    resected_g[closed] = m.resected_total_g;
+    displacement_mm[closed] = m.max_tissue_displacement_mm;
+    chips[closed] = m.chips;
+    std::printf("%s stroke: resected %.3f g, chips %llu, largest displacement %.2f mm, at the end %.2f mm\n", closed ? "closed" : "open",
+                m.resected_total_g, static_cast<unsigned long long>(m.chips), m.max_tissue_displacement_mm,
+                units::m_to_mm(sim->tissue().max_displacement_m()));
+    EXPECT_LT(check.worst_conservation, 1e-12);
+    EXPECT_EQ(m.sphincter_zone_violations, 0u);
+    expect_valid_surface(*sim, closed ? "after the closed stroke" : "after the open stroke");
+  }
+  EXPECT_GE(chips[1], 1u) << "closing against the sheath severs what the loop held";
+  EXPECT_GT(resected_g[1], resected_g[0]);
+  // The sheath dilates the channel by about 1.5 mm and the stroke presses a few millimetres (about 6
+  // at this coarse gland); a strand towed with the sheath goes most of the 40 mm it is withdrawn (54
+  // before the loop could close).
+  EXPECT_LT(displacement_mm[1], 15.0);
+}
+
 TEST(Resection, CuttingIntoTheCapsuleIsAPerforation) {
   // Tilted hard toward the left: the loop reaches through the lobe and the capsule.
   auto sim = small_simulation();
