@@ -236,7 +236,7 @@ void Simulation::prepare_cut() {
   // the last collision step into the slot: that closes the stroke against the sheath and severs the
   // chip. (Without it the stroke stopped up to a step short of the tip, and what the loop held stayed
   // joined to the gland by a strand the withdrawn sheath then dragged out.)
-  const bool closing = !loop_cutting() && wire_from_valid_ && cut_pedal_ && placed_.present;
+  const bool closing = cut_pedal_ && wire_from_valid_ && !loop_out_of_sheath();
   cut_job_.cutting = loop_cutting() || closing;
   if (cut_job_.cutting) {
     // The loop's frame is the sheath's moved out by the travel, so the sheath's pose places the
