@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 
 #include <glm/common.hpp>
 
@@ -118,19 +119,57 @@ Closest nearest_tissue_face(const Vec3* x, const std::vector<Triangle>& triangle
   return best;
 }
 
-/// A face's corners, for guard_nearest_side: a rigid part's in its frame, the tissue's where they are.
-inline auto tool_corners(const TriangleMesh& mesh) {
-  return [&mesh](std::uint32_t face) {
+/// The faces guard_nearest_side weighs: their corners, boxes and how high a point stands over their
+/// plane (nullopt for a degenerate face). A rigid part's stand still in its frame, so their boxes and
+/// unit normals were worked out once (add_part).
+struct RigidFaces {
+  static constexpr bool kMoving = false;
+  const TriangleMesh& mesh;
+  const std::vector<Vec3>& unit_normals;
+  const std::vector<std::pair<Vec3, Vec3>>& boxes;
+  std::array<Vec3, 3> corners(std::uint32_t face) const {
     const Triangle& t = mesh.triangles[face];
-    return std::array<Vec3, 3>{mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]};
-  };
-}
-inline auto tissue_corners(const Vec3* x, const std::vector<Triangle>& triangles) {
-  return [x, &triangles](std::uint32_t face) {
+    return {mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]};
+  }
+  std::pair<Vec3, Vec3> box(std::uint32_t face, const std::array<Vec3, 3>&) const { return boxes[face]; }
+  std::optional<double> height(std::uint32_t face, const std::array<Vec3, 3>& c, const Vec3& at, double, double&) const {
+    const Vec3& normal = unit_normals[face];
+    if (!(glm::dot(normal, normal) > 0.0)) return std::nullopt;
+    return glm::dot(at - c[0], normal) - 1e-12;  // a picometre for the rounding
+  }
+};
+/// The tissue's faces move, so their bounds are formed where they are, and a height must allow for the
+/// plane's turning: while the corners move less than `travel_cap` (narrowed here) it turns under 30
+/// degrees, and the plane moves at the point's foot by the corners' travel times the foot's barycentric
+/// weights' absolute sum L, so the bound is (0.866 h) / L (guard_nearest_side).
+struct TissueFaces {
+  static constexpr bool kMoving = true;
+  const Vec3* x;
+  const std::vector<Triangle>& triangles;
+  std::array<Vec3, 3> corners(std::uint32_t face) const {
     const Triangle& t = triangles[face];
-    return std::array<Vec3, 3>{x[t[0]], x[t[1]], x[t[2]]};
-  };
-}
+    return {x[t[0]], x[t[1]], x[t[2]]};
+  }
+  std::pair<Vec3, Vec3> box(std::uint32_t, const std::array<Vec3, 3>& c) const {
+    return {glm::min(c[0], glm::min(c[1], c[2])), glm::max(c[0], glm::max(c[1], c[2]))};
+  }
+  std::optional<double> height(std::uint32_t, const std::array<Vec3, 3>& c, const Vec3& at, double start_radius, double& travel_cap) const {
+    constexpr double kTurnedHeight = 0.866;  // cos 30°, rounded down
+    const Vec3 a = c[1] - c[0], b = c[2] - c[0], u = at - c[0];
+    const Vec3 n2 = glm::cross(a, b);
+    const double area2 = glm::length(n2);
+    if (!(area2 > 0.0)) return std::nullopt;
+    const double height = glm::dot(u, n2) / area2 - 1e-12;
+    if (!(height > 0.0)) return height;
+    // Corners moving t change n2 by at most 2t(|a| + |b|) + 4t^2; under half of |n2|, it turns < 30°.
+    const double aa = glm::dot(a, a), ab = glm::dot(a, b), bb = glm::dot(b, b), ua = glm::dot(u, a), ub = glm::dot(u, b);
+    travel_cap = std::min(travel_cap, 0.5 * area2 / (2.0 * (std::sqrt(aa) + std::sqrt(bb)) + 4.0 * start_radius));
+    const double inverse = 1.0 / (area2 * area2);  // aa * bb - ab^2, Lagrange's identity
+    const double l1 = (bb * ua - ab * ub) * inverse, l2 = (aa * ub - ab * ua) * inverse;
+    const double weights = std::abs(1.0 - l1 - l2) + std::abs(l1) + std::abs(l2);
+    return kTurnedHeight * height / (weights * (1.0 + 1e-9)) - 1e-12;
+  }
+};
 
 /// The brute-force test a certificate stands in for decides a point's side by its nearest candidate
 /// face's plane, and that answer can change without the point crossing any face: where the faces
@@ -147,47 +186,35 @@ inline auto tissue_corners(const Vec3* x, const std::vector<Triangle>& triangles
 /// Each face within reach bounds the radius by the larger of its two bounds. Faces come nearest first
 /// with their distance at the search (`searched`, or null), nearer now by at most `moved`: past
 /// d + 2 * radius none can overtake, and the scan stops.
-template <typename Corners>
+template <typename Faces>
 void guard_nearest_side(ToolContacts::Clearance& clearance, const Closest& best, const std::uint32_t* faces, std::uint32_t count, const double* searched,
-                        double moved, bool faces_move, const Corners& corners) {
+                        double moved, const Faces& geometry) {
   constexpr double kTieDistance = 1e-9;  // m: Closest::kTie's squared tolerance as a distance, rounded up
   constexpr double kSlack = kTieDistance + 1e-12;  // and a picometre for the rounding of the tests
-  constexpr double kTurnedHeight = 0.866;  // cos 30°, rounded down
   const Vec3& at = clearance.at;
   const double nearest = std::sqrt(best.distance2);
   double radius = clearance.radius;
   const double start_radius = radius;
-  double travel_cap = faces_move ? start_radius : std::numeric_limits<double>::infinity();
+  double travel_cap = Faces::kMoving ? start_radius : std::numeric_limits<double>::infinity();
   for (std::uint32_t e = 0; e < count && radius > 0.0; ++e) {
     // The window narrows as the radius is cut; every face within the final one has been weighed.
     const double reach = nearest + 2.0 * (radius + kSlack);
     if (searched != nullptr && searched[e] - moved - 1e-12 > reach) break;
-    const std::array<Vec3, 3> c = corners(faces[e]);
-    const Vec3 gap = glm::max(glm::max(glm::min(c[0], glm::min(c[1], c[2])) - at, at - glm::max(c[0], glm::max(c[1], c[2]))), Vec3(0.0));
+    const std::array<Vec3, 3> c = geometry.corners(faces[e]);
+    const std::pair<Vec3, Vec3> box = geometry.box(faces[e], c);
+    const Vec3 gap = glm::max(glm::max(box.first - at, at - box.second), Vec3(0.0));
     const double gap2 = glm::dot(gap, gap);
     if (gap2 > reach * reach) continue;
-    const Vec3 a = c[1] - c[0], b = c[2] - c[0], u = at - c[0];
-    const Vec3 n2 = glm::cross(a, b);
-    const double area2 = glm::length(n2);
-    if (!(area2 > 0.0)) {  // a degenerate face has no side to keep
+    const std::optional<double> height = geometry.height(faces[e], c, at, start_radius, travel_cap);
+    if (!height) {  // a degenerate face has no side to keep
       radius = 0.0;
       break;
     }
-    double height = glm::dot(u, n2) / area2 - 1e-12;
-    if (faces_move && height > 0.0) {
-      // Corners moving t change n2 by at most 2t(|a| + |b|) + 4t^2; under half of |n2|, it turns < 30°.
-      const double aa = glm::dot(a, a), ab = glm::dot(a, b), bb = glm::dot(b, b), ua = glm::dot(u, a), ub = glm::dot(u, b);
-      travel_cap = std::min(travel_cap, 0.5 * area2 / (2.0 * (std::sqrt(aa) + std::sqrt(bb)) + 4.0 * start_radius));
-      const double inverse = 1.0 / (area2 * area2);  // aa * bb - ab^2, Lagrange's identity
-      const double l1 = (bb * ua - ab * ub) * inverse, l2 = (aa * ub - ab * ua) * inverse;
-      const double weights = std::abs(1.0 - l1 - l2) + std::abs(l1) + std::abs(l2);
-      height = kTurnedHeight * height / (weights * (1.0 + 1e-9)) - 1e-12;
-    }
-    if (height >= radius) continue;
+    if (*height >= radius) continue;
     // The box's distance bounds the face's from below: the closest point only when that is not enough.
     if (0.5 * (std::sqrt(gap2) - nearest) - kSlack >= radius) continue;
     const double distance = glm::length(at - closest_point_on_triangle(at, c[0], c[1], c[2]));
-    radius = std::max(0.0, std::min(radius, std::max(height, 0.5 * (distance - nearest) - kSlack)));
+    radius = std::max(0.0, std::min(radius, std::max(*height, 0.5 * (distance - nearest) - kSlack)));
   }
   clearance.radius = radius;
   clearance.travel_cap = travel_cap;
@@ -200,13 +227,12 @@ void guard_nearest_side(ToolContacts::Clearance& clearance, const Closest& best,
 /// candidates, up to the margin less the shift; only such a ball proves that the point stays outside
 /// the other surface while it is in it. guard_nearest_side() then cuts it so that the brute-force test
 /// answers "outside" throughout.
-template <typename Corners>
+template <typename Faces>
 ToolContacts::Clearance certify_within_candidates(const Closest& best, const Vec3& at, double tissue_travel, double shift, double margin,
-                                                  const std::uint32_t* faces, std::uint32_t count, const double* searched, bool faces_move,
-                                                  const Corners& corners) {
+                                                  const std::uint32_t* faces, std::uint32_t count, const double* searched, const Faces& geometry) {
   if (best.side < 0.0) return {};
   ToolContacts::Clearance clearance{at, std::max(0.0, std::min(best.clearance(), margin - shift)), tissue_travel};
-  guard_nearest_side(clearance, best, faces, count, searched, shift, faces_move, corners);
+  guard_nearest_side(clearance, best, faces, count, searched, shift, geometry);
   return clearance;
 }
 
@@ -253,6 +279,8 @@ int ToolContacts::add_part(const TriangleMesh& mesh) {
     double radius = 0.0;
     for (std::uint32_t v : tri) radius = std::max(radius, glm::length(mesh.positions[v] - centroid));
     part.triangle_spheres.push_back({centroid, radius});
+    const std::array<Vec3, 3> c{mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]]};
+    part.face_boxes.emplace_back(glm::min(c[0], glm::min(c[1], c[2])), glm::max(c[0], glm::max(c[1], c[2])));
   }
   part.grid.build(mesh, margin_m_);
   build_vertex_clusters(part);
@@ -261,31 +289,51 @@ int ToolContacts::add_part(const TriangleMesh& mesh) {
 }
 
 void ToolContacts::build_vertex_clusters(Part& part) const {
-  // Vertices binned on a grid of the margin's size: a cluster is at most 2.6 mm across, so its
-  // descent finds barely more tissue than one vertex's would, and a wire's many vertices share one.
+  // Vertices binned on a grid of the margin's size, in the bins' order (the same clusters every
+  // run); bins then merge, in that order, into clusters whose bound stays within kClusterMargins
+  // margins. A cluster picks the tissue faces near it from the part's leaves once for all its
+  // vertices: the sheath's tip ring is then a cluster or two, not a score of them.
   const double cell = margin_m_;
   std::vector<std::uint8_t> used(part.mesh.vertex_count(), 0);
   for (const Triangle& t : part.mesh.triangles) {
     for (std::uint32_t v : t) used[v] = 1;
   }
-  std::map<std::array<std::int64_t, 3>, std::vector<std::uint32_t>> bins;  // ordered: the same clusters every run
+  std::map<std::array<std::int64_t, 3>, std::vector<std::uint32_t>> bins;
   for (std::uint32_t v = 0; v < part.mesh.vertex_count(); ++v) {
     if (!used[v]) continue;
     const Vec3 at = glm::floor(part.mesh.positions[v] / cell);
     bins[{static_cast<std::int64_t>(at.x), static_cast<std::int64_t>(at.y), static_cast<std::int64_t>(at.z)}].push_back(v);
   }
-  for (const auto& [key, vertices] : bins) {
+  std::vector<const std::vector<std::uint32_t>*> bin_vertices;
+  for (const auto& [key, vertices] : bins) bin_vertices.push_back(&vertices);
+  const auto bound_of = [&](const std::vector<std::uint32_t>& vertices) {
     Vec3 low(1e300), high(-1e300);
     for (std::uint32_t v : vertices) {
       low = glm::min(low, part.mesh.positions[v]);
       high = glm::max(high, part.mesh.positions[v]);
     }
+    Sphere bound{0.5 * (low + high), 0.0};
+    for (std::uint32_t v : vertices) bound.radius = std::max(bound.radius, glm::length(part.mesh.positions[v] - bound.center));
+    return bound;
+  };
+  std::vector<std::uint8_t> taken(bin_vertices.size(), 0);
+  std::vector<std::uint32_t> members, widened;
+  for (std::size_t seed = 0; seed < bin_vertices.size(); ++seed) {
+    if (taken[seed]) continue;
+    members.clear();
+    for (std::size_t b = seed; b < bin_vertices.size(); ++b) {
+      if (taken[b]) continue;
+      widened = members;
+      widened.insert(widened.end(), bin_vertices[b]->begin(), bin_vertices[b]->end());
+      if (b != seed && bound_of(widened).radius > kClusterMargins * margin_m_) continue;
+      members.swap(widened);
+      taken[b] = 1;
+    }
     VertexCluster cluster;
-    cluster.bound.center = 0.5 * (low + high);
-    for (std::uint32_t v : vertices) cluster.bound.radius = std::max(cluster.bound.radius, glm::length(part.mesh.positions[v] - cluster.bound.center));
+    cluster.bound = bound_of(members);
     cluster.first = static_cast<std::uint32_t>(part.cluster_vertices.size());
-    cluster.count = static_cast<std::uint32_t>(vertices.size());
-    part.cluster_vertices.insert(part.cluster_vertices.end(), vertices.begin(), vertices.end());
+    cluster.count = static_cast<std::uint32_t>(members.size());
+    part.cluster_vertices.insert(part.cluster_vertices.end(), members.begin(), members.end());
     part.clusters.push_back(cluster);
   }
 }
@@ -311,33 +359,64 @@ bool ToolContacts::push_pair(std::uint32_t triangle) {
   return true;
 }
 
-void ToolContacts::gather_triangles(const SphereTree& tree, const Vec3& p, double radius) {
-  near_triangles_.clear();
-  if (tree.empty()) return;
-  ++stamp_;
+void ToolContacts::gather_part_leaves(const Part& part, const SphereTree& tissue_tree, const TriangleMesh& surface) {
+  part_leaves_.clear();
+  near_nodes_.clear();
+  if (tissue_tree.empty() || part.grid.cell_count() == 0) return;
+  const RigidPose& pose = part.query_pose;
+  const Vec3& lower = part.grid.lower();
+  const Vec3& upper = part.grid.upper();
+  const auto& spheres = tissue_tree.spheres();
+  const auto& links = tissue_tree.links();
   stack_.clear();
-  stack_.push_back(tree.root());
-  const auto& spheres = tree.spheres();
-  const auto& links = tree.links();
+  stack_.push_back(tissue_tree.root());
   while (!stack_.empty()) {
-    const std::int32_t node = stack_.back();
+    const std::int32_t tree_node = stack_.back();
     stack_.pop_back();
-    if (!sphere_near(spheres[static_cast<std::size_t>(node)], p, radius)) continue;
-    if (tree.is_leaf(node)) {
-      const std::uint32_t t = tree.pieces()[static_cast<std::size_t>(node)].triangle;
-      if (tissue_triangle_stamp_[t] == stamp_) continue;
-      tissue_triangle_stamp_[t] = stamp_;
-      if (near_triangles_.size() < near_triangles_.capacity()) {
-        near_triangles_.push_back(t);
+    const Sphere& sphere = spheres[static_cast<std::size_t>(tree_node)];
+    const Vec3 c = pose.inverse_apply_point(sphere.center);
+    const Vec3 gap = glm::max(glm::max(lower - c, c - upper), Vec3(0.0));
+    if (glm::dot(gap, gap) > sphere.radius * sphere.radius) continue;
+    if (tissue_tree.is_leaf(tree_node)) {
+      if (part_leaves_.size() < part_leaves_.capacity()) {
+        part_leaves_.push_back({sphere, tissue_tree.pieces()[static_cast<std::size_t>(tree_node)].triangle});
       } else {
         search_.stats.overflowed = true;
       }
     } else if (stack_.size() + 2 <= stack_.capacity()) {
-      stack_.push_back(links[static_cast<std::size_t>(node)].right);
-      stack_.push_back(links[static_cast<std::size_t>(node)].left);
+      stack_.push_back(links[static_cast<std::size_t>(tree_node)].right);
+      stack_.push_back(links[static_cast<std::size_t>(tree_node)].left);
     } else {
       search_.stats.overflowed = true;
     }
+  }
+  search_.stats.tissue_leaves += static_cast<std::int32_t>(part_leaves_.size());
+  // The corners as bits, read back word by word: each node once and in ascending order, so the
+  // search finds them in the order the forces want them (order_points() has nothing to do) and
+  // reads the positions, which the node order keeps near one another in space, in that order too.
+  for (const NearLeaf& leaf : part_leaves_) {
+    for (std::uint32_t n : surface.triangles[leaf.triangle]) near_node_bits_[n / 64] |= std::uint64_t{1} << (n % 64);
+  }
+  for (std::size_t word = 0; word < near_node_bits_.size(); ++word) {
+    for (std::uint64_t bits = near_node_bits_[word]; bits != 0; bits &= bits - 1) {
+      const auto n = static_cast<std::uint32_t>(64 * word + static_cast<std::size_t>(std::countr_zero(bits)));
+      near_nodes_.push_back({n, pose.inverse_apply_point(surface.positions[n])});  // each node once: within the room
+    }
+    near_node_bits_[word] = 0;
+  }
+}
+
+void ToolContacts::select_triangles(const Vec3& p, double radius, const TriangleMesh& surface) {
+  near_triangles_.clear();
+  near_boxes_.clear();
+  const std::uint32_t mark = ++stamp_;
+  const std::vector<Vec3>& x = surface.positions;
+  for (const NearLeaf& leaf : part_leaves_) {
+    if (!sphere_near(leaf.sphere, p, radius) || tissue_triangle_stamp_[leaf.triangle] == mark) continue;
+    tissue_triangle_stamp_[leaf.triangle] = mark;
+    const Triangle& t = surface.triangles[leaf.triangle];
+    near_triangles_.push_back(leaf.triangle);  // each triangle once: within the room
+    near_boxes_.push(glm::min(x[t[0]], glm::min(x[t[1]], x[t[2]])), glm::max(x[t[0]], glm::max(x[t[1]], x[t[2]])));
   }
 }
 
@@ -397,10 +476,12 @@ void ToolContacts::copy_query_state(const ToolContacts& front) {
 }
 
 void ToolContacts::order_points(std::vector<PointCandidates>& points, std::vector<Clearance>& clearance, std::size_t count) {
+  const auto in_order = [](const PointCandidates& a, const PointCandidates& b) { return a.part != b.part ? a.part < b.part : a.point < b.point; };
+  if (std::is_sorted(points.begin(), points.begin() + static_cast<std::ptrdiff_t>(count), in_order)) return;  // the tissue nodes always are
   std::vector<std::pair<PointCandidates, Clearance>>& sorting = search_.sorting;
   for (std::size_t i = 0; i < count; ++i) sorting[i] = {points[i], clearance[i]};
-  const auto by_part_then_point = [](const std::pair<PointCandidates, Clearance>& a, const std::pair<PointCandidates, Clearance>& b) {
-    return a.first.part != b.first.part ? a.first.part < b.first.part : a.first.point < b.first.point;
+  const auto by_part_then_point = [&](const std::pair<PointCandidates, Clearance>& a, const std::pair<PointCandidates, Clearance>& b) {
+    return in_order(a.first, b.first);
   };
   std::sort(sorting.begin(), sorting.begin() + static_cast<std::ptrdiff_t>(count), by_part_then_point);
   for (std::size_t i = 0; i < count; ++i) {
@@ -454,7 +535,13 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
   if (node_stamp_.size() < surface.vertex_count()) node_stamp_.assign(surface.vertex_count(), 0);
   if (tissue_triangle_stamp_.size() < surface.triangle_count()) tissue_triangle_stamp_.assign(surface.triangle_count(), 0);
   if (near_triangles_.capacity() < surface.triangle_count()) near_triangles_.reserve(surface.triangle_count());
-  if (near_boxes_.capacity() < surface.triangle_count()) near_boxes_.reserve(surface.triangle_count());
+  if (part_leaves_.capacity() < tissue_tree.spheres().size()) part_leaves_.reserve(tissue_tree.spheres().size());
+  if (near_nodes_.capacity() < surface.vertex_count()) near_nodes_.reserve(surface.vertex_count());
+  if (64 * near_node_bits_.size() < surface.vertex_count()) near_node_bits_.assign((surface.vertex_count() + 63) / 64, 0);
+  if (near_indices_.size() < surface.triangle_count()) {
+    near_boxes_.reserve(surface.triangle_count());
+    near_indices_.resize(surface.triangle_count());
+  }
   if (stack_.capacity() < 4 * surface.triangle_count()) stack_.reserve(4 * surface.triangle_count());
   if (search_.corners.size() < surface.vertex_count()) search_.corners.resize(surface.vertex_count());
   if (stamp_ > 0xfff00000u) {  // keep the stamps from wrapping
@@ -466,8 +553,9 @@ void ToolContacts::search_candidates(const SphereTree& tissue_tree, const Triang
   search_.stats = {};
   for (std::size_t pi = 0; pi < parts_.size(); ++pi) {
     if (!parts_[pi].query_enabled) continue;
-    search_tissue_nodes(static_cast<std::uint16_t>(pi), tissue_tree, surface);
-    search_tool_vertices(static_cast<std::uint16_t>(pi), tissue_tree, surface);
+    gather_part_leaves(parts_[pi], tissue_tree, surface);
+    search_tissue_nodes(static_cast<std::uint16_t>(pi), surface);
+    search_tool_vertices(static_cast<std::uint16_t>(pi), surface);
   }
   collect_searched_corners(surface);
   // The points were found in the order of the tissue tree's shape, which edits, rebuilds and the copy
@@ -507,85 +595,58 @@ double ToolContacts::corners_moved(std::span<const Vec3> x) const {
   return rounded_up(std::sqrt(largest2));
 }
 
-void ToolContacts::search_tissue_nodes(std::uint16_t part_index, const SphereTree& tissue_tree, const TriangleMesh& surface) {
+void ToolContacts::search_tissue_nodes(std::uint16_t part_index, const TriangleMesh& surface) {
   // A node within the margin of the part lies in the part's grid box, so the leaves of its faces
-  // reach that box: one descent of the tissue tree against the box (in the part's frame) finds every
-  // such node, and the grid answers which of the part's faces each may touch.
+  // reach that box: the corners of the leaves gathered against the box are every such node, and the
+  // grid answers which of the part's faces each may touch. The grid's cells are read a few nodes
+  // ahead: they are scattered over the part's length, and waiting for each was most of the search.
+  constexpr std::size_t kAhead = 8;
   const Part& part = parts_[part_index];
   CandidateSet& out = search_;
-  if (tissue_tree.empty() || part.grid.cell_count() == 0) return;
-  const RigidPose& pose = part.query_pose;
-  const Vec3& lower = part.grid.lower();
-  const Vec3& upper = part.grid.upper();
-  const auto& spheres = tissue_tree.spheres();
-  const auto& links = tissue_tree.links();
-  const std::uint32_t node_mark = ++stamp_;
-  stack_.clear();
-  stack_.push_back(tissue_tree.root());
-  while (!stack_.empty()) {
-    const std::int32_t tree_node = stack_.back();
-    stack_.pop_back();
-    const Sphere& sphere = spheres[static_cast<std::size_t>(tree_node)];
-    const Vec3 c = pose.inverse_apply_point(sphere.center);
-    const Vec3 gap = glm::max(glm::max(lower - c, c - upper), Vec3(0.0));
-    if (glm::dot(gap, gap) > sphere.radius * sphere.radius) continue;
-    if (!tissue_tree.is_leaf(tree_node)) {
-      if (stack_.size() + 2 > stack_.capacity()) {
-        out.stats.overflowed = true;
-        continue;
-      }
-      stack_.push_back(links[static_cast<std::size_t>(tree_node)].right);
-      stack_.push_back(links[static_cast<std::size_t>(tree_node)].left);
+  const std::size_t count = near_nodes_.size();
+  for (std::size_t i = 0; i < std::min(kAhead, count); ++i) part.grid.prefetch(near_nodes_[i].in_part);
+  for (std::size_t i = 0; i < count; ++i) {
+    if (i + kAhead < count) part.grid.prefetch(near_nodes_[i + kAhead].in_part);
+    if (i + kAhead / 2 < count) part.grid.prefetch_list(near_nodes_[i + kAhead / 2].in_part);
+    const std::uint32_t n = near_nodes_[i].node;
+    const Vec3& p = near_nodes_[i].in_part;
+    const std::span<const std::uint32_t> near = part.grid.candidates(p);
+    if (near.empty()) continue;
+    if (out.node_count >= out.nodes.size()) {
+      out.stats.overflowed = true;
       continue;
     }
-    ++out.stats.tissue_leaves;
-    const Triangle& tri = surface.triangles[tissue_tree.pieces()[static_cast<std::size_t>(tree_node)].triangle];
-    for (std::uint32_t n : tri) {
-      if (node_stamp_[n] == node_mark) continue;
-      node_stamp_[n] = node_mark;
-      const Vec3 p = pose.inverse_apply_point(surface.positions[n]);
-      const std::span<const std::uint32_t> near = part.grid.candidates(p);
-      if (near.empty()) continue;
-      if (out.node_count >= out.nodes.size()) {
-        out.stats.overflowed = true;
-        continue;
-      }
-      const auto first = static_cast<std::uint32_t>(out.pair_count);
-      for (std::uint32_t t : near) {
-        if (sphere_near(part.triangle_spheres[t], p, margin_m_)) push_pair(t);
-      }
-      keep_within_margin(first, p, part.mesh.positions, part.mesh.triangles);
-      const auto count = static_cast<std::uint32_t>(out.pair_count - first);
-      if (count == 0) continue;
-      const Vec3 at = part.certify_pose.inverse_apply_point(surface.positions[n]);
-      const double shift = rounded_up(glm::length(at - p));
-      const Closest best = nearest_tool_face(part.mesh, part.face_normals, part.triangle_spheres, at, &out.pair_triangles[first], count,
-                                             &out.pair_distance[first], shift);
-      out.node_clearance[out.node_count] = certify_within_candidates(best, at, 0.0, shift, margin_m_, &out.pair_triangles[first], count,
-                                                                     &out.pair_distance[first], false, tool_corners(part.mesh));
-      out.nodes[out.node_count++] = {n, part_index, first, count, p};
+    const auto first = static_cast<std::uint32_t>(out.pair_count);
+    for (std::uint32_t t : near) {
+      if (sphere_near(part.triangle_spheres[t], p, margin_m_)) push_pair(t);
     }
+    keep_within_margin(first, p, part.mesh.positions, part.mesh.triangles);
+    const auto kept = static_cast<std::uint32_t>(out.pair_count - first);
+    if (kept == 0) continue;
+    const Vec3 at = part.certify_pose.inverse_apply_point(surface.positions[n]);
+    const double shift = rounded_up(glm::length(at - p));
+    const Closest best = nearest_tool_face(part.mesh, part.face_normals, part.triangle_spheres, at, &out.pair_triangles[first], kept,
+                                           &out.pair_distance[first], shift);
+    out.node_clearance[out.node_count] = certify_within_candidates(best, at, 0.0, shift, margin_m_, &out.pair_triangles[first], kept,
+                                                                   &out.pair_distance[first], RigidFaces{part.mesh, part.face_normals, part.face_boxes});
+    out.nodes[out.node_count++] = {n, part_index, first, kept, p};
   }
 }
 
-void ToolContacts::search_tool_vertices(std::uint16_t part_index, const SphereTree& tissue_tree, const TriangleMesh& surface) {
-  // One descent per cluster of the part's vertices finds the tissue faces near any of them; each
-  // vertex then keeps those within the margin of it.
+void ToolContacts::search_tool_vertices(std::uint16_t part_index, const TriangleMesh& surface) {
+  // A tissue face within the margin of a vertex reaches the part's grid box (the vertex is inside
+  // the part's bounding box), so the part's leaves hold it: each cluster picks the faces near it from
+  // them, and each of its vertices keeps those within the margin of it.
   const Part& part = parts_[part_index];
   CandidateSet& out = search_;
+  if (part_leaves_.empty()) return;
   const RigidPose& pose = part.query_pose;
   const double margin2 = margin_m_ * margin_m_;
   const std::vector<Vec3>& x = surface.positions;
   for (const VertexCluster& cluster : part.clusters) {
-    gather_triangles(tissue_tree, pose.apply_point(cluster.bound.center), cluster.bound.radius + margin_m_);
+    select_triangles(pose.apply_point(cluster.bound.center), cluster.bound.radius + margin_m_, surface);
     if (near_triangles_.empty()) continue;
     ++out.stats.tool_clusters;
-    // Each face's box once for the cluster's vertices, read in order by each.
-    near_boxes_.clear();
-    for (std::uint32_t face : near_triangles_) {
-      const Triangle& t = surface.triangles[face];
-      near_boxes_.push_back({glm::min(x[t[0]], glm::min(x[t[1]], x[t[2]])), glm::max(x[t[0]], glm::max(x[t[1]], x[t[2]]))});
-    }
     for (std::uint32_t k = cluster.first; k < cluster.first + cluster.count; ++k) {
       const std::uint32_t v = part.cluster_vertices[k];
       if (out.vertex_count >= out.vertices.size()) {
@@ -594,10 +655,8 @@ void ToolContacts::search_tool_vertices(std::uint16_t part_index, const SphereTr
       }
       const auto first = static_cast<std::uint32_t>(out.pair_count);
       const Vec3 w = pose.apply_point(part.mesh.positions[v]);
-      for (std::size_t k = 0; k < near_triangles_.size(); ++k) {
-        const Vec3 gap = glm::max(glm::max(near_boxes_[k].low - w, w - near_boxes_[k].high), Vec3(0.0));
-        if (glm::dot(gap, gap) <= margin2) push_pair(near_triangles_[k]);
-      }
+      const std::size_t within = near_boxes_.within(w, margin2, near_indices_.data());
+      for (std::size_t k = 0; k < within; ++k) push_pair(near_triangles_[near_indices_[k]]);
       keep_within_margin(first, w, x, surface.triangles);
       const auto count = static_cast<std::uint32_t>(out.pair_count - first);
       if (count == 0) continue;
@@ -605,7 +664,7 @@ void ToolContacts::search_tool_vertices(std::uint16_t part_index, const SphereTr
       const double shift = rounded_up(glm::length(at - w));
       const Closest best = nearest_tissue_face(x.data(), surface.triangles, at, &out.pair_triangles[first], count, &out.pair_distance[first], shift);
       out.vertex_clearance[out.vertex_count] = certify_within_candidates(best, at, query_tissue_travel_m_, shift, margin_m_, &out.pair_triangles[first],
-                                                                         count, &out.pair_distance[first], true, tissue_corners(x.data(), surface.triangles));
+                                                                         count, &out.pair_distance[first], TissueFaces{x.data(), surface.triangles});
       out.vertices[out.vertex_count++] = {v, part_index, first, count, w};
     }
   }
@@ -733,6 +792,10 @@ void ToolContacts::reserve_tissue(std::size_t max_nodes, std::size_t max_faces) 
   if (tissue_triangle_stamp_.size() < max_faces) tissue_triangle_stamp_.assign(max_faces, 0);
   near_triangles_.reserve(max_faces);
   near_boxes_.reserve(max_faces);
+  if (near_indices_.size() < max_faces) near_indices_.resize(max_faces);
+  part_leaves_.reserve(2 * max_faces);  // a tree has fewer leaves than nodes; a leaf or two per face
+  near_nodes_.reserve(max_nodes);
+  if (64 * near_node_bits_.size() < max_nodes) near_node_bits_.assign((max_nodes + 63) / 64, 0);
   // Both buffers: publishing swaps them.
   if (search_.corners.size() < max_nodes) search_.corners.resize(max_nodes);
   if (searched_corners_.size() < max_nodes) searched_corners_.resize(max_nodes);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "rtcore/collision/sphere_tree.h"
+#include "rtcore/geometry/box_columns.h"
 #include "rtcore/geometry/rigid_pose.h"
 #include "rtcore/mesh/triangle_mesh.h"
 #include "rtcore/collision/tool_proximity_grid.h"
@@ -34,7 +35,7 @@ struct ToolContactCapacity {
 /// What one collision step found, for the profiler and the tests.
 struct ToolContactStats {
   std::int32_t tissue_leaves = 0;  ///< tissue leaves that reached a part's grid, over all parts
-  std::int32_t tool_clusters = 0;  ///< tool vertex clusters that reached the tissue, over all parts
+  std::int32_t tool_clusters = 0;  ///< tool vertex clusters that found tissue faces near them, over all parts
   std::int32_t tissue_nodes = 0;   ///< candidate tissue nodes
   std::int32_t tool_vertices = 0;  ///< candidate tool vertices
   std::int32_t pair_entries = 0;
@@ -165,8 +166,9 @@ class ToolContacts {
   std::int64_t points_skipped() const { return points_skipped_; }
 
  private:
-  /// Vertices of a part near one another, searched against the tissue together: one tree descent
-  /// for the cluster instead of one per vertex. Vertices [first, first + count) of cluster_vertices.
+  /// Vertices of a part near one another, searched against the tissue together: the tissue faces near
+  /// the cluster are picked once for all of them. Vertices [first, first + count) of cluster_vertices.
+  static constexpr double kClusterMargins = 4.0;  ///< the largest radius of a cluster's bound, in margins
   struct VertexCluster {
     Sphere bound;  // tool frame
     std::uint32_t first = 0, count = 0;
@@ -175,6 +177,7 @@ class ToolContacts {
     TriangleMesh mesh;          // tool frame
     std::vector<Vec3> face_normals;  // unit, tool frame
     std::vector<Sphere> triangle_spheres;  // per face, tool frame: prunes the closest-point tests
+    std::vector<std::pair<Vec3, Vec3>> face_boxes;  // per face, tool frame: its bounding box (low, high)
     ToolProximityGrid grid;     // the faces within the margin of a point of the tool frame
     std::vector<VertexCluster> clusters;
     std::vector<std::uint32_t> cluster_vertices;
@@ -222,13 +225,17 @@ class ToolContacts {
   void build_vertex_clusters(Part& part) const;
   /// Puts the search's first `count` points in (part, point) order, with their certificates.
   void order_points(std::vector<PointCandidates>& points, std::vector<Clearance>& clearance, std::size_t count);
-  /// Fills near_triangles_ with the triangles of `tree` whose leaf sphere is within `radius` of
-  /// `point`, each once.
-  void gather_triangles(const SphereTree& tree, const Vec3& point, double radius);
-  /// The tissue nodes of `part` (at `pose`) within the margin, with their candidate faces.
-  void search_tissue_nodes(std::uint16_t part_index, const SphereTree& tissue_tree, const TriangleMesh& surface);
-  /// The part's vertices within the margin of the tissue, with their candidate tissue faces.
-  void search_tool_vertices(std::uint16_t part_index, const SphereTree& tissue_tree, const TriangleMesh& surface);
+  /// Fills part_leaves_ with the tissue tree's leaves that reach the part's grid box at its query
+  /// pose, and near_nodes_ with their corners, each once.
+  void gather_part_leaves(const Part& part, const SphereTree& tissue_tree, const TriangleMesh& surface);
+  /// Fills near_triangles_ and near_boxes_ with the triangles of part_leaves_ whose leaf sphere is
+  /// within `radius` of `point`, each once, and their boxes.
+  void select_triangles(const Vec3& point, double radius, const TriangleMesh& surface);
+  /// The tissue nodes of near_nodes_ within the margin of the part, with their candidate faces.
+  void search_tissue_nodes(std::uint16_t part_index, const TriangleMesh& surface);
+  /// The part's vertices within the margin of the tissue, with their candidate tissue faces
+  /// (from part_leaves_: every face within the margin of the part reaches its grid box).
+  void search_tool_vertices(std::uint16_t part_index, const TriangleMesh& surface);
   bool push_pair(std::uint32_t triangle);
   /// Lists the corners of the tool vertices' candidate faces with their searched positions.
   void collect_searched_corners(const TriangleMesh& surface);
@@ -276,11 +283,22 @@ class ToolContacts {
   std::vector<std::uint32_t> node_stamp_, tissue_triangle_stamp_;
   std::uint32_t stamp_ = 0;
   std::vector<std::int32_t> stack_;
-  std::vector<std::uint32_t> near_triangles_;  // gather_triangles()'s result
-  struct Box {
-    Vec3 low, high;
+  /// A tissue leaf near a part: its sphere and triangle.
+  struct NearLeaf {
+    Sphere sphere;
+    std::uint32_t triangle;
   };
-  std::vector<Box> near_boxes_;  // per face of near_triangles_, its box at the searched positions
+  std::vector<NearLeaf> part_leaves_;  // gather_part_leaves()'s
+  /// A tissue node at a corner of a leaf near a part, and where it is in the part's frame.
+  struct NearNode {
+    std::uint32_t node;
+    Vec3 in_part;
+  };
+  std::vector<NearNode> near_nodes_;  // gather_part_leaves()'s
+  std::vector<std::uint64_t> near_node_bits_;  // gather_part_leaves()'s scratch: a bit per tissue node, all clear between calls
+  std::vector<std::uint32_t> near_triangles_;  // select_triangles()'s result
+  BoxColumns near_boxes_;  // per face of near_triangles_, its box at the searched positions
+  std::vector<std::uint32_t> near_indices_;  // a vertex's boxes within the margin (BoxColumns::within)
   ToolContactStats stats_;
 };
 
