@@ -30,6 +30,9 @@ Vec3 barycentric(const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
   return {1.0 - v - w, v, w};
 }
 
+/// A triangle's bounding box (low, high) from its corners.
+std::pair<Vec3, Vec3> corner_box(const Vec3& a, const Vec3& b, const Vec3& c) { return {glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))}; }
+
 bool sphere_near(const Sphere& s, const Vec3& p, double radius) {
   const double reach = s.radius + radius;
   const Vec3 d = p - s.center;
@@ -109,7 +112,8 @@ Closest nearest_tissue_face(const Vec3* x, const std::vector<Triangle>& triangle
   for (std::uint32_t e = 0; e < count; ++e) {
     if (cannot_win(best, searched, e, moved)) break;
     const Triangle& t = triangles[faces[e]];
-    if (best.beyond_box(w, glm::min(x[t[0]], glm::min(x[t[1]], x[t[2]])), glm::max(x[t[0]], glm::max(x[t[1]], x[t[2]])))) continue;
+    const auto [low, high] = corner_box(x[t[0]], x[t[1]], x[t[2]]);
+    if (best.beyond_box(w, low, high)) continue;
     const Vec3 q = closest_point_on_triangle(w, x[t[0]], x[t[1]], x[t[2]]);
     if (best.further(glm::dot(w - q, w - q))) continue;
     const Vec3 n2 = glm::cross(x[t[1]] - x[t[0]], x[t[2]] - x[t[0]]);
@@ -151,7 +155,7 @@ struct TissueFaces {
     return {x[t[0]], x[t[1]], x[t[2]]};
   }
   std::pair<Vec3, Vec3> box(std::uint32_t, const std::array<Vec3, 3>& c) const {
-    return {glm::min(c[0], glm::min(c[1], c[2])), glm::max(c[0], glm::max(c[1], c[2]))};
+    return corner_box(c[0], c[1], c[2]);
   }
   std::optional<double> height(std::uint32_t, const std::array<Vec3, 3>& c, const Vec3& at, double start_radius, double& travel_cap) const {
     constexpr double kTurnedHeight = 0.866;  // cos 30°, rounded down
@@ -279,8 +283,7 @@ int ToolContacts::add_part(const TriangleMesh& mesh) {
     double radius = 0.0;
     for (std::uint32_t v : tri) radius = std::max(radius, glm::length(mesh.positions[v] - centroid));
     part.triangle_spheres.push_back({centroid, radius});
-    const std::array<Vec3, 3> c{mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]]};
-    part.face_boxes.emplace_back(glm::min(c[0], glm::min(c[1], c[2])), glm::max(c[0], glm::max(c[1], c[2])));
+    part.face_boxes.push_back(corner_box(mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]]));
   }
   part.grid.build(mesh, margin_m_);
   build_vertex_clusters(part);
@@ -416,7 +419,8 @@ void ToolContacts::select_triangles(const Vec3& p, double radius, const Triangle
     tissue_triangle_stamp_[leaf.triangle] = mark;
     const Triangle& t = surface.triangles[leaf.triangle];
     near_triangles_.push_back(leaf.triangle);  // each triangle once: within the room
-    near_boxes_.push(glm::min(x[t[0]], glm::min(x[t[1]], x[t[2]])), glm::max(x[t[0]], glm::max(x[t[1]], x[t[2]])));
+    const auto [low, high] = corner_box(x[t[0]], x[t[1]], x[t[2]]);
+    near_boxes_.push(low, high);
   }
 }
 
