@@ -222,8 +222,14 @@ void SphereTree::begin_build(const TriangleMesh& mesh, const SphereTree& covered
   start_build(mesh);
 }
 
-void SphereTree::reserve(std::int32_t max_nodes, std::uint32_t max_triangles) {
+void SphereTree::reserve(std::int32_t max_nodes, std::uint32_t max_triangles, std::size_t max_vertices) {
   const auto nodes = static_cast<std::size_t>(std::max(max_nodes, 1));
+  fitted_positions_.reserve(max_vertices);
+  vertex_slot_begin_.reserve(max_vertices + 1);
+  slack_vertices_.reserve(max_vertices);
+  vertex_slots_.reserve(3 * nodes);
+  for (auto* bits : {&moved_slot_bits_, &dirty_node_bits_}) bits->reserve(nodes / 64 + 1);
+  for (auto* list : {&dirty_nodes_, &dirty_by_height_}) list->reserve(nodes);
   spheres_.reserve(nodes);
   links_.reserve(nodes);
   pieces_.reserve(nodes);
@@ -304,6 +310,8 @@ void SphereTree::abandon_build() {
   next_leaf_.clear();
   std::fill(first_leaf_.begin(), first_leaf_.end(), kNoNode);
   order_dirty_ = true;
+  applied_slack_ = 0.0;
+  fitted_ = false;
 }
 
 bool SphereTree::continue_build(std::int64_t work) {
@@ -333,6 +341,8 @@ bool SphereTree::continue_build(std::int64_t work) {
     first_leaf_[t] = leaf;
   }
   order_dirty_ = true;
+  applied_slack_ = 0.0;  // built tight, before quality() measures it
+  fitted_ = false;
   built_mean_internal_radius_ = quality().mean_internal_radius;
   return true;
 }
@@ -602,6 +612,10 @@ void SphereTree::update_sphere_refit_blocks() {
     end_block();
   }
   merge_children_.resize(merge_order_.size());
+  preorder_ = true;
+  for (std::int32_t n = 0; n < node_capacity() && preorder_; ++n) {
+    if (links_[n].height > 0) preorder_ = links_[n].left > n && links_[n].right > n;
+  }
   for (std::size_t i = 0; i < merge_order_.size(); ++i) merge_children_[i] = {links_[merge_order_[i]].left, links_[merge_order_[i]].right};
 }
 
@@ -665,6 +679,7 @@ void SphereTree::refit_internal(const TriangleMesh& mesh, std::int32_t node) {
 
 void SphereTree::refit(const TriangleMesh& mesh) {
   if (order_dirty_) update_refit_order();
+  last_refit_leaves_ = leaf_count_;
   // Leaves from their triangles' corners, then one pass of O(1) merges, children before parents:
   // each internal bound holds its two children's, so every leaf below stays covered. Two loops
   // without a branch on the kind of node, each reading its arrays in order.
@@ -674,6 +689,7 @@ void SphereTree::refit(const TriangleMesh& mesh) {
     return;
   }
   // Spheres alone: the same bounds as refit_leaf and refit_internal give, block by block, four at a time.
+  const bool leaves_changed = corners_stale_;
   if (corners_stale_) {
     // The leaves' triangles keep their corners until a removal or insertion changes the order.
     whole_corners_.resize(whole_leaves_.size());
@@ -682,6 +698,12 @@ void SphereTree::refit(const TriangleMesh& mesh) {
     for (std::size_t i = 0; i < sliced_leaves_.size(); ++i) sliced_operands_[i] = slice_operands(mesh, pieces_[sliced_leaves_[i]]);
     corners_stale_ = false;
   }
+  if (refit_slack_ > 0.0 && fitted_ && !leaves_changed && fitted_positions_.size() == mesh.positions.size() && refit_moved_leaves(mesh)) return;
+  refit_every_sphere(mesh);
+  keep_fitted_positions(mesh, leaves_changed);
+}
+
+void SphereTree::refit_every_sphere(const TriangleMesh& mesh) {
   const std::span<const std::int32_t> whole(whole_leaves_), sliced(sliced_leaves_), merges(merge_order_);
   RefitBlock begin{0, 0, 0};
   std::size_t merged = 0;  // merge_order_'s entries done
@@ -786,7 +808,8 @@ SphereTreeQuality SphereTree::quality() const {
     }
   }
   q.mean_internal_radius = internal > 0 ? sum / internal : 0.0;
-  q.radius_growth = built_mean_internal_radius_ > 0.0 ? q.mean_internal_radius / built_mean_internal_radius_ : 1.0;
+  // The refit's slack grows every sphere alike; what decays the tree is the growth beyond it.
+  q.radius_growth = built_mean_internal_radius_ > 0.0 ? (q.mean_internal_radius - applied_slack_) / built_mean_internal_radius_ : 1.0;
   return q;
 }
 

@@ -152,7 +152,20 @@ class SphereTree {
   /// Recomputes every sphere bottom-up from the mesh's current vertex positions (section 3.4).
   /// Allocates nothing once the tree's size has been seen before. The vertices may move; a triangle
   /// whose corners change must be removed and inserted again (the tree keeps its leaves' corners).
+  /// With a refit slack (set_refit_slack), only the leaves with a corner that moved further than
+  /// the slack since they were last fitted are fitted again, with their ancestors.
   void refit(const TriangleMesh& mesh);
+
+  /// Lets refit() leave a leaf alone while none of its corners has moved further than `slack`
+  /// (mesh units) since it was fitted: every leaf sphere is fitted to its corners as they were then
+  /// and grown by `slack`, which holds the triangle as long as each corner stays within `slack` of
+  /// where it was (a triangle's point is a weighted mean of its corners). Spheres-only trees (the
+  /// contact's search); 0, the default, refits every sphere every time. Takes effect at the next
+  /// refit, which fits every leaf.
+  void set_refit_slack(double slack);
+  double refit_slack() const { return refit_slack_; }
+  /// The leaves the last refit() fitted (every one unless the slack spared some).
+  std::int32_t last_refit_leaves() const { return last_refit_leaves_; }
 
   /// Adds the leaves of triangle `t` of `mesh`, each descending by the principal direction of the
   /// nodes it passes (the line between their children's centres), then refits the path (3.5).
@@ -162,9 +175,10 @@ class SphereTree {
   /// ancestors are refitted, and the two freed nodes go to the free list (3.5).
   void remove_triangle(std::uint32_t t);
 
-  /// Reserves room for `max_nodes` nodes over up to `max_triangles` triangle slots, so insertions
-  /// and refits within it allocate nothing (a tissue that resection grows reserves its room at start).
-  void reserve(std::int32_t max_nodes, std::uint32_t max_triangles);
+  /// Reserves room for `max_nodes` nodes over up to `max_triangles` triangle slots and meshes of up
+  /// to `max_vertices` vertices, so insertions and refits within it allocate nothing (a tissue that
+  /// resection grows reserves its room at start).
+  void reserve(std::int32_t max_nodes, std::uint32_t max_triangles, std::size_t max_vertices = 0);
   /// The current shape and how far it has drifted from the last build.
   SphereTreeQuality quality() const;
   /// True when the tree is taller than the policy tolerates (over 2 log2(n) + 4) or its internal
@@ -248,6 +262,16 @@ class SphereTree {
   void add_triangle_leaves(const TriangleMesh& mesh, std::uint32_t t, bool insert);
   void update_refit_order();
   void update_sphere_refit_blocks();
+  void refit_every_sphere(const TriangleMesh& mesh);
+  /// The refit with slack: after a refit of every leaf, records the positions fitted and grows every
+  /// sphere by the slack; between them, refit_moved_leaves() fits only the leaves of the corners that
+  /// moved beyond it and the ancestors, and returns false (having done nothing the full refit must
+  /// undo) when so many moved that a full refit is cheaper.
+  void keep_fitted_positions(const TriangleMesh& mesh, bool leaves_changed);
+  bool refit_moved_leaves(const TriangleMesh& mesh);
+  void update_vertex_slots(std::size_t vertex_count);
+  void fit_moved_leaf(std::size_t slot);
+  void merge_dirty_nodes();
 
   std::vector<Sphere> spheres_;         // hot: per node
   std::vector<SphereTreeLinks> links_;  // per node
@@ -278,6 +302,20 @@ class SphereTree {
   std::vector<std::int32_t> block_top_, block_nodes_, block_walk_;  // scratch
   std::vector<std::size_t> height_slots_;                           // scratch
   std::vector<std::int32_t> stack_;        // scratch for update_refit_order and update_sphere_refit_blocks
+  // The refit with slack (set_refit_slack): the positions the leaves were last fitted to, per mesh
+  // vertex; each vertex's refit slots (an index into whole_leaves_, or whole_leaves_.size() plus one
+  // into sliced_leaves_), from vertex_slot_begin_[v] to vertex_slot_begin_[v + 1]; the vertices with
+  // any; a bit per slot and per node for the ones to fit again, read back in memory order; whether
+  // every child is numbered after its parent (then the nodes backwards are children first).
+  double refit_slack_ = 0.0;
+  double applied_slack_ = 0.0;  // the slack the spheres now carry (0 after a build)
+  bool fitted_ = false;         // fitted_positions_ hold every leaf's last fit
+  bool preorder_ = false;
+  std::vector<Vec3> fitted_positions_;
+  std::vector<std::int32_t> vertex_slot_begin_, vertex_slots_, slack_vertices_;
+  std::vector<std::uint64_t> moved_slot_bits_, dirty_node_bits_;
+  std::vector<std::int32_t> dirty_nodes_, dirty_by_height_;
+  std::int32_t last_refit_leaves_ = 0;
   std::int32_t root_ = kNoNode;
   std::int32_t free_list_ = kNoNode;
   std::int32_t leaf_count_ = 0;

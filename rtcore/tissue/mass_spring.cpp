@@ -69,9 +69,11 @@ MassSpringTissue::MassSpringTissue(OrderedMesh&& ordered_mesh, const TissueParam
   }
   tool_.set_clearance_skipping(config_.clearance_certificates);
   surface_ = boundary_surface(mesh);
-  surface_tree_.set_slabs(false);  // its one query is the contact's, on spheres (ToolContacts)
+  for (SphereTree* tree : {&surface_tree_, &spare_tree_}) {
+    tree->set_slabs(false);  // its one query is the contact's, on spheres (ToolContacts)
+    tree->set_refit_slack(config_.surface_refit_slack_m);
+  }
   surface_tree_.build(surface_);
-  spare_tree_.set_slabs(false);
   reserve_topology(topology_.node_capacity(), topology_.tetrahedron_capacity());
   map_initial_surface();
   refresh_mesh_surface();

@@ -48,6 +48,11 @@ struct TissueConfig {
   /// at most a third of it: contact_candidates_still_serve) keeps them instead of refitting and
   /// searching again, its margin short by that much. 0: every collision step searches.
   double contact_reuse_m = 0.0003;
+  /// The contact tree's refit leaves a face's sphere as it is while each of its corners stays within
+  /// this distance of where it was fitted (SphereTree::set_refit_slack): under a tool only the
+  /// pressed region moves that far between collision steps. Every sphere is that much larger, so the
+  /// search's descent reaches a little further. 0: every sphere refitted every step.
+  double surface_refit_slack_m = 0.0003;
   ToolContactCapacity contact_capacity;
   /// Steps the nodes in locality order (node_order.h) rather than the mesh's; off only to measure
   /// what the order buys.

@@ -94,7 +94,7 @@ void MassSpringTissue::reserve_topology(std::size_t node_capacity, std::size_t t
   changed_faces_.reserve(surface_face_capacity_);
   tool_.reserve_tissue(node_capacity, surface_face_capacity_);
   for (SphereTree* tree : {&surface_tree_, &spare_tree_}) {
-    tree->reserve(static_cast<std::int32_t>(4 * surface_face_capacity_), static_cast<std::uint32_t>(surface_face_capacity_));
+    tree->reserve(static_cast<std::int32_t>(4 * surface_face_capacity_), static_cast<std::uint32_t>(surface_face_capacity_), node_capacity);
   }
   mesh_surface_.triangles.resize(surface_face_capacity_);
   mesh_surface_.regions.resize(surface_face_capacity_);
