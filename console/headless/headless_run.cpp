@@ -203,7 +203,6 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
     helper_raised = raised.physics_helper;
     if (recorder) recorder_raised = raise_to_fifo(recorder->native_handle(), kRecorderFifoPriority);
   }
-  if (LoopHelper* helper = sim.physics_helper(); helper != nullptr && !options.realtime) helper->set_nice(kBatchPhysicsHelperNice);
   const auto wall_start = std::chrono::steady_clock::now();
   if (options.realtime) {
     sim.set_paced();
@@ -274,11 +273,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   }
   r["scheduling"] = {{"core", core_raised ? "SCHED_FIFO " + std::to_string(kCoreFifoPriority) : std::string("normal")},
                      {"collision", collision_raised ? "SCHED_FIFO " + std::to_string(kCollisionFifoPriority) : std::string("normal")}};
-  if (const LoopHelper* helper = sim.physics_helper()) {
-    r["scheduling"]["physics_helper"] = helper_raised        ? "SCHED_FIFO " + std::to_string(kCoreFifoPriority)
-                                        : helper->nice() != 0 ? "normal, nice " + std::to_string(helper->nice())
-                                                              : std::string("normal");
-  }
+  if (sim.physics_helper()) r["scheduling"]["physics_helper"] = helper_raised ? "SCHED_FIFO " + std::to_string(kCoreFifoPriority) : std::string("normal");
   if (recorder) r["scheduling"]["recorder"] = recorder_raised ? "SCHED_FIFO " + std::to_string(kRecorderFifoPriority) : std::string("normal");
   r["model"] = {{"surface_triangles", sim.prostate().surface.triangle_count()},
                 {"tetrahedra", sim.tetrahedron_count()},

@@ -15,8 +15,6 @@
 #pragma once
 
 #include <sched.h>
-#include <sys/resource.h>
-#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
@@ -73,13 +71,6 @@ class LoopHelper {
   void send_home() { on_call_.store(0, std::memory_order_relaxed); }
   /// Whether the helper is on call (called in, and not yet sent or gone home).
   bool on_call() const { return on_call_.load(std::memory_order_relaxed) != 0; }
-
-  /// Owner: the helper's thread runs at this nice value from its next call-in on (Linux keeps one
-  /// per thread; raising it needs no privilege). In a run without deadlines the helper, spinning
-  /// between a step's loops, would otherwise take a processor from the collision job beside it.
-  void set_nice(int nice) { wanted_nice_.store(nice, std::memory_order_relaxed); }
-  /// The nice value the helper's thread last took (0 until set_nice() and a call-in).
-  int nice() const { return applied_nice_.load(std::memory_order_relaxed); }
 
   /// Owner: body(chunk) for every chunk in [0, chunks), run by this thread and the helper (if it is on
   /// call); returns once all have run, with their writes visible. A loop of more than kMaxChunks
@@ -146,14 +137,6 @@ class LoopHelper {
     }
   }
 
-  // Only where the helper waits for work (after a call-in, and now and then while on call between
-  // loops): a system call when the value changes, never while the owner waits on a chunk.
-  void take_wanted_nice() {
-    const int wanted = wanted_nice_.load(std::memory_order_relaxed);
-    if (wanted == applied_nice_.load(std::memory_order_relaxed)) return;
-    if (setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), wanted) == 0) applied_nice_.store(wanted, std::memory_order_relaxed);
-  }
-
   template <class Body>
   static void call_body(void* context, std::uint32_t chunk) {
     (*static_cast<Body*>(context))(chunk);
@@ -168,7 +151,6 @@ class LoopHelper {
       if (on_call_.load(std::memory_order_acquire) == 0) {
         while (on_call_.load(std::memory_order_acquire) == 0) futex_sleep_while_equal(on_call_, 0);
         idle_spins = 0;
-        take_wanted_nice();
       }
       if (stopping_.load(std::memory_order_relaxed)) return;
       const std::uint64_t w = work_.load(std::memory_order_acquire);
@@ -177,7 +159,6 @@ class LoopHelper {
         // The clock only now and then: a pause lasts tens of cycles on one processor, over a hundred
         // on another. Going home is always safe: the owner never waits for the helper to arrive.
         if (idle_spins++ % 1024 == 0) {
-          take_wanted_nice();
           const auto now = std::chrono::steady_clock::now();
           if (idle_spins == 1) idle_since = now;
           if (now - idle_since > kIdleOnCall) {
@@ -215,8 +196,6 @@ class LoopHelper {
   std::atomic<bool> stopping_{false};
   std::atomic<std::uint64_t> helped_{0};
   std::atomic<std::uint64_t> gone_home_{0};
-  std::atomic<int> wanted_nice_{0};
-  std::atomic<int> applied_nice_{0};
   std::thread thread_;  // last: starts once the rest exists
 };
 

@@ -18,10 +18,6 @@ inline constexpr int kCollisionFifoPriority = 40;
 /// The recorder thread (recordings/): below both, above every normal thread, so a loaded machine
 /// cannot starve the recording of a real-time run (it needs ~5% of a core).
 inline constexpr int kRecorderFifoPriority = 30;
-/// A batch run's physics helper (LoopHelper::set_nice): a batch run has no deadline, and its helper,
-/// spinning between a step's loops, took half a processor from the collision job beside it (three
-/// threads on two processors: the 138,240-triangle gland's search 9.2 ms against 5.5 at nice 10).
-inline constexpr int kBatchPhysicsHelperNice = 10;
 
 /// Puts `thread` under SCHED_FIFO at `priority` (1..99); false (nothing changed) if not permitted.
 bool raise_to_fifo(pthread_t thread, int priority);

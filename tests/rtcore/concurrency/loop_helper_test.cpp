@@ -3,8 +3,6 @@
 // data, so the thread sanitizer reports a missing edge). A helper that is sleeping, being called in,
 // or sent home between loops never loses or doubles a chunk.
 #include <gtest/gtest.h>
-#include <sys/resource.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -168,28 +166,6 @@ TEST(LoopHelper, CalledInForLoopsThatDoNotComeItGoesHomeByItself) {
   }
   EXPECT_GT(helper.chunks_helped(), 0u);
   for (std::size_t chunk = 0; chunk < runs.size(); ++chunk) EXPECT_EQ(runs[chunk].load(), loops) << "chunk " << chunk;
-}
-
-TEST(LoopHelper, TheHelperTakesTheNiceValueAskedAtItsNextCallIn) {
-  // Higher than this thread's (a test run may itself be niced): raising it needs no privilege.
-  const int mine = getpriority(PRIO_PROCESS, static_cast<id_t>(gettid()));
-  const int wanted = std::min(mine + 3, 19);
-  LoopHelper helper;
-  EXPECT_EQ(helper.nice(), 0);
-  helper.set_nice(wanted);
-  const auto asked = std::chrono::steady_clock::now();
-  helper.call_in();
-  while (helper.nice() != wanted && std::chrono::steady_clock::now() - asked < std::chrono::seconds(20)) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  EXPECT_EQ(helper.nice(), wanted);
-  // The value is the helper's thread's alone: this one keeps its own.
-  EXPECT_EQ(getpriority(PRIO_PROCESS, static_cast<id_t>(gettid())), mine);
-  std::vector<std::atomic<int>> runs(16);
-  auto body = [&](std::uint32_t chunk) { runs[chunk].fetch_add(1, std::memory_order_relaxed); };
-  helper.for_each_chunk(16, body);
-  helper.send_home();
-  for (const auto& r : runs) EXPECT_EQ(r.load(), 1);
 }
 
 TEST(LoopHelper, DestructionJoinsWhetherAsleepOrOnCall) {
