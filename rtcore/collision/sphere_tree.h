@@ -160,8 +160,9 @@ class SphereTree {
   /// (mesh units) since it was fitted: every leaf sphere is fitted to its corners as they were then
   /// and grown by `slack`, which holds the triangle as long as each corner stays within `slack` of
   /// where it was (a triangle's point is a weighted mean of its corners). Spheres-only trees (the
-  /// contact's search); 0, the default, refits every sphere every time. Takes effect at the next
-  /// refit, which fits every leaf.
+  /// contact's search); 0, the default, refits every sphere every time. A refit after a build or an
+  /// edit fits every leaf without slack; the first one after it without an edit fits every leaf with
+  /// the slack and records the positions, and the ones after that spare what stayed within it.
   void set_refit_slack(double slack);
   double refit_slack() const { return refit_slack_; }
   /// The leaves the last refit() fitted (every one unless the slack spared some).
@@ -267,7 +268,7 @@ class SphereTree {
   /// sphere by the slack; between them, refit_moved_leaves() fits only the leaves of the corners that
   /// moved beyond it and the ancestors, and returns false (having done nothing the full refit must
   /// undo) when so many moved that a full refit is cheaper.
-  void keep_fitted_positions(const TriangleMesh& mesh, bool leaves_changed);
+  void keep_fitted_positions(const TriangleMesh& mesh);
   bool refit_moved_leaves(const TriangleMesh& mesh);
   void update_vertex_slots(std::size_t vertex_count);
   void fit_moved_leaf(std::size_t slot);
@@ -310,6 +311,7 @@ class SphereTree {
   double refit_slack_ = 0.0;
   double applied_slack_ = 0.0;  // the slack the spheres now carry (0 after a build)
   bool fitted_ = false;         // fitted_positions_ hold every leaf's last fit
+  bool vertex_slots_stale_ = true;
   bool preorder_ = false;
   std::vector<Vec3> fitted_positions_;
   std::vector<std::int32_t> vertex_slot_begin_, vertex_slots_, slack_vertices_;

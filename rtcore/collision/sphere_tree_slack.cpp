@@ -21,7 +21,7 @@ void SphereTree::set_refit_slack(double slack) {
   fitted_ = false;  // the next refit fits every leaf with the new slack
 }
 
-void SphereTree::keep_fitted_positions(const TriangleMesh& mesh, bool leaves_changed) {
+void SphereTree::keep_fitted_positions(const TriangleMesh& mesh) {
   if (!(refit_slack_ > 0.0)) {
     applied_slack_ = 0.0;
     fitted_ = false;
@@ -32,7 +32,8 @@ void SphereTree::keep_fitted_positions(const TriangleMesh& mesh, bool leaves_cha
   for (std::int32_t n = 0; n < node_capacity(); ++n) spheres_[static_cast<std::size_t>(n)].radius += refit_slack_;
   applied_slack_ = refit_slack_;
   fitted_positions_.assign(mesh.positions.begin(), mesh.positions.end());
-  if (leaves_changed || vertex_slot_begin_.size() != mesh.positions.size() + 1) update_vertex_slots(mesh.positions.size());
+  if (vertex_slots_stale_ || vertex_slot_begin_.size() != mesh.positions.size() + 1) update_vertex_slots(mesh.positions.size());
+  vertex_slots_stale_ = false;
   moved_slot_bits_.assign((whole_leaves_.size() + sliced_leaves_.size() + 63) / 64, 0);
   dirty_node_bits_.assign((static_cast<std::size_t>(node_capacity()) + 63) / 64, 0);
   fitted_ = true;

@@ -79,8 +79,10 @@ void run_presses(TriangleMesh& mesh, std::uint64_t seed) {
   tree.set_slabs(false);
   tree.set_refit_slack(slack);
   tree.build(mesh);
-  tree.refit(mesh);
-  EXPECT_EQ(tree.last_refit_leaves(), tree.leaf_count()) << "the first refit fits every leaf";
+  for (int first = 0; first < 2; ++first) {
+    tree.refit(mesh);
+    EXPECT_EQ(tree.last_refit_leaves(), tree.leaf_count()) << "the refits after the build fit every leaf";
+  }
   std::vector<bool> in_tree(mesh.triangle_count(), true);
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
@@ -145,7 +147,8 @@ TEST(SphereTreeSlack, JitterWithinTheSlackFitsNoLeafAndAMovedVertexOnlyItsOwn) {
   tree.set_slabs(false);
   tree.set_refit_slack(slack);
   tree.build(mesh);
-  tree.refit(mesh);
+  tree.refit(mesh);  // after the build: without slack
+  tree.refit(mesh);  // the first without an edit: with it
   for (Vec3& p : mesh.positions) p.x += 0.9 * slack;
   tree.refit(mesh);
   EXPECT_EQ(tree.last_refit_leaves(), 0);
@@ -159,6 +162,15 @@ TEST(SphereTreeSlack, JitterWithinTheSlackFitsNoLeafAndAMovedVertexOnlyItsOwn) {
   EXPECT_EQ(tree.last_refit_leaves(), touching);
   expect_leaves_cover(tree, mesh);
   testing::expect_tree_invariants(tree);
+  // An edit: the refit after it fits every leaf without slack, the next with it, and then only what moves.
+  tree.remove_triangle(1);
+  tree.refit(mesh);
+  EXPECT_EQ(tree.last_refit_leaves(), tree.leaf_count());
+  tree.refit(mesh);
+  EXPECT_EQ(tree.last_refit_leaves(), tree.leaf_count());
+  tree.refit(mesh);
+  EXPECT_EQ(tree.last_refit_leaves(), 0);
+  expect_leaves_cover(tree, mesh);
   // Slack off: every leaf again.
   tree.set_refit_slack(0.0);
   tree.refit(mesh);
