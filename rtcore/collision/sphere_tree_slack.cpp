@@ -67,7 +67,8 @@ void SphereTree::update_vertex_slots(std::size_t vertex_count) {
 bool SphereTree::refit_moved_leaves(const TriangleMesh& mesh) {
   const double slack2 = refit_slack_ * refit_slack_;
   // A moved vertex takes about two leaves of its own (a surface has twice as many triangles as
-  // vertices); past a quarter of the leaves, the full refit's passes in memory order are cheaper.
+  // vertices): past an eighth of the leaves' count in moved vertices (about a quarter of the leaves),
+  // the full refit's passes in memory order are the cheaper.
   const std::size_t most = (whole_leaves_.size() + sliced_leaves_.size()) / 8;
   std::size_t moved = 0;
   // Every vertex that moved first, so that each leaf below is fitted to its corners' final fitted
