@@ -566,14 +566,9 @@ void SphereTree::update_sphere_refit_blocks() {
   merge_children_.clear();
   corners_stale_ = true;
   if (root_ == kNoNode) return;
-  const auto add_by_height = [this](std::span<const std::int32_t> nodes, std::int32_t tallest) {  // a counting sort
-    std::vector<std::size_t>& next = height_slots_;
-    next.assign(static_cast<std::size_t>(tallest) + 2, 0);
-    for (const std::int32_t n : nodes) ++next[static_cast<std::size_t>(links_[n].height) + 1];
-    next[0] = merge_order_.size();
-    for (std::size_t h = 1; h < next.size(); ++h) next[h] += next[h - 1];
-    merge_order_.resize(merge_order_.size() + nodes.size());
-    for (const std::int32_t n : nodes) merge_order_[next[static_cast<std::size_t>(links_[n].height)]++] = n;
+  const auto add_by_height = [this](std::span<const std::int32_t> nodes, std::int32_t tallest) {
+    append_by_height(nodes, tallest, merge_order_);
+    const std::vector<std::size_t>& next = height_slots_;
     for (std::size_t h = 1; h < next.size() - 1; ++h) {  // next[h] now ends height h
       if (next[h] != (merge_group_ends_.empty() ? 0 : merge_group_ends_.back())) merge_group_ends_.push_back(next[h]);
     }
@@ -617,6 +612,16 @@ void SphereTree::update_sphere_refit_blocks() {
     if (links_[n].height > 0) preorder_ = links_[n].left > n && links_[n].right > n;
   }
   for (std::size_t i = 0; i < merge_order_.size(); ++i) merge_children_[i] = {links_[merge_order_[i]].left, links_[merge_order_[i]].right};
+}
+
+void SphereTree::append_by_height(std::span<const std::int32_t> nodes, std::int32_t tallest, std::vector<std::int32_t>& out) {
+  std::vector<std::size_t>& next = height_slots_;
+  next.assign(static_cast<std::size_t>(tallest) + 2, 0);
+  for (const std::int32_t n : nodes) ++next[static_cast<std::size_t>(links_[n].height) + 1];
+  next[0] = out.size();
+  for (std::size_t h = 1; h < next.size(); ++h) next[h] += next[h - 1];
+  out.resize(out.size() + nodes.size());
+  for (const std::int32_t n : nodes) out[next[static_cast<std::size_t>(links_[n].height)]++] = n;
 }
 
 void SphereTree::refit_leaf(const TriangleMesh& mesh, std::int32_t leaf) {

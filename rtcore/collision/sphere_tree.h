@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "rtcore/mesh/triangle_mesh.h"
@@ -263,6 +264,9 @@ class SphereTree {
   void add_triangle_leaves(const TriangleMesh& mesh, std::uint32_t t, bool insert);
   void update_refit_order();
   void update_sphere_refit_blocks();
+  /// Appends `nodes` (internal, none taller than `tallest`) to `out` by height, a counting sort;
+  /// height_slots_[h] then ends height h's run in `out`.
+  void append_by_height(std::span<const std::int32_t> nodes, std::int32_t tallest, std::vector<std::int32_t>& out);
   void refit_every_sphere(const TriangleMesh& mesh);
   /// The refit with slack: after a refit of every leaf, records the positions fitted and grows every
   /// sphere by the slack; between them, refit_moved_leaves() fits only the leaves of the corners that

@@ -9,7 +9,6 @@
 // all its leaves), and merges their ancestors, children before parents.
 #include <algorithm>
 #include <bit>
-#include <limits>
 
 #include "rtcore/collision/sphere_refit_kernel.h"
 #include "rtcore/collision/sphere_tree.h"
@@ -151,12 +150,8 @@ void SphereTree::merge_dirty_nodes() {
     }
     dirty_node_bits_[word] = 0;
   }
-  std::vector<std::size_t>& next = height_slots_;
-  next.assign(static_cast<std::size_t>(tallest) + 2, 0);
-  for (const std::int32_t n : dirty_nodes_) ++next[static_cast<std::size_t>(links_[static_cast<std::size_t>(n)].height) + 1];
-  for (std::size_t h = 1; h < next.size(); ++h) next[h] += next[h - 1];
-  dirty_by_height_.resize(dirty_nodes_.size());
-  for (const std::int32_t n : dirty_nodes_) dirty_by_height_[next[static_cast<std::size_t>(links_[static_cast<std::size_t>(n)].height)]++] = n;
+  dirty_by_height_.clear();
+  append_by_height(dirty_nodes_, tallest, dirty_by_height_);
   for (const std::int32_t n : dirty_by_height_) merge(n);
 }
 
