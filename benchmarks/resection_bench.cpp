@@ -98,7 +98,11 @@ BENCHMARK(BM_TopologyUpdateWhileCutting)->Arg(8640)->Arg(34560)->Iterations(1)->
 
 /// Physics-stage median over one second with the tool withdrawn, after running `procedure_name`
 /// (or on the uncut gland when empty).
-double physics_median_us(int triangles, const char* procedure_name, double* remaining_fraction, std::size_t* nodes, std::size_t* springs) {
+struct GlandSize {
+  std::size_t nodes = 0, stepped_nodes = 0, springs = 0;
+};
+
+double physics_median_us(int triangles, const char* procedure_name, double* remaining_fraction, GlandSize* size) {
   auto sim = simulation(triangles);
   const double tick_s = sim->config().tick_s();
   std::uint64_t tick = 0;
@@ -111,26 +115,29 @@ double physics_median_us(int triangles, const char* procedure_name, double* rema
   TickInput away;  // no tool: the gland alone
   for (std::uint64_t k = 0; k < 960; ++k, ++tick) sim->step(away, {}, &profiler);
   *remaining_fraction = sim->metrics().remaining_adenoma_fraction;
-  *nodes = sim->tissue().node_count();
-  *springs = sim->tissue().network().spring_count();
+  size->nodes = sim->tissue().node_count();
+  size->stepped_nodes = sim->tissue().stepped_node_count();
+  size->springs = sim->tissue().network().spring_count();
   return profiler.statistics(Stage::kPhysics).median_us;
 }
 
 void BM_PhysicsStepAfterTurp(benchmark::State& state) {
   double uncut = 0.0, cut = 0.0, fraction = 1.0, ignored = 1.0;
-  std::size_t nodes_uncut = 0, nodes_cut = 0, springs_uncut = 0, springs_cut = 0;
+  GlandSize uncut_size, cut_size;
   for (auto _ : state) {
-    uncut = physics_median_us(8640, nullptr, &ignored, &nodes_uncut, &springs_uncut);
-    cut = physics_median_us(8640, "turp", &fraction, &nodes_cut, &springs_cut);
+    uncut = physics_median_us(8640, nullptr, &ignored, &uncut_size);
+    cut = physics_median_us(8640, "turp", &fraction, &cut_size);
   }
   state.counters["physics_median_uncut_us"] = uncut;
   state.counters["physics_median_after_turp_us"] = cut;
   state.counters["ratio"] = cut / uncut;
   state.counters["remaining_adenoma_fraction"] = fraction;
-  state.counters["nodes_uncut"] = static_cast<double>(nodes_uncut);
-  state.counters["nodes_after"] = static_cast<double>(nodes_cut);
-  state.counters["springs_uncut"] = static_cast<double>(springs_uncut);
-  state.counters["springs_after"] = static_cast<double>(springs_cut);
+  state.counters["nodes_uncut"] = static_cast<double>(uncut_size.nodes);
+  state.counters["nodes_after"] = static_cast<double>(cut_size.nodes);
+  state.counters["stepped_nodes_uncut"] = static_cast<double>(uncut_size.stepped_nodes);
+  state.counters["stepped_nodes_after"] = static_cast<double>(cut_size.stepped_nodes);
+  state.counters["springs_uncut"] = static_cast<double>(uncut_size.springs);
+  state.counters["springs_after"] = static_cast<double>(cut_size.springs);
 }
 BENCHMARK(BM_PhysicsStepAfterTurp)->Iterations(1)->Unit(benchmark::kSecond);
 

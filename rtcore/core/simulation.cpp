@@ -426,6 +426,7 @@ void Simulation::run_collision_job() {
   job_edited_ = !lag_log_.empty();
   if (job_edited_ && !cut_job_.cutting) other.set_positions(positions);  // a compaction adds no node
   other.refresh_mesh_surface();  // for the snapshot of the tick that takes this copy in (fill_snapshot)
+  other.refresh_stepped_nodes();  // here rather than in the physics step that takes it in
   search_timing_.topology_end_ns = FrameProfiler::now_ns();
   // Temporal coherence: while the tool and the tissue have barely moved from where the front's
   // candidates were searched, they serve the next window too, and the step skips its refit and

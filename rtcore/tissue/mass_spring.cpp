@@ -77,6 +77,7 @@ MassSpringTissue::MassSpringTissue(OrderedMesh&& ordered_mesh, const TissueParam
   reserve_topology(topology_.node_capacity(), topology_.tetrahedron_capacity());
   map_initial_surface();
   refresh_mesh_surface();
+  refresh_stepped_nodes();
   topology_hash_ = topology_hash();
   update_material();
 }
@@ -253,19 +254,20 @@ void MassSpringTissue::accumulate_forces(double h_s) {
   };
   const std::size_t compressed = springs_.compute(x_.data(), v_.data(), helper_, side_task(find_contact_forces));
   const double viscous_rate = parameters_.si(TissueParameter::kViscousDamping);
-  const std::size_t n = x_.size();
   auto node_pass = [&](std::uint32_t chunk) {
-    const std::size_t begin = chunk * kNodesPerChunk, end = std::min(n, begin + kNodesPerChunk);
-    for (std::size_t i = begin; i < end; ++i) force_[i] = -viscous_rate * mass_[i] * v_[i];
-    springs_.add_sums(force_.data(), begin, end);
-    // Springs, dampers, anchors and viscous damping bound the same every step until a parameter
-    // changes (update_material); what varies is added on top.
-    std::copy(base_stiffness_bound_.begin() + static_cast<std::ptrdiff_t>(begin), base_stiffness_bound_.begin() + static_cast<std::ptrdiff_t>(end),
-              stiffness_bound_.begin() + static_cast<std::ptrdiff_t>(begin));
-    std::copy(base_damping_bound_.begin() + static_cast<std::ptrdiff_t>(begin), base_damping_bound_.begin() + static_cast<std::ptrdiff_t>(end),
-              damping_bound_.begin() + static_cast<std::ptrdiff_t>(begin));
+    for (const NodeSpan span : stepped_.chunk(chunk)) {
+      const std::size_t begin = span.begin, end = span.end;
+      for (std::size_t i = begin; i < end; ++i) force_[i] = -viscous_rate * mass_[i] * v_[i];
+      springs_.add_sums(force_.data(), begin, end);
+      // Springs, dampers, anchors and viscous damping bound the same every step until a parameter
+      // changes (update_material); what varies is added on top.
+      std::copy(base_stiffness_bound_.begin() + static_cast<std::ptrdiff_t>(begin), base_stiffness_bound_.begin() + static_cast<std::ptrdiff_t>(end),
+                stiffness_bound_.begin() + static_cast<std::ptrdiff_t>(begin));
+      std::copy(base_damping_bound_.begin() + static_cast<std::ptrdiff_t>(begin), base_damping_bound_.begin() + static_cast<std::ptrdiff_t>(end),
+                damping_bound_.begin() + static_cast<std::ptrdiff_t>(begin));
+    }
   };
-  for_each_chunk(helper_, chunks_covering(n, kNodesPerChunk), node_pass);
+  for_each_chunk(helper_, stepped_.chunk_count(), node_pass);
   for (std::size_t a = 0; a < anchor_k_.size(); ++a) {
     const std::uint32_t i = network_.anchor_nodes[a];
     force_[i] -= anchor_k_[a] * (x_[i] - rest_[i]);
@@ -287,16 +289,22 @@ void MassSpringTissue::step_bounded_symplectic(double h_s) {
   // The finite check rides along: a node's sum is formed once it has moved.
   // Node by node, in chunks shared with the loop helper; each chunk keeps its own fastest speed and
   // first non-finite node, and the maximum and the minimum over chunks do not depend on the order.
+  // The nodes the step leaves out (stepped_nodes.h) are orphans: still, so they add no speed, and finite.
   const std::size_t n = x_.size();
-  const std::uint32_t chunks = chunks_covering(n, kNodesPerChunk);
+  const std::uint32_t chunks = stepped_.chunk_count();
   fastest2_per_chunk_.resize(chunks);  // within the reserved room
   first_non_finite_per_chunk_.resize(chunks);
   const NodeStepArrays nodes{mass_.data(), stiffness_bound_.data(), damping_bound_.data(), force_.data(), step_mass_.data(), v_.data(), x_.data()};
   auto integrate = [&](std::uint32_t chunk) {
-    const std::size_t begin = chunk * kNodesPerChunk, end = std::min(n, begin + kNodesPerChunk);
-    const NodeStepSummary summary = step_nodes(nodes, h_s, begin, end);
-    fastest2_per_chunk_[chunk] = summary.fastest2;
-    first_non_finite_per_chunk_[chunk] = summary.first_non_finite == NodeStepSummary::kNone ? n : summary.first_non_finite;
+    double fastest2 = 0.0;
+    std::size_t first_non_finite = n;
+    for (const NodeSpan span : stepped_.chunk(chunk)) {
+      const NodeStepSummary summary = step_nodes(nodes, h_s, span.begin, span.end);
+      fastest2 = std::max(fastest2, summary.fastest2);
+      if (first_non_finite == n && summary.first_non_finite != NodeStepSummary::kNone) first_non_finite = summary.first_non_finite;
+    }
+    fastest2_per_chunk_[chunk] = fastest2;
+    first_non_finite_per_chunk_[chunk] = first_non_finite;
   };
   for_each_chunk(helper_, chunks, integrate);
   const double fastest2 = chunks == 0 ? 0.0 : *std::max_element(fastest2_per_chunk_.begin(), fastest2_per_chunk_.end());
@@ -408,6 +416,7 @@ void MassSpringTissue::step_implicit_euler(double h_s) {
 }
 
 ToolReaction MassSpringTissue::physics_step(double h_s) {
+  refresh_stepped_nodes();  // normally done by the editor already
   if (helper_ != nullptr) helper_->call_in();
   switch (config_.integrator) {
     case TissueIntegrator::kBoundedSymplectic: step_bounded_symplectic(h_s); break;  // checks finiteness itself

@@ -11,6 +11,7 @@
 #include "rtcore/concurrency/loop_helper.h"
 #include "rtcore/tissue/spring_forces.h"
 #include "rtcore/tissue/springs.h"
+#include "rtcore/tissue/stepped_nodes.h"
 #include "rtcore/tissue/tissue_edit_log.h"
 #include "rtcore/tissue/tet_mesh.h"
 #include "rtcore/tissue/tet_topology.h"
@@ -57,6 +58,9 @@ struct TissueConfig {
   /// Steps the nodes in locality order (node_order.h) rather than the mesh's; off only to measure
   /// what the order buys.
   bool locality_order = true;
+  /// Leaves the orphans resection leaves behind out of the physics step's node loops
+  /// (stepped_nodes.h); off only to check that this changes no bit and to measure what it buys.
+  bool skip_orphans = true;
   /// Lets the contact skip points whose clearance certificate holds (ToolContacts); off only for
   /// the brute-force reference, which gives the same forces.
   bool clearance_certificates = true;
@@ -242,6 +246,13 @@ class MassSpringTissue {
   /// Lists the live faces and their regions as MeshSurface does into `triangles` and `regions`, as many
   /// as fit in both; returns how many it listed.
   std::size_t list_mesh_surface(std::span<Triangle> triangles, std::span<TissueRegion> regions) const;
+  /// Relists the nodes the physics step's loops visit if an edit changed them since (a pass over the
+  /// nodes, about 10 us at 8640 triangles): the editor calls it after its edits, so that the cost
+  /// falls on the edit; a physics step that finds the list stale relists it first. Allocates nothing.
+  void refresh_stepped_nodes();
+  /// Nodes the physics step's loops visit: every one a tetrahedron or an anchor holds, and the others
+  /// of their groups of four (stepped_nodes.h).
+  std::size_t stepped_node_count() const { return stepped_.listed_nodes(); }
   /// Relists mesh_surface() if an edit changed the surface since (a pass over the surface, about 0.1 ms
   /// at 8640 triangles). The editor calls it after its edits, so that the core's publish at the
   /// collision tick that takes this copy in only copies the list. Allocates nothing.
@@ -327,6 +338,9 @@ class MassSpringTissue {
   // The physics step's node loops run in chunks of this many nodes, shared with helper_ if set.
   static constexpr std::size_t kNodesPerChunk = 512;
   LoopHelper* helper_ = nullptr;
+  // The nodes those loops visit (stepped_nodes.h), relisted after edits by refresh_stepped_nodes().
+  SteppedNodes stepped_;
+  bool stepped_stale_ = true;
   std::vector<double> fastest2_per_chunk_;
   std::vector<std::size_t> first_non_finite_per_chunk_;
   std::vector<double> mass_, stiffness_bound_, damping_bound_;

@@ -21,9 +21,10 @@ using avx2::store_packed_points;
 
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 arrays are packed (x, y, z) triples");
 
-}  // namespace
-
-NodeStepSummary step_nodes_portable(const NodeStepArrays& nodes, double h_s, std::size_t begin, std::size_t end) {
+// Inlined into both kernels: the AVX2 one's last nodes then run as VEX code too, where a call into
+// the portable function's SSE code cost each call a transition (a tenth of the step once resection
+// split the loops into a few hundred spans: stepped_nodes.h).
+[[gnu::always_inline]] inline NodeStepSummary step_node_range(const NodeStepArrays& nodes, double h_s, std::size_t begin, std::size_t end) {
   NodeStepSummary summary;
   for (std::size_t i = begin; i < end; ++i) {
     const double d = nodes.mass[i] + 0.5 * h_s * h_s * nodes.stiffness_bound[i] + h_s * nodes.damping_bound[i];
@@ -39,6 +40,12 @@ NodeStepSummary step_nodes_portable(const NodeStepArrays& nodes, double h_s, std
     if (!std::isfinite(sum) && summary.first_non_finite == NodeStepSummary::kNone) summary.first_non_finite = i;
   }
   return summary;
+}
+
+}  // namespace
+
+NodeStepSummary step_nodes_portable(const NodeStepArrays& nodes, double h_s, std::size_t begin, std::size_t end) {
+  return step_node_range(nodes, h_s, begin, end);
 }
 
 __attribute__((target("avx2"))) NodeStepSummary step_nodes_avx2(const NodeStepArrays& nodes, double h_s, std::size_t begin, std::size_t end) {
@@ -84,7 +91,7 @@ __attribute__((target("avx2"))) NodeStepSummary step_nodes_avx2(const NodeStepAr
   }
   alignas(32) double lanes[4];
   _mm256_store_pd(lanes, fastest2);
-  const NodeStepSummary tail = step_nodes_portable(nodes, h_s, i, end);
+  const NodeStepSummary tail = step_node_range(nodes, h_s, i, end);
   summary.fastest2 = std::max({lanes[0], lanes[1], lanes[2], lanes[3], tail.fastest2});
   if (summary.first_non_finite == NodeStepSummary::kNone) summary.first_non_finite = tail.first_non_finite;
   return summary;

@@ -36,6 +36,7 @@ void MassSpringTissue::reserve_topology(std::size_t node_capacity, std::size_t t
   for (auto* vec : {&x_, &v_, &rest_, &force_}) vec->reserve(node_capacity);
   fastest2_per_chunk_.reserve(chunks_covering(node_capacity, kNodesPerChunk));
   first_non_finite_per_chunk_.reserve(chunks_covering(node_capacity, kNodesPerChunk));
+  stepped_.reserve(node_capacity, kNodesPerChunk);
   for (auto* vec : {&mass_, &stiffness_bound_, &damping_bound_, &step_mass_, &base_stiffness_bound_, &base_damping_bound_,
                     &network_.node_volume_m3}) {
     vec->reserve(node_capacity);
@@ -263,6 +264,7 @@ std::size_t MassSpringTissue::surface_growth_bound(std::span<const std::uint32_t
 void MassSpringTissue::add_midpoint_nodes(std::span<const std::array<std::uint32_t, 2>> parents) {
   assert(x_.size() + parents.size() <= topology_.node_capacity());
   if (edit_log_ != nullptr) edit_log_->record_midpoint_nodes(parents);
+  stepped_stale_ = true;
   for (const auto& [a, b] : parents) {
     const auto node = static_cast<std::uint32_t>(x_.size());
     x_.push_back(0.5 * (x_[a] + x_[b]));
@@ -316,6 +318,7 @@ TopologyChange MassSpringTissue::edit_tetrahedra(std::span<const std::uint32_t> 
     ++faults_.topology_capacity_refusals;
     return change;
   }
+  stepped_stale_ = true;  // nodes may lose their last tetrahedron or gain their first
   if (edit_log_ != nullptr) edit_log_->record_edit(removed, added, added_regions);
   touched_nodes_.clear();
   touched_springs_.clear();
@@ -483,6 +486,18 @@ TopologyChange MassSpringTissue::edit_tetrahedra(std::span<const std::uint32_t> 
   return change;
 }
 
+void MassSpringTissue::refresh_stepped_nodes() {
+  if (!stepped_stale_) return;
+  // An orphan that no anchor holds has no force (its springs are dead, its contacts dropped) and no
+  // speed (adopt_motion stops it): the bounded symplectic step would leave it where it is, so it
+  // leaves it out. An anchor still pulls an orphan, and the
+  // other integrators read every node's force, so those nodes stay in.
+  const bool every_node = config_.integrator != TissueIntegrator::kBoundedSymplectic || !config_.skip_orphans;
+  stepped_.rebuild(x_.size(), kNodesPerChunk,
+                   [&](std::uint32_t n) { return every_node || topology_.valence(n) > 0 || anchor_of_node_[n] >= 0; });
+  stepped_stale_ = false;
+}
+
 void MassSpringTissue::compact_springs() {
   std::vector<std::uint32_t>& kept = touched_springs_;  // scratch with room for every spring
   kept.clear();
@@ -556,7 +571,10 @@ void MassSpringTissue::adopt_motion(const MassSpringTissue& front, std::span<con
     v_[shared + k] = 0.5 * (v_[a] + v_[b]);
     step_mass_[shared + k] = 0.5 * (step_mass_[a] + step_mass_[b]);
   }
-  for (std::uint32_t n : orphans) v_[n] = Vec3(0.0);
+  for (std::uint32_t n : orphans) {
+    v_[n] = Vec3(0.0);
+    step_mass_[n] = mass_[n];  // the D a step would give it; it may no longer be stepped (refresh_stepped_nodes)
+  }
   travel_m_ = front.travel_m_;
   reaction_ = front.reaction_;
   const std::int64_t refusals = faults_.topology_capacity_refusals;  // this copy made the newest edits
