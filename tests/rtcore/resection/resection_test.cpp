@@ -75,6 +75,29 @@ TEST(Resection, DemoCutsConservesMassAndKeepsAValidSurface) {
   expect_valid_surface(**sim, "after demo");
 }
 
+// The whole scripted resection (145 s, 55 strokes on the coarse gland), checked as the demo is.
+TEST(Resection, TurpConservesMassAfterEveryCollisionStepAndKeepsAValidSurface) {
+  SimulationConfig config;
+  config.prostate_triangles = 1296;
+  auto sim = Simulation::create(config);
+  ASSERT_TRUE(sim) << sim.error();
+  Result<Procedure> turp = builtin_procedure("turp");
+  ASSERT_TRUE(turp);
+  const RunCheck check = run_checked(**sim, *turp);
+  const ProcedureMetrics& m = (*sim)->metrics();
+  std::printf("turp 1296: resected %.3f g (adenoma %.3f, capsule %.3f), adenoma left %.3f, chips %llu, cuts %llu, perforations %llu, "
+              "%llu collision steps, worst conservation %.2e\n",
+              m.resected_total_g, m.resected_adenoma_g, m.resected_capsule_g, m.remaining_adenoma_fraction,
+              static_cast<unsigned long long>(m.chips), static_cast<unsigned long long>(m.cuts),
+              static_cast<unsigned long long>(m.perforations), static_cast<unsigned long long>(check.collision_steps),
+              check.worst_conservation);
+  EXPECT_GT(check.collision_steps, 8000u);
+  EXPECT_GE(m.cuts, 20u);
+  EXPECT_EQ(m.non_finite_steps, 0u);
+  EXPECT_LT(check.worst_conservation, 1e-12);
+  expect_valid_surface(**sim, "after turp");
+}
+
 std::unique_ptr<Simulation> small_simulation() {
   SimulationConfig config;
   config.prostate_triangles = 1296;
