@@ -335,7 +335,8 @@ class MassSpringTissue {
   // The positions the last contact search read (the surface's, taken by begin_collision_step, which
   // the next one overwrites): how far the tissue has moved since decides whether its candidates serve on.
   std::vector<Vec3> searched_positions_;
-  // The physics step's node loops run in chunks of this many nodes, shared with helper_ if set.
+  // The physics step's node loops run in chunks of this many listed nodes (stepped_), shared with
+  // helper_ if set.
   static constexpr std::size_t kNodesPerChunk = 512;
   LoopHelper* helper_ = nullptr;
   // The nodes those loops visit (stepped_nodes.h), relisted after edits by refresh_stepped_nodes().

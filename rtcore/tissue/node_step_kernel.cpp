@@ -22,7 +22,7 @@ using avx2::store_packed_points;
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 arrays are packed (x, y, z) triples");
 
 // Inlined into both kernels: the AVX2 one's last nodes then run as VEX code too, where a call into
-// the portable function's SSE code cost each call a transition (a tenth of the step once resection
+// the portable function's SSE code cost each call a transition (about 8% of the step once resection
 // split the loops into a few hundred spans: stepped_nodes.h).
 [[gnu::always_inline]] inline NodeStepSummary step_node_range(const NodeStepArrays& nodes, double h_s, std::size_t begin, std::size_t end) {
   NodeStepSummary summary;
