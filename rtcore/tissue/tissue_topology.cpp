@@ -571,10 +571,7 @@ void MassSpringTissue::adopt_motion(const MassSpringTissue& front, std::span<con
     v_[shared + k] = 0.5 * (v_[a] + v_[b]);
     step_mass_[shared + k] = 0.5 * (step_mass_[a] + step_mass_[b]);
   }
-  for (std::uint32_t n : orphans) {
-    v_[n] = Vec3(0.0);
-    step_mass_[n] = mass_[n];  // the D a step would give it; it may no longer be stepped (refresh_stepped_nodes)
-  }
+  for (std::uint32_t n : orphans) v_[n] = Vec3(0.0);
   travel_m_ = front.travel_m_;
   reaction_ = front.reaction_;
   const std::int64_t refusals = faults_.topology_capacity_refusals;  // this copy made the newest edits

@@ -53,15 +53,21 @@ void expect_valid_surface(const Simulation& sim, const char* what) {
   EXPECT_NEAR(report->volume_m3, volume, 1e-9 * volume) << what;
 }
 
-TEST(Resection, DemoCutsConservesMassAndKeepsAValidSurface) {
+std::unique_ptr<Simulation> small_simulation() {
   SimulationConfig config;
   config.prostate_triangles = 1296;
   auto sim = Simulation::create(config);
-  ASSERT_TRUE(sim) << sim.error();
+  EXPECT_TRUE(sim) << sim.error();
+  return std::move(*sim);
+}
+
+TEST(Resection, DemoCutsConservesMassAndKeepsAValidSurface) {
+  const std::unique_ptr<Simulation> sim = small_simulation();
+  ASSERT_NE(sim, nullptr);
   Result<Procedure> demo = builtin_procedure("demo");
   ASSERT_TRUE(demo);
-  const RunCheck check = run_checked(**sim, *demo);
-  const ProcedureMetrics& m = (*sim)->metrics();
+  const RunCheck check = run_checked(*sim, *demo);
+  const ProcedureMetrics& m = sim->metrics();
   std::printf("demo 1296: resected %.3f g (adenoma %.3f, capsule %.3f), chips %llu (%.3f g), cuts %llu, refined %llu, refusals %llu, "
               "displacement %.2f mm, worst conservation %.2e\n",
               m.resected_total_g, m.resected_adenoma_g, m.resected_capsule_g, static_cast<unsigned long long>(m.chips), m.chips_g,
@@ -72,19 +78,17 @@ TEST(Resection, DemoCutsConservesMassAndKeepsAValidSurface) {
   EXPECT_EQ(m.perforations, 0u);
   EXPECT_EQ(m.non_finite_steps, 0u);
   EXPECT_LT(check.worst_conservation, 1e-12);
-  expect_valid_surface(**sim, "after demo");
+  expect_valid_surface(*sim, "after demo");
 }
 
 // The whole scripted resection (145 s, 55 strokes on the coarse gland), checked as the demo is.
 TEST(Resection, TurpConservesMassAfterEveryCollisionStepAndKeepsAValidSurface) {
-  SimulationConfig config;
-  config.prostate_triangles = 1296;
-  auto sim = Simulation::create(config);
-  ASSERT_TRUE(sim) << sim.error();
+  const std::unique_ptr<Simulation> sim = small_simulation();
+  ASSERT_NE(sim, nullptr);
   Result<Procedure> turp = builtin_procedure("turp");
   ASSERT_TRUE(turp);
-  const RunCheck check = run_checked(**sim, *turp);
-  const ProcedureMetrics& m = (*sim)->metrics();
+  const RunCheck check = run_checked(*sim, *turp);
+  const ProcedureMetrics& m = sim->metrics();
   std::printf("turp 1296: resected %.3f g (adenoma %.3f, capsule %.3f), adenoma left %.3f, chips %llu, cuts %llu, perforations %llu, "
               "%llu collision steps, worst conservation %.2e\n",
               m.resected_total_g, m.resected_adenoma_g, m.resected_capsule_g, m.remaining_adenoma_fraction,
@@ -95,15 +99,7 @@ TEST(Resection, TurpConservesMassAfterEveryCollisionStepAndKeepsAValidSurface) {
   EXPECT_GE(m.cuts, 20u);
   EXPECT_EQ(m.non_finite_steps, 0u);
   EXPECT_LT(check.worst_conservation, 1e-12);
-  expect_valid_surface(**sim, "after turp");
-}
-
-std::unique_ptr<Simulation> small_simulation() {
-  SimulationConfig config;
-  config.prostate_triangles = 1296;
-  auto sim = Simulation::create(config);
-  EXPECT_TRUE(sim) << sim.error();
-  return std::move(*sim);
+  expect_valid_surface(*sim, "after turp");
 }
 
 Procedure script(const char* text) {
