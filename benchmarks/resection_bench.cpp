@@ -99,7 +99,7 @@ BENCHMARK(BM_TopologyUpdateWhileCutting)->Arg(8640)->Arg(34560)->Iterations(1)->
 /// Physics-stage median over one second with the tool withdrawn, after running `procedure_name`
 /// (or on the uncut gland when empty).
 struct GlandSize {
-  std::size_t nodes = 0, stepped_nodes = 0, springs = 0;
+  std::size_t nodes = 0, stepped_nodes = 0, deferred_sum_nodes = 0, springs = 0;
 };
 
 double physics_median_us(int triangles, const char* procedure_name, double* remaining_fraction, GlandSize* size) {
@@ -117,6 +117,7 @@ double physics_median_us(int triangles, const char* procedure_name, double* rema
   *remaining_fraction = sim->metrics().remaining_adenoma_fraction;
   size->nodes = sim->tissue().node_count();
   size->stepped_nodes = sim->tissue().stepped_node_count();
+  size->deferred_sum_nodes = sim->tissue().deferred_sum_node_count();
   size->springs = sim->tissue().network().spring_count();
   return profiler.statistics(Stage::kPhysics).median_us;
 }
@@ -136,6 +137,7 @@ void BM_PhysicsStepAfterTurp(benchmark::State& state) {
   state.counters["nodes_after"] = static_cast<double>(cut_size.nodes);
   state.counters["stepped_nodes_uncut"] = static_cast<double>(uncut_size.stepped_nodes);
   state.counters["stepped_nodes_after"] = static_cast<double>(cut_size.stepped_nodes);
+  state.counters["deferred_sum_nodes_after"] = static_cast<double>(cut_size.deferred_sum_nodes);
   state.counters["springs_uncut"] = static_cast<double>(uncut_size.springs);
   state.counters["springs_after"] = static_cast<double>(cut_size.springs);
 }

@@ -241,33 +241,60 @@ void MassSpringTissue::end_collision_step() {
 }
 
 void MassSpringTissue::accumulate_forces(double h_s) {
-  // Springs first, each into its own slot; then per node, in node order: viscous damping, its
-  // springs in ascending spring order (SpringForces::add_sums), its anchor. Each node's force is
-  // thus the same sum in the same order every run, and the bounds start from their constant part.
-  // Both passes run in chunks shared with the loop helper; every value belongs to one spring or one
-  // node, so the threads change no bit. The contact forces read only positions and velocities: this
+  // Springs first, each into its own slot; then per node: viscous damping, its springs in ascending
+  // spring order (SpringForces::add_sums), its anchor. Each node's force is thus the same sum in the
+  // same order every run, and the bounds start from their constant part. The sums of a chunk of
+  // nodes run as soon as the springs they read are computed (spring_sum_schedule.h), in chunks shared
+  // with the loop helper; every value belongs to one spring or one node, so the threads change no bit. The contact forces read only positions and velocities: this
   // thread finds them while the helper starts on the springs (with the tool in contact they were up to
   // a fifth of the step, run alone), and adds them last, as when they were found there.
   auto find_contact_forces = [&] {
     reaction_ = tool_.evaluate_forces(x_, v_, surface_.triangles, parameters_.si(TissueParameter::kPenaltyStiffness),
                                       parameters_.si(TissueParameter::kPenaltyDamping), h_s, travel_m_);
   };
-  const std::size_t compressed = springs_.compute(x_.data(), v_.data(), helper_, side_task(find_contact_forces));
   const double viscous_rate = parameters_.si(TissueParameter::kViscousDamping);
-  auto node_pass = [&](std::uint32_t chunk) {
-    for (const NodeSpan span : stepped_.chunk(chunk)) {
-      const std::size_t begin = span.begin, end = span.end;
-      for (std::size_t i = begin; i < end; ++i) force_[i] = -viscous_rate * mass_[i] * v_[i];
-      springs_.add_sums(force_.data(), begin, end);
-      // Springs, dampers, anchors and viscous damping bound the same every step until a parameter
-      // changes (update_material); what varies is added on top.
-      std::copy(base_stiffness_bound_.begin() + static_cast<std::ptrdiff_t>(begin), base_stiffness_bound_.begin() + static_cast<std::ptrdiff_t>(end),
-                stiffness_bound_.begin() + static_cast<std::ptrdiff_t>(begin));
-      std::copy(base_damping_bound_.begin() + static_cast<std::ptrdiff_t>(begin), base_damping_bound_.begin() + static_cast<std::ptrdiff_t>(end),
-                damping_bound_.begin() + static_cast<std::ptrdiff_t>(begin));
-    }
+  // Viscous damping starts each node's force; springs, dampers, anchors and viscous damping bound
+  // the same every step until a parameter changes (update_material), and what varies is added on top.
+  auto start_node_forces = [&](NodeSpan span) {
+    const std::size_t begin = span.begin, end = span.end;
+    for (std::size_t i = begin; i < end; ++i) force_[i] = -viscous_rate * mass_[i] * v_[i];
+    std::copy(base_stiffness_bound_.begin() + static_cast<std::ptrdiff_t>(begin), base_stiffness_bound_.begin() + static_cast<std::ptrdiff_t>(end),
+              stiffness_bound_.begin() + static_cast<std::ptrdiff_t>(begin));
+    std::copy(base_damping_bound_.begin() + static_cast<std::ptrdiff_t>(begin), base_damping_bound_.begin() + static_cast<std::ptrdiff_t>(end),
+              damping_bound_.begin() + static_cast<std::ptrdiff_t>(begin));
   };
-  for_each_chunk(helper_, stepped_.chunk_count(), node_pass);
+  auto add_spring_sums = [&](std::span<const NodeSpan> spans) {
+    for (const NodeSpan span : spans) springs_.add_sums(force_.data(), span.begin, span.end);
+  };
+  std::size_t compressed = 0;
+  if (config_.fuse_spring_sums && sum_schedule_.chunk_count() > 0) {
+    // One pass: each chunk starts its nodes' forces and computes its springs, and whichever thread
+    // completes the last chunk another waits for sums that one (spring_sum_schedule.h); the deferred
+    // groups after it.
+    springs_.refresh_groups();  // normally done by the edits' end already: then free
+    sum_schedule_.arm();
+    compressed_per_chunk_.resize(sum_schedule_.chunk_count());  // within the reserved room
+    auto chunk_pass = [&](std::uint32_t chunk) {
+      for (const NodeSpan span : stepped_.chunk(chunk)) start_node_forces(span);
+      compressed_per_chunk_[chunk] = static_cast<std::uint32_t>(
+          springs_.compute_range(x_.data(), v_.data(), sum_schedule_.spring_begin(chunk), sum_schedule_.spring_begin(chunk + 1)));
+      sum_schedule_.finish(chunk, [&](std::uint32_t ready) { add_spring_sums(sum_schedule_.summed_spans(ready)); });
+    };
+    for_each_chunk(helper_, sum_schedule_.chunk_count(), chunk_pass, side_task(find_contact_forces));
+    compressed = springs_.gather_compressed(sum_schedule_.spring_begins(), compressed_per_chunk_);
+    const SteppedNodes& deferred = sum_schedule_.deferred();
+    auto deferred_pass = [&](std::uint32_t chunk) { add_spring_sums(deferred.chunk(chunk)); };
+    for_each_chunk(helper_, deferred.chunk_count(), deferred_pass);
+  } else {
+    compressed = springs_.compute(x_.data(), v_.data(), helper_, side_task(find_contact_forces));
+    auto node_pass = [&](std::uint32_t chunk) {
+      for (const NodeSpan span : stepped_.chunk(chunk)) {
+        start_node_forces(span);
+        springs_.add_sums(force_.data(), span.begin, span.end);
+      }
+    };
+    for_each_chunk(helper_, stepped_.chunk_count(), node_pass);
+  }
   for (std::size_t a = 0; a < anchor_k_.size(); ++a) {
     const std::uint32_t i = network_.anchor_nodes[a];
     force_[i] -= anchor_k_[a] * (x_[i] - rest_[i]);

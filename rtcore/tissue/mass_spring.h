@@ -10,6 +10,7 @@
 #include "rtcore/collision/sphere_tree.h"
 #include "rtcore/concurrency/loop_helper.h"
 #include "rtcore/tissue/spring_forces.h"
+#include "rtcore/tissue/spring_sum_schedule.h"
 #include "rtcore/tissue/springs.h"
 #include "rtcore/tissue/stepped_nodes.h"
 #include "rtcore/tissue/tissue_edit_log.h"
@@ -61,6 +62,10 @@ struct TissueConfig {
   /// Leaves the orphans resection leaves behind out of the physics step's node loops
   /// (stepped_nodes.h); off only to check that this changes no bit and to measure what it buys.
   bool skip_orphans = true;
+  /// Sums each chunk of nodes' spring forces inside the spring pass, once the chunks holding its
+  /// springs are computed (spring_sum_schedule.h), rather than in a pass of its own; off only to
+  /// check that this changes no bit and to measure what it buys.
+  bool fuse_spring_sums = true;
   /// Lets the contact skip points whose clearance certificate holds (ToolContacts); off only for
   /// the brute-force reference, which gives the same forces.
   bool clearance_certificates = true;
@@ -246,13 +251,17 @@ class MassSpringTissue {
   /// Lists the live faces and their regions as MeshSurface does into `triangles` and `regions`, as many
   /// as fit in both; returns how many it listed.
   std::size_t list_mesh_surface(std::span<Triangle> triangles, std::span<TissueRegion> regions) const;
-  /// Relists the nodes the physics step's loops visit if an edit changed them since (a pass over the
-  /// nodes, about 10 us at 8640 triangles): the editor calls it after its edits, so that the cost
-  /// falls on the edit; a physics step that finds the list stale relists it first. Allocates nothing.
+  /// Relists the nodes the physics step's loops visit, and plans when their spring sums run, if an
+  /// edit changed them since (a pass over the nodes and the springs): the editor calls it after its
+  /// edits, so that the cost falls on the edit; a physics step that finds the list stale relists it
+  /// first. Allocates nothing.
   void refresh_stepped_nodes();
   /// Nodes the physics step's loops visit: every one a tetrahedron or an anchor holds, and the others
   /// of their groups of four (stepped_nodes.h).
   std::size_t stepped_node_count() const { return stepped_.listed_nodes(); }
+  /// How many of those have their spring forces summed after the spring pass rather than inside it
+  /// (spring_sum_schedule.h: refinement's springs reach them from a later chunk).
+  std::size_t deferred_sum_node_count() const { return sum_schedule_.deferred().listed_nodes(); }
   /// Relists mesh_surface() if an edit changed the surface since (a pass over the surface, about 0.1 ms
   /// at 8640 triangles). The editor calls it after its edits, so that the core's publish at the
   /// collision tick that takes this copy in only copies the list. Allocates nothing.
@@ -342,6 +351,9 @@ class MassSpringTissue {
   // The nodes those loops visit (stepped_nodes.h), relisted after edits by refresh_stepped_nodes().
   SteppedNodes stepped_;
   bool stepped_stale_ = true;
+  // When each chunk's spring sums run in the spring pass (spring_sum_schedule.h), planned with stepped_.
+  SpringSumSchedule sum_schedule_;
+  std::vector<std::uint32_t> compressed_per_chunk_;  // springs compressed below half their rest length, per chunk
   std::vector<double> fastest2_per_chunk_;
   std::vector<std::size_t> first_non_finite_per_chunk_;
   std::vector<double> mass_, stiffness_bound_, damping_bound_;

@@ -156,6 +156,7 @@ void SpringForces::reserve(std::size_t spring_capacity, std::size_t node_capacit
   grown_nodes_.reserve(2 * spring_capacity);
   fill_.reserve(node_capacity + 1);
   listed_per_chunk_.reserve(chunks_covering(spring_capacity, kSpringsPerChunk));
+  chunk_first_.reserve(chunks_covering(spring_capacity, kSpringsPerChunk));
 }
 
 std::size_t SpringForces::compute(const Vec3* x, const Vec3* v, LoopHelper* helper, SideTask alongside) {
@@ -163,21 +164,26 @@ std::size_t SpringForces::compute(const Vec3* x, const Vec3* v, LoopHelper* help
   const std::size_t count = spring_count();
   const std::uint32_t chunks = chunks_covering(count, kSpringsPerChunk);
   listed_per_chunk_.resize(chunks);  // within the reserved room
-  std::uint32_t* compressed = arrays_.compressed.data();
-  const std::size_t nodes = incidence_.first_first.size() - 1;
+  chunk_first_.resize(chunks);
   auto chunk_pass = [&](std::uint32_t chunk) {
     const std::size_t begin = chunk * kSpringsPerChunk, end = std::min(count, begin + kSpringsPerChunk);
-    listed_per_chunk_[chunk] = static_cast<std::uint32_t>(spring_forces(arrays_, x, v, nodes, begin, end, compressed + begin));
+    chunk_first_[chunk] = static_cast<std::uint32_t>(begin);
+    listed_per_chunk_[chunk] = static_cast<std::uint32_t>(compute_range(x, v, begin, end));
   };
   for_each_chunk(helper, chunks, chunk_pass, alongside);
-  // Each chunk listed its springs at its own start; close the gaps, in chunk order (so ascending).
-  std::size_t listed = 0;
-  for (std::uint32_t chunk = 0; chunk < chunks; ++chunk) {
-    const std::uint32_t* first = compressed + chunk * kSpringsPerChunk;
-    std::copy(first, first + listed_per_chunk_[chunk], compressed + listed);
-    listed += listed_per_chunk_[chunk];
+  return gather_compressed(chunk_first_, listed_per_chunk_);
+}
+
+std::size_t SpringForces::gather_compressed(std::span<const std::uint32_t> range_first, std::span<const std::uint32_t> listed) {
+  // Each range listed its springs at its own start; close the gaps, in range order (so ascending).
+  std::uint32_t* compressed = arrays_.compressed.data();
+  std::size_t gathered = 0;
+  for (std::size_t r = 0; r < range_first.size(); ++r) {
+    const std::uint32_t* first = compressed + range_first[r];
+    std::copy(first, first + listed[r], compressed + gathered);
+    gathered += listed[r];
   }
-  return listed;
+  return gathered;
 }
 
 void SpringForces::append(std::uint32_t i, std::uint32_t j, double rest_m) {

@@ -36,6 +36,16 @@ class SpringForces {
   /// (add_compression_bounds handles those; usually none). `alongside` runs on this thread while
   /// the helper starts on the chunks (LoopHelper::for_each_chunk).
   std::size_t compute(const Vec3* x, const Vec3* v, LoopHelper* helper = nullptr, SideTask alongside = {});
+  /// The per-spring pass over springs [begin, end) on this thread, one share of compute()'s work for
+  /// a caller that chunks the springs itself (any thread, disjoint ranges; refresh_groups() first).
+  /// Lists the compressed springs ascending from arrays().compressed[begin]; returns how many.
+  std::size_t compute_range(const Vec3* x, const Vec3* v, std::size_t begin, std::size_t end) {
+    return spring_forces(arrays_, x, v, incidence_.first_first.size() - 1, begin, end, arrays_.compressed.data() + begin);
+  }
+  /// Moves the lists compute_range() left at the starts of consecutive ranges (range r begins at
+  /// range_first[r] and listed listed[r] springs) into one list from arrays().compressed[0], in
+  /// range order (so ascending); returns its length.
+  std::size_t gather_compressed(std::span<const std::uint32_t> range_first, std::span<const std::uint32_t> listed);
 
   /// The per-node pass: adds to each force[n] (n in [begin, end)) n's spring forces of the last
   /// compute(), in a fixed order (its springs as node j ascending, then as node i ascending). Each
@@ -95,6 +105,7 @@ class SpringForces {
   std::vector<std::uint32_t> new_group_offsets_;  // scratch of regroup_grown_nodes()
   std::vector<std::uint32_t> fill_;  // scratch of rebuild_incidence
   std::vector<std::uint32_t> listed_per_chunk_;  // compute(): compressed springs each chunk listed
+  std::vector<std::uint32_t> chunk_first_;       // compute(): each chunk's first spring
 };
 
 }  // namespace resecto

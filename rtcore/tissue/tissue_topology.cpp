@@ -37,6 +37,8 @@ void MassSpringTissue::reserve_topology(std::size_t node_capacity, std::size_t t
   fastest2_per_chunk_.reserve(chunks_covering(node_capacity, kNodesPerChunk));
   first_non_finite_per_chunk_.reserve(chunks_covering(node_capacity, kNodesPerChunk));
   stepped_.reserve(node_capacity, kNodesPerChunk);
+  sum_schedule_.reserve(node_capacity, kNodesPerChunk);
+  compressed_per_chunk_.reserve(chunks_covering(node_capacity, kNodesPerChunk) + 1);
   for (auto* vec : {&mass_, &stiffness_bound_, &damping_bound_, &step_mass_, &base_stiffness_bound_, &base_damping_bound_,
                     &network_.node_volume_m3}) {
     vec->reserve(node_capacity);
@@ -495,6 +497,7 @@ void MassSpringTissue::refresh_stepped_nodes() {
   const bool every_node = config_.integrator != TissueIntegrator::kBoundedSymplectic || !config_.skip_orphans;
   stepped_.rebuild(x_.size(), kNodesPerChunk,
                    [&](std::uint32_t n) { return every_node || topology_.valence(n) > 0 || anchor_of_node_[n] >= 0; });
+  sum_schedule_.rebuild(stepped_, springs_.arrays(), springs_.incidence(), x_.size(), kNodesPerChunk);
   stepped_stale_ = false;
 }
 
@@ -507,6 +510,7 @@ void MassSpringTissue::compact_springs() {
   if (kept.size() == springs_.spring_count()) return;
   if (edit_log_ != nullptr) edit_log_->record_compaction();
   springs_.keep(kept, x_.size());
+  stepped_stale_ = true;  // the springs' numbers changed: the spring sums' schedule with them
   for (std::size_t k = 0; k < kept.size(); ++k) {
     const std::uint32_t s = kept[k];
     network_.spring_nodes[2 * k] = network_.spring_nodes[2 * s];

@@ -3,13 +3,18 @@
 #pragma once
 
 #include <cstring>
+#include <span>
 #include <vector>
 
 namespace resecto::testing {
 
 template <class T>
-bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+bool same_bits(std::span<const T> a, std::span<const T> b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+template <class T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+  return same_bits(std::span<const T>(a), std::span<const T>(b));
 }
 
 }  // namespace resecto::testing
