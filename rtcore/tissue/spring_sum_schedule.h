@@ -75,9 +75,11 @@ class SpringSumSchedule {
   std::unique_ptr<std::atomic<std::uint32_t>[]> waits_;  // per chunk, counting down in a pass
   std::size_t waits_capacity_ = 0;
   SteppedNodes deferred_;
-  // Rebuild scratch: each node's chunk, each group's deferral.
+  // Rebuild scratch: each node's chunk, each chunk's first wait, each group's flags.
+  static constexpr std::uint8_t kStepped = 1, kLate = 2;
   std::vector<std::uint32_t> node_chunk_;
-  std::vector<std::uint8_t> group_deferred_;
+  std::vector<std::uint32_t> first_wait_;
+  std::vector<std::uint8_t> group_flags_;
 };
 
 }  // namespace resecto
