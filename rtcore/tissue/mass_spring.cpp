@@ -244,10 +244,11 @@ void MassSpringTissue::accumulate_forces(double h_s) {
   // Springs first, each into its own slot; then per node: viscous damping, its springs in ascending
   // spring order (SpringForces::add_sums), its anchor. Each node's force is thus the same sum in the
   // same order every run, and the bounds start from their constant part. The sums of a chunk of
-  // nodes run as soon as the springs they read are computed (spring_sum_schedule.h), in chunks shared
-  // with the loop helper; every value belongs to one spring or one node, so the threads change no bit. The contact forces read only positions and velocities: this
-  // thread finds them while the helper starts on the springs (with the tool in contact they were up to
-  // a fifth of the step, run alone), and adds them last, as when they were found there.
+  // nodes run as soon as the springs they read are computed (spring_sum_schedule.h), in chunks
+  // shared with the loop helper; every value belongs to one spring or one node, so the threads
+  // change no bit. The contact forces read only positions and velocities: this thread finds them
+  // while the helper starts on the springs (with the tool in contact they were up to a fifth of the
+  // step, run alone), and adds them last, as when they were found there.
   auto find_contact_forces = [&] {
     reaction_ = tool_.evaluate_forces(x_, v_, surface_.triangles, parameters_.si(TissueParameter::kPenaltyStiffness),
                                       parameters_.si(TissueParameter::kPenaltyDamping), h_s, travel_m_);

@@ -1,7 +1,7 @@
 // When each node's spring sum may run inside the per-spring pass rather than in a pass of its own.
 // Summed in a second pass over the nodes, every spring's force (a 32-byte row) was written by the
 // first pass and read back twice from memory: at 138,240 triangles the 720,000 rows (23 MB) have
-// left the caches by then, and the sums were a third of the physics step. In locality order
+// left the caches by then, and the sums were a third of the physics step or more. In locality order
 // (node_order.h) a node's springs are its own (as node i) or those of nodes a little before it, so
 // once the chunks of the spring pass that hold a chunk's springs are done, that chunk can be summed
 // while their forces are still in cache.
@@ -49,7 +49,7 @@ class SpringSumSchedule {
   }
   /// The groups summed after the pass, in chunks of their own.
   const SteppedNodes& deferred() const { return deferred_; }
-  /// The first chunk whose springs chunk c's sums read.
+  /// The first of the chunks chunk c's sums wait for (they wait for all from it to c).
   std::uint32_t first_needed(std::uint32_t c) const { return c + 1 - waits_per_chunk_[c]; }
 
   /// Before each pass: every chunk waits for all of its chunks again.
