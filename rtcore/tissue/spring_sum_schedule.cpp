@@ -15,16 +15,12 @@ void SpringSumSchedule::reserve(std::size_t node_capacity, std::size_t nodes_per
   const std::size_t chunks = chunks_covering(node_capacity, nodes_per_chunk) + 1;
   spring_first_.reserve(chunks + 1);
   summed_first_.reserve(chunks + 1);
-  waits_per_chunk_.reserve(chunks);
+  first_wait_.reserve(chunks);
   waiters_end_.reserve(chunks);
   summed_.reserve(node_capacity / kGroup + 1);
-  if (chunks > waits_capacity_) {
-    waits_ = std::make_unique<std::atomic<std::uint32_t>[]>(chunks);
-    waits_capacity_ = chunks;
-  }
+  if (chunks > waits_.size()) waits_ = std::vector<std::atomic<std::uint32_t>>(chunks);
   deferred_.reserve(node_capacity, nodes_per_chunk);
   node_chunk_.reserve(node_capacity);
-  first_wait_.reserve(chunks);
   group_flags_.reserve(node_capacity / kGroup + 1);
 }
 
@@ -48,7 +44,7 @@ void SpringSumSchedule::rebuild(const SteppedNodes& stepped, const SpringArrays&
   // One sequential pass over the springs: spring s of chunk c (its node i there) reaches its node j
   // in chunk c or later (the mesh's springs, i < j), whose sums then wait for chunk c, or in an
   // earlier chunk (refinement's springs, i > j), whose group of four is then summed after the pass.
-  // Orphans' springs count too: a wait more changes no sum. first_wait_ is each chunk's first.
+  // Orphans' springs count too: a wait more changes no sum.
   first_wait_.resize(chunks);
   for (std::uint32_t c = 0; c < chunks; ++c) first_wait_[c] = c;
   group_flags_.assign((node_count + kGroup - 1) / kGroup, 0);
@@ -66,9 +62,7 @@ void SpringSumSchedule::rebuild(const SteppedNodes& stepped, const SpringArrays&
   // A chunk also waits for whatever a later chunk waits for (a running minimum from the back), so
   // the chunks waiting for chunk k are one run [k, waiters_end_[k]).
   for (std::uint32_t c = chunks; c-- > 1;) first_wait_[c - 1] = std::min(first_wait_[c - 1], first_wait_[c]);
-  waits_per_chunk_.clear();
   waiters_end_.clear();
-  for (std::uint32_t c = 0; c < chunks; ++c) waits_per_chunk_.push_back(c + 1 - first_wait_[c]);
   for (std::uint32_t k = 0, c = 0; k < chunks; ++k) {
     while (c < chunks && first_wait_[c] <= k) ++c;
     waiters_end_.push_back(c);

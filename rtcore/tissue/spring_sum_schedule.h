@@ -18,7 +18,6 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
-#include <memory>
 #include <span>
 #include <vector>
 
@@ -38,7 +37,7 @@ class SpringSumSchedule {
   void rebuild(const SteppedNodes& stepped, const SpringArrays& springs, const SpringIncidence& incidence, std::size_t node_count,
                std::size_t nodes_per_chunk);
 
-  std::uint32_t chunk_count() const { return static_cast<std::uint32_t>(waits_per_chunk_.size()); }
+  std::uint32_t chunk_count() const { return static_cast<std::uint32_t>(first_wait_.size()); }
   /// The springs chunk c computes: [spring_begin(c), spring_begin(c + 1)).
   std::uint32_t spring_begin(std::uint32_t c) const { return spring_first_[c]; }
   /// Each chunk's first spring, in chunk order.
@@ -50,11 +49,11 @@ class SpringSumSchedule {
   /// The groups summed after the pass, in chunks of their own.
   const SteppedNodes& deferred() const { return deferred_; }
   /// The first of the chunks chunk c's sums wait for (they wait for all from it to c).
-  std::uint32_t first_needed(std::uint32_t c) const { return c + 1 - waits_per_chunk_[c]; }
+  std::uint32_t first_needed(std::uint32_t c) const { return first_wait_[c]; }
 
   /// Before each pass: every chunk waits for all of its chunks again.
   void arm() {
-    for (std::size_t c = 0; c < waits_per_chunk_.size(); ++c) waits_[c].store(waits_per_chunk_[c], std::memory_order_relaxed);
+    for (std::uint32_t c = 0; c < chunk_count(); ++c) waits_[c].store(c + 1 - first_wait_[c], std::memory_order_relaxed);
   }
   /// After chunk k's springs are computed (on any thread): calls sum(c) for each chunk c that k was
   /// the last wait of. The count-down's acquire-release makes every needed chunk's writes visible
@@ -70,15 +69,13 @@ class SpringSumSchedule {
   std::vector<std::uint32_t> spring_first_;     // per chunk + 1
   std::vector<NodeSpan> summed_;                // every chunk's summed spans, in chunk order
   std::vector<std::uint32_t> summed_first_;     // per chunk + 1, into summed_
-  std::vector<std::uint32_t> waits_per_chunk_;  // chunk c waits for [c + 1 - waits, c]
-  std::vector<std::uint32_t> waiters_end_;      // chunk k is waited for by [k, waiters_end_[k])
-  std::unique_ptr<std::atomic<std::uint32_t>[]> waits_;  // per chunk, counting down in a pass
-  std::size_t waits_capacity_ = 0;
+  std::vector<std::uint32_t> first_wait_;   // chunk c waits for [first_wait_[c], c]
+  std::vector<std::uint32_t> waiters_end_;  // chunk k is waited for by [k, waiters_end_[k])
+  std::vector<std::atomic<std::uint32_t>> waits_;  // per chunk (room for every chunk), counting down in a pass
   SteppedNodes deferred_;
-  // Rebuild scratch: each node's chunk, each chunk's first wait, each group's flags.
+  // Rebuild scratch: each node's chunk, each group's flags.
   static constexpr std::uint8_t kStepped = 1, kLate = 2;
   std::vector<std::uint32_t> node_chunk_;
-  std::vector<std::uint32_t> first_wait_;
   std::vector<std::uint8_t> group_flags_;
 };
 
