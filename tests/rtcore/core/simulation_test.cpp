@@ -118,6 +118,32 @@ TEST(Simulation, ThePhysicsHelperChangesNoBit) {
   EXPECT_GT((*sim)->physics_helper()->chunks_helped(), 0u) << "the helper never ran a chunk: the comparison above proved nothing";
 }
 
+TEST(Simulation, ABatchRunLeavesTheCollisionJobItsProcessor) {
+  // Batch ticks come back to back: a tick stepped while the collision job runs offers the helper no
+  // loop (the job keeps the second processor), and the others share theirs. A plain tick launches
+  // no job, so one running both before and after the step ran when the step chose.
+  SimulationConfig config = small_config();
+  config.collision_thread = true;
+  config.physics_threads = 2;
+  auto sim = Simulation::create(config);
+  ASSERT_TRUE(sim) << sim.error();
+  const LoopHelper& helper = *(*sim)->physics_helper();
+  JobThread& job = *(*sim)->collision_thread();
+  int beside_job = 0;
+  for (std::uint64_t tick = 0; tick < 2 * 960; ++tick) {
+    const bool plain = !(*sim)->is_collision_tick(tick);
+    const bool running_before = !job.idle();
+    const std::uint64_t offered = helper.chunks_offered();
+    (*sim)->step(input_at(tick, config.tick_s()), {});
+    if (plain && running_before && !job.idle()) {
+      ++beside_job;
+      EXPECT_EQ(helper.chunks_offered(), offered) << "tick " << tick << " shared its loops beside the running job";
+    }
+  }
+  EXPECT_GT(beside_job, 0) << "no tick ran beside the job: nothing was tested";
+  EXPECT_GT(helper.chunks_offered(), 0u) << "ticks without the job share their loops";
+}
+
 TEST(Simulation, APacedCoreThatStopsWaitingGivesUpTheHelper) {
   // Batch ticks (never paced) always share; once paced, a core that waited before fewer than half of
   // its last 32 ticks runs alone, until it keeps time again.
