@@ -24,6 +24,8 @@ struct ConsoleCliOptions {
   std::string screenshot;
   std::uint64_t frames = 0;
   std::string report;
+  std::string trace;  ///< --trace: the core's stages and the console's frames, Chrome trace-event JSON
+  int trace_events = 0;  ///< --trace-events: the stage timings the trace keeps (0: the headless run's default)
   std::vector<std::string> sets;
   bool lockstep = false;
   double start_insertion_mm = 165.0;

@@ -67,6 +67,8 @@ void run(const RunOptions& o) {
     console.seed = o.seed;
     console.calibration = o.calibration;
     console.report = o.report;
+    console.trace = o.trace;
+    console.trace_events = o.trace_events;
     console.record = o.record;
     open_console(console);
     return;
@@ -212,12 +214,11 @@ void register_run(CLI::App& app) {
           refuse_command_line(std::string(console_only) + " is an option of the operator console; a --headless run follows its procedure through the emulated device");
         }
       }
-      if (cmd->count("--trace-events") > 0 && o->trace.empty()) refuse_command_line("--trace-events sizes the trace: give --trace FILE too");
     } else {
       // And the other way: the console runs until its window closes, in real time, with the core's
-      // default contact search and input filter, and writes no trace or surface; taking these
+      // default contact search and input filter, and writes no surface; taking these
       // silently let a user wait for a file that never came (audit 8, G7).
-      for (const char* headless_only : {"--seconds", "--realtime", "--trace", "--trace-events", "--export-surface", "--json", "--inline-collision", "--raw-input",
+      for (const char* headless_only : {"--seconds", "--realtime", "--export-surface", "--json", "--inline-collision", "--raw-input",
                                         "--contact-reuse-mm", "--contact-margin-mm"}) {
         if (cmd->count(headless_only) > 0) {
           refuse_command_line(std::string(headless_only) + " is an option of a --headless run; without --headless `resecto run` opens the operator "
@@ -225,6 +226,7 @@ void register_run(CLI::App& app) {
         }
       }
     }
+    if (cmd->count("--trace-events") > 0 && o->trace.empty()) refuse_command_line("--trace-events sizes the trace: give --trace FILE too");
     run(*o);
   });
 }

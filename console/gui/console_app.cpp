@@ -12,6 +12,7 @@
 #include <backends/imgui_impl_opengl3.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
@@ -60,6 +61,10 @@ class ConsoleWindow {
     controller_.protect_inputs(options.input_paths);
     controller_.claim_output(options.report_path, OutputKind::kReport);
     controller_.claim_output(options.screenshot_path, OutputKind::kScreenshot);
+    controller_.claim_output(options.trace_path, OutputKind::kTrace);
+    // The frames for --trace, the last ones in a ring as the core's stages are (a frame is ~50 ms
+    // here; this holds hours of them).
+    if (!options.trace_path.empty()) frame_spans_.resize(kTracedFrames);
     // Checked with the other outputs before the window opened (open_console): it starts.
     if (!options.record_path.empty()) (void)controller_.start_recording(options.record_path);
     for (const TissueParameterSpec& spec : tissue_parameter_specs()) {
@@ -72,8 +77,11 @@ class ConsoleWindow {
   /// Opens --replay's recording before the first frame.
   Status open_initial_replay() { return options_.replay_path.empty() ? Status(Ok{}) : controller_.open_replay(options_.replay_path); }
   ConsoleUi& ui() { return ui_; }
+  /// The frames drawn, oldest first, as the trace's spans (the last kTracedFrames; none without --trace).
+  std::vector<TraceSpan> traced_frames() const;
 
  private:
+  static constexpr std::size_t kTracedFrames = std::size_t{1} << 18;
   Status apply_action(const Action& action);
   Status account_for_unrun_actions() const;
   void read_manual_input(double dt_s);
@@ -105,7 +113,16 @@ class ConsoleWindow {
   std::vector<std::string> screenshots_due_;
   bool quit_ = false;
   bool have_frame_ = false;
+  std::vector<TraceSpan> frame_spans_;  // a ring: frame n at n % size
 };
+
+std::vector<TraceSpan> ConsoleWindow::traced_frames() const {
+  std::vector<TraceSpan> frames;
+  if (frame_spans_.empty()) return frames;
+  const std::uint64_t drawn = ui_.frame, kept = std::min<std::uint64_t>(drawn, frame_spans_.size());
+  for (std::uint64_t n = drawn - kept; n < drawn; ++n) frames.push_back(frame_spans_[n % frame_spans_.size()]);
+  return frames;
+}
 
 Status ConsoleWindow::apply_action(const Action& a) {
   const std::string where = options_.actions_path + ":" + std::to_string(a.line) + ":" + std::to_string(a.column) + ": ";
@@ -426,6 +443,10 @@ Status ConsoleWindow::run() {
     ui_.frame_history_ms[ui_.frame_history_next] = static_cast<float>(frame_ms);
     ui_.frame_history_next = static_cast<std::uint32_t>((ui_.frame_history_next + 1) % ui_.frame_history_ms.size());
     last_frame_ns = shown_ns;
+    if (!frame_spans_.empty()) {
+      const std::uint64_t drawn_tick = shown_ != nullptr ? shown_->tick : 0;
+      frame_spans_[ui_.frame % frame_spans_.size()] = {begin_ns, shown_ns - begin_ns, ui_.frame, drawn_tick};
+    }
     ++ui_.frame;
     if (options_.frames > 0 && ui_.frame >= options_.frames) quit_ = true;
   }
@@ -626,6 +647,8 @@ Result<ordered_json> run_console(const ConsoleOptions& options) {
   const auto wall_start = std::chrono::steady_clock::now();
   Status ran = Ok{};
   ordered_json report;
+  ordered_json traced;  // what --trace wrote
+  Status trace_written = Ok{};  // a trace that could not be written fails the session after its report
   {
     // The window first: it queues --record's start, which the core then takes before its first tick
     // (started the other way round, a loaded machine let the core tick first, and the recording began
@@ -641,11 +664,21 @@ Result<ordered_json> run_console(const ConsoleOptions& options) {
     }
     session.stop();
     session.frames().update();  // the core's last frame: the recording's final figures
+    if (ran && !options.trace_path.empty()) {
+      // The core has stopped: its profiler is this thread's to read.
+      const std::vector<TraceSpan> frames = console.traced_frames();
+      const std::array<TraceTrack, 1> tracks{TraceTrack{"console (frames: drawing to the swap)", "frame", "frame", frames}};
+      trace_written = session.profiler().write_chrome_trace(options.trace_path, tracks);
+      // A long session's trace holds its end: the report says from which tick.
+      if (trace_written) traced = {{"path", options.trace_path}, {"first_tick", session.profiler().trace_first_tick()},
+                         {"dropped_stage_timings", session.profiler().trace_dropped()}, {"frames", frames.size()}};
+    }
     console.ui().replay.wait_for_verification();
     int w = 0, h = 0;
     glfwGetFramebufferSize(window, &w, &h);
     report = make_report(session, console.ui(), options, std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count(), w, h);
     report["renderer"] = {{"gl_renderer", gl_renderer}, {"view_scale", resolved.view_scale}};
+    if (!traced.is_null()) report["trace"] = traced;
     renderer->reset();  // its GL objects go while the context lives
   }
   ImGui_ImplOpenGL3_Shutdown();
@@ -656,6 +689,7 @@ Result<ordered_json> run_console(const ConsoleOptions& options) {
   if (!options.report_path.empty()) {
     if (Status written = write_file_atomically(options.report_path, report.dump(2) + "\n"); !written) return Error{written.error()};
   }
+  if (!trace_written) return Error{trace_written.error()};
   // After the report (which holds it too): a recording lost is a failed session, as in a headless run.
   if (!session.recording_error().empty()) return Error{session.recording_error()};
   return report;

@@ -24,6 +24,7 @@ struct ConsoleOptions {
   std::string screenshot_path;  ///< --screenshot: written after frame `frames`
   std::uint64_t frames = 0;     ///< --frames: quit after this many frames (0: run until closed)
   std::string report_path;      ///< --report: the session's JSON report
+  std::string trace_path;       ///< --trace: the core's stages and the frames, Chrome trace-event JSON
   std::string record_path;      ///< --record: record the session from its first tick
   std::string replay_path;      ///< --replay: open this recording in the replay panel
   /// Every file the session reads (--actions, --preset, --replay, --calibration, a procedure file):

@@ -81,6 +81,7 @@ const char* output_kind_name(OutputKind kind) {
     case OutputKind::kReport: return "report";
     case OutputKind::kScreenshot: return "screenshot";
     case OutputKind::kPreset: return "preset";
+    case OutputKind::kTrace: return "trace";
   }
   return "output";
 }

@@ -14,7 +14,7 @@ namespace resecto::gui {
 
 /// What a file this session writes holds: one path holds one of them (audit 8, G1: a `record` action
 /// onto --report's path lost the recording, a screenshot onto --record's path the screenshot).
-enum class OutputKind { kRecording, kReport, kScreenshot, kPreset };
+enum class OutputKind { kRecording, kReport, kScreenshot, kPreset, kTrace };
 
 class ConsoleController {
  public:

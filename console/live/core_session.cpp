@@ -57,7 +57,7 @@ Result<std::unique_ptr<CoreSession>> CoreSession::create(const CoreSessionOption
 CoreSession::CoreSession(const CoreSessionOptions& options, std::unique_ptr<Simulation> sim)
     : options_(options),
       sim_(std::move(sim)),
-      profiler_(default_stage_budgets_us(sim_->config()), 1u << 16),
+      profiler_(default_stage_budgets_us(sim_->config()), options.trace_capacity),
       scheduler_(schedule_for(options)),
       frames_(LiveFrame{sim_->make_snapshot(), CoreStatus{}}) {
   if (options.lockstep) {

@@ -37,6 +37,8 @@ struct CoreSessionOptions {
   std::int64_t spin_us = kDefaultRealtimeSpinUs;
   bool realtime_priority = true;     ///< SCHED_FIFO for the core and collision threads where permitted
   std::size_t hash_capacity = 1u << 18;  ///< collision-step hashes kept for the report (an hour at 60 Hz)
+  /// Stage timings the profiler's trace ring keeps (the last ones; ~6 a tick): what --trace writes.
+  std::size_t trace_capacity = 1u << 16;
 };
 
 /// What the console asks the core to do, applied at the start of the core's next tick.

@@ -6,6 +6,8 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <span>
+#include <string>
 #include <vector>
 
 #include "rtcore/base/result.h"
@@ -43,6 +45,24 @@ struct StageTiming {
   Stage stage = Stage::kTick;
 };
 
+/// A span of work another thread did, for a track of its own beside the core's in the trace (the
+/// console's frames): its place in time on the profiler's clock, its number, and the core's tick it
+/// relates to (a frame's: the tick of the snapshot it drew).
+struct TraceSpan {
+  std::int64_t begin_ns = 0;
+  std::int64_t duration_ns = 0;
+  std::uint64_t number = 0;
+  std::uint64_t tick = 0;
+};
+
+/// A track of spans: the track's name in the viewer, each span's name, and the name of its number.
+struct TraceTrack {
+  std::string track;
+  std::string span;
+  std::string number;
+  std::span<const TraceSpan> spans;
+};
+
 class FrameProfiler {
  public:
   /// Budgets per stage in microseconds; the trace keeps the last `trace_capacity` stage timings
@@ -69,8 +89,9 @@ class FrameProfiler {
   std::uint64_t trace_first_tick() const;
 
   /// Writes the trace ring as Chrome trace-event JSON (complete "X" events, microseconds), streamed
-  /// to the file in blocks: a full ring is ~470 MB of text, which a string would hold twice.
-  Status write_chrome_trace(const std::filesystem::path& path) const;
+  /// to the file in blocks: a full ring is ~470 MB of text, which a string would hold twice. `tracks`
+  /// go beside the core's and the collision thread's, one thread each, on the same time axis.
+  Status write_chrome_trace(const std::filesystem::path& path, std::span<const TraceTrack> tracks = {}) const;
 
  private:
   std::array<double, kStageCount> budgets_us_;

@@ -421,6 +421,52 @@ TEST(ConsoleWindow, RunWithoutHeadlessOpensTheConsole) {
   EXPECT_GT(load_png(dir / "run.png").width, 0);
 }
 
+TEST(ConsoleWindow, ATraceHoldsTheCoresStagesAndTheFramesOnOneClock) {
+  // --trace from the console (and from `run` without --headless): the core's stages on their tracks,
+  // every frame on one of its own with its number and the tick it drew, all on one time axis.
+  REQUIRE_X_SERVER();
+  const auto dir = scratch_directory("console_trace");
+  for (const std::string command : {"console", "run"}) {
+    const std::filesystem::path trace_path = dir / (command + ".trace.json"), report_path = dir / (command + ".report.json");
+    const CommandOutput run = run_in_xvfb(command + " --triangles 1296 --frames 6 --trace " + trace_path.string() + " --report " + report_path.string(), dir);
+    ASSERT_EQ(run.exit_code, 0) << command << ": " << run.err;
+    const nlohmann::json trace = load_json(trace_path);
+    std::string frames_track;
+    std::vector<nlohmann::json> frames;
+    int physics = 0, queries = 0;
+    double ticks_begin = 1e300, ticks_end = 0.0;
+    for (const auto& event : trace.at("traceEvents")) {
+      if (event.at("ph") == "M" && event.at("tid") == 3) frames_track = event.at("args").at("name");
+      if (event.at("ph") != "X") continue;
+      if (event.at("tid") == 3) frames.push_back(event);
+      if (event.at("name") == "physics" && event.at("tid") == 1) ++physics;
+      if (event.at("name") == "query" && event.at("tid") == 2) ++queries;
+      if (event.at("name") == "tick") {
+        ticks_begin = std::min(ticks_begin, event.at("ts").get<double>());
+        ticks_end = std::max(ticks_end, event.at("ts").get<double>() + event.at("dur").get<double>());
+      }
+    }
+    EXPECT_NE(frames_track.find("console"), std::string::npos) << command;
+    EXPECT_GT(physics, 0) << command;
+    EXPECT_GT(queries, 0) << command;
+    ASSERT_EQ(frames.size(), 6u) << command;
+    for (std::size_t n = 0; n < frames.size(); ++n) {
+      EXPECT_EQ(frames[n].at("name"), "frame");
+      EXPECT_EQ(frames[n].at("args").at("frame").get<std::uint64_t>(), n);
+      EXPECT_GT(frames[n].at("dur").get<double>(), 0.0);
+      if (n > 0) {
+        EXPECT_GE(frames[n].at("ts").get<double>(), frames[n - 1].at("ts").get<double>() + frames[n - 1].at("dur").get<double>());
+        EXPECT_GE(frames[n].at("args").at("tick").get<std::uint64_t>(), frames[n - 1].at("args").at("tick").get<std::uint64_t>());
+      }
+    }
+    // The core ran while the frames were drawn: the two tracks share the clock.
+    const double last_frame_end = frames.back().at("ts").get<double>() + frames.back().at("dur").get<double>();
+    EXPECT_LT(ticks_begin, last_frame_end) << command;
+    EXPECT_GT(ticks_end, frames.front().at("ts").get<double>()) << command;
+    EXPECT_EQ(load_json(report_path).at("trace").at("frames").get<std::uint64_t>(), 6u) << command;
+  }
+}
+
 TEST(ConsoleWindow, RecordedSessionReplaysAtAScrubbedTimeWithTheRecordedToolPoseAndVerifies) {
   REQUIRE_X_SERVER();
   const auto dir = scratch_directory("console_replay");

@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <vector>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
@@ -84,6 +86,38 @@ TEST(FrameProfiler, ATraceOfManyBlocksIsWrittenWhole) {
   }
   EXPECT_EQ(expected_tick, 40'000u);
   std::filesystem::remove(path);
+}
+
+TEST(FrameProfiler, AnotherThreadsSpansGetATrackOfTheirOwnOnTheSameClock) {
+  // The console's frames beside the core's stages: a named track (tid 3), each span with its number
+  // and tick, placed on the same time axis (the earliest event, here a frame, is time zero).
+  std::array<double, kStageCount> budgets{};
+  budgets.fill(100.0);
+  FrameProfiler profiler(budgets, 16);
+  for (std::uint64_t tick = 0; tick < 4; ++tick) profiler.record(Stage::kTick, tick, 1'000'000 + 1'000'000 * static_cast<std::int64_t>(tick), 1'200'000 + 1'000'000 * static_cast<std::int64_t>(tick));
+  const std::vector<TraceSpan> frames{{500'000, 2'000'000, 0, 0}, {2'500'000, 2'000'000, 1, 2}};
+  const std::array<TraceTrack, 1> tracks{TraceTrack{"console (frames)", "frame", "frame", frames}};
+  const auto path = std::filesystem::temp_directory_path() / ("resecto_tracks_" + std::to_string(::getpid()) + ".json");
+  ASSERT_TRUE(profiler.write_chrome_trace(path, tracks));
+  const auto trace = nlohmann::json::parse(std::ifstream(path));
+  std::filesystem::remove(path);
+  bool named = false;
+  std::vector<nlohmann::json> frame_events, tick_events;
+  for (const auto& event : trace.at("traceEvents")) {
+    if (event.at("ph") == "M" && event.at("tid") == 3) named = event.at("args").at("name") == "console (frames)";
+    if (event.at("ph") != "X") continue;
+    (event.at("tid") == 3 ? frame_events : tick_events).push_back(event);
+  }
+  EXPECT_TRUE(named);
+  ASSERT_EQ(frame_events.size(), 2u);
+  ASSERT_EQ(tick_events.size(), 4u);
+  EXPECT_EQ(frame_events[0].at("name"), "frame");
+  EXPECT_DOUBLE_EQ(frame_events[0].at("ts").get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(frame_events[1].at("ts").get<double>(), 2000.0);
+  EXPECT_DOUBLE_EQ(frame_events[1].at("dur").get<double>(), 2000.0);
+  EXPECT_EQ(frame_events[1].at("args").at("frame"), 1);
+  EXPECT_EQ(frame_events[1].at("args").at("tick"), 2);
+  EXPECT_DOUBLE_EQ(tick_events[0].at("ts").get<double>(), 500.0);  // 1 ms on the clock, the frame at 0.5 ms
 }
 
 }  // namespace
