@@ -506,6 +506,7 @@ ordered_json make_report(CoreSession& session, ConsoleUi& ui, const ConsoleOptio
                {"max_late_us", d.max_late_us},
                {"resynchronizations", d.resynchronizations},
                {"scheduling", session.realtime_priority_held() ? "SCHED_FIFO " + std::to_string(kCoreFifoPriority) : std::string("normal")}};
+  if (session.core_cpu() >= 0) r["core"]["core_cpu"] = session.core_cpu();
   const std::string advice =
       realtime_advice(realtime_figures(sim, r["core"]["miss_fraction"].get<double>(), session.profiler().statistics(Stage::kTick).p99_us));
   if (!advice.empty()) r["core"]["advice"] = advice;

@@ -197,10 +197,12 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   bool collision_raised = false;
   bool helper_raised = false;
   bool recorder_raised = false;
+  int core_cpu = -1;  // the processor the core was kept on (keep_core_apart), -1: wherever the OS put it
   if (core_priority.raised()) {
     const RaisedThreads raised = raise_simulation_threads(sim);
     collision_raised = raised.collision;
     helper_raised = raised.physics_helper;
+    core_cpu = raised.core_cpu;
     if (recorder) recorder_raised = raise_to_fifo(recorder->native_handle(), kRecorderFifoPriority);
   }
   const auto wall_start = std::chrono::steady_clock::now();
@@ -274,6 +276,7 @@ Result<HeadlessResult> run_headless(const HeadlessOptions& options) {
   r["scheduling"] = {{"core", core_raised ? "SCHED_FIFO " + std::to_string(kCoreFifoPriority) : std::string("normal")},
                      {"collision", collision_raised ? "SCHED_FIFO " + std::to_string(kCollisionFifoPriority) : std::string("normal")}};
   if (sim.physics_helper()) r["scheduling"]["physics_helper"] = helper_raised ? "SCHED_FIFO " + std::to_string(kCoreFifoPriority) : std::string("normal");
+  if (core_cpu >= 0) r["scheduling"]["core_cpu"] = core_cpu;
   if (recorder) r["scheduling"]["recorder"] = recorder_raised ? "SCHED_FIFO " + std::to_string(kRecorderFifoPriority) : std::string("normal");
   r["model"] = {{"surface_triangles", sim.prostate().surface.triangle_count()},
                 {"tetrahedra", sim.tetrahedron_count()},

@@ -106,7 +106,7 @@ void CoreSession::run_core() {
   // The core first, the collision thread next, as in the headless real-time run; the console's own
   // thread stays at normal priority, so a slow frame can never hold a tick back.
   ScopedFifoPriority priority(kCoreFifoPriority, options_.realtime_priority);
-  if (priority.raised()) raise_simulation_threads(*sim_);
+  if (priority.raised()) core_cpu_.store(raise_simulation_threads(*sim_).core_cpu, std::memory_order_release);
   priority_held_.store(priority.raised(), std::memory_order_release);
   const double period_ns = static_cast<double>(schedule_for(options_).period_ns);
   sim_->set_paced();

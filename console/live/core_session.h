@@ -139,6 +139,8 @@ class CoreSession {
   const std::vector<std::pair<std::uint64_t, std::uint64_t>>& collision_hashes() const { return hashes_; }
   /// After stop(): how well the schedule held.
   const DeadlineReport& deadlines() const { return scheduler_.report(); }
+  /// The processor the core's thread was kept on (keep_core_apart), or -1.
+  int core_cpu() const { return core_cpu_.load(std::memory_order_acquire); }
   const FrameProfiler& profiler() const { return profiler_; }
   /// After stop(): the first recording that could not be started or finished whole, empty when none
   /// (the panel shows the last one; a session ends with exit 1 on this one, audit 8, G4).
@@ -159,6 +161,7 @@ class CoreSession {
   std::unique_ptr<Simulation> sim_;
   std::unique_ptr<LiveDevice> live_;
   std::unique_ptr<LockstepDevice> lockstep_;
+  std::atomic<int> core_cpu_{-1};
   FrameProfiler profiler_;
   FixedStepScheduler scheduler_;
   SpscRing<DeviceSample> samples_{4096};

@@ -191,6 +191,9 @@ RaisedThreads raise_simulation_threads(Simulation& sim) {
   RaisedThreads raised;
   if (sim.collision_thread()) raised.collision = raise_to_fifo(sim.collision_thread()->native_handle(), kCollisionFifoPriority);
   if (sim.physics_helper()) raised.physics_helper = raise_to_fifo(sim.physics_helper()->native_handle(), kCoreFifoPriority);
+  std::vector<pthread_t> helper;
+  if (sim.physics_helper()) helper.push_back(sim.physics_helper()->native_handle());
+  raised.core_cpu = keep_core_apart(pthread_self(), helper);
   return raised;
 }
 

@@ -356,11 +356,13 @@ int default_physics_threads();
 struct RaisedThreads {
   bool collision = false;
   bool physics_helper = false;
+  int core_cpu = -1;  ///< the processor the core's thread was kept on (keep_core_apart), or -1
 };
 /// Real time, once the core's thread holds kCoreFifoPriority: the collision thread under it (it has
 /// a whole collision period) and the physics helper level with it (it runs only inside the core's
 /// physics step, and the core may wait on a chunk it holds, so nothing the core outranks may
-/// preempt it).
+/// preempt it). Call on the core's thread: it also keeps that thread on a processor of its own and
+/// the helper off it (keep_core_apart).
 RaisedThreads raise_simulation_threads(Simulation& sim);
 
 /// The stages' budgets at a tick rate, microseconds (the tick's time split among its stages).

@@ -19,4 +19,22 @@ void restore_normal_scheduling(pthread_t thread) {
   (void)pthread_setschedparam(thread, SCHED_OTHER, &parameters);
 }
 
+int keep_core_apart(pthread_t core, std::span<const pthread_t> others) {
+  // The processors this process may use (a cgroup or taskset may allow fewer than the machine has).
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (sched_getaffinity(0, sizeof allowed, &allowed) != 0 || CPU_COUNT(&allowed) < 2) return -1;
+  int last = -1;
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+    if (CPU_ISSET(cpu, &allowed)) last = cpu;
+  }
+  cpu_set_t core_set, rest = allowed;
+  CPU_ZERO(&core_set);
+  CPU_SET(last, &core_set);
+  CPU_CLR(last, &rest);
+  if (pthread_setaffinity_np(core, sizeof core_set, &core_set) != 0) return -1;
+  for (const pthread_t other : others) (void)pthread_setaffinity_np(other, sizeof rest, &rest);
+  return last;
+}
+
 }  // namespace resecto

@@ -6,6 +6,7 @@
 
 #include <pthread.h>
 
+#include <span>
 #include <string>
 
 namespace resecto {
@@ -23,6 +24,16 @@ inline constexpr int kRecorderFifoPriority = 30;
 bool raise_to_fifo(pthread_t thread, int priority);
 /// Back to the default time-sharing policy.
 void restore_normal_scheduling(pthread_t thread);
+
+/// Keeps a real-time core's thread on a processor of its own among those this process may use: the
+/// last one, with `others` (its physics helper) on the rest. Processor 0 takes the machine's
+/// housekeeping: on the development VM a system agent's timer wakes there every ~1.05 s and its work
+/// holds the processor ~2 ms (the kernel does not preempt it), and a core sleeping between ticks on
+/// that processor started a tick that late about once a second (session 44's console runs; its
+/// headless runs, whose core had landed on processor 1, did not). A helper level with the core must
+/// not share its processor either: SCHED_FIFO at one priority does not preempt. Returns the core's
+/// processor, or -1 (nothing changed) with fewer than two processors or where the OS refuses.
+int keep_core_apart(pthread_t core, std::span<const pthread_t> others);
 
 /// Raises the calling thread for its lifetime and restores it after. A plain object rather than an
 /// optional one for runs that may not want it: GCC's flow analysis under the sanitizers took an

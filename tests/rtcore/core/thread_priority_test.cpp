@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <sched.h>
 
+#include <atomic>
 #include <thread>
 
 namespace resecto {
@@ -35,6 +36,41 @@ TEST(ThreadPriority, ScopedRaiseEitherTakesEffectOrChangesNothing) {
     EXPECT_EQ(policy_of(self), before) << "the scope restores normal scheduling";
   });
   worker.join();
+}
+
+TEST(ThreadPriority, TheCoreKeepsAProcessorOfItsOwnAndTheHelperTheOthers) {
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  ASSERT_EQ(sched_getaffinity(0, sizeof allowed, &allowed), 0);
+  // Two threads that live until the checks are done (an ended thread has no affinity to read).
+  std::atomic<bool> done{false};
+  const auto wait_for_done = [&done] {
+    while (!done.load(std::memory_order_acquire)) std::this_thread::yield();
+  };
+  std::thread core_thread(wait_for_done), helper_thread(wait_for_done);
+  const pthread_t core = core_thread.native_handle(), helper = helper_thread.native_handle();
+  const pthread_t others[] = {helper};
+  const int placed = keep_core_apart(core, others);
+  cpu_set_t core_set, helper_set;
+  const bool read = pthread_getaffinity_np(core, sizeof core_set, &core_set) == 0 && pthread_getaffinity_np(helper, sizeof helper_set, &helper_set) == 0;
+  done.store(true, std::memory_order_release);
+  core_thread.join();
+  helper_thread.join();
+  if (CPU_COUNT(&allowed) < 2) {
+    EXPECT_EQ(placed, -1) << "one processor: nothing to keep apart";
+    return;
+  }
+  ASSERT_GE(placed, 0) << "affinity refused here";
+  ASSERT_TRUE(read);
+  int last = -1;
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+    if (CPU_ISSET(cpu, &allowed)) last = cpu;
+  }
+  EXPECT_EQ(placed, last);
+  EXPECT_EQ(CPU_COUNT(&core_set), 1);
+  EXPECT_TRUE(CPU_ISSET(last, &core_set));
+  EXPECT_FALSE(CPU_ISSET(last, &helper_set)) << "a helper level with the core must not share its processor";
+  EXPECT_EQ(CPU_COUNT(&helper_set), CPU_COUNT(&allowed) - 1);
 }
 
 TEST(ThreadPriority, OutOfRangePriorityIsRefused) {
