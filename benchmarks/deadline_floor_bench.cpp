@@ -11,7 +11,16 @@
 // busy time on this machine at its quickest), so a stall or a slow stretch delays them as it delays a
 // physics step: the floor a computing tick has. The real-time figures are judged against the first;
 // the second tells how much of the rest is the machine's.
+// BM_DeadlineFloorShared's ticks do the same fixed work in chunks shared with a helper thread, as the
+// core shares its physics step (LoopHelper, the helper at the core's priority on the other processor,
+// keep_core_apart): a tick then waits on both processors, and a stall of either one while it holds a
+// chunk delays the tick. That is the floor of a real-time run with two physics threads, which no
+// single-threaded floor shows (session 45: the 8640 demo's late ticks came with neither of the
+// core's threads descheduled in the guest's own scheduler trace, on either processor).
 #include <benchmark/benchmark.h>
+
+#include <pthread.h>
+#include <sched.h>
 
 #include <algorithm>
 #include <array>
@@ -23,6 +32,7 @@
 #include <string>
 #include <tuple>
 
+#include "rtcore/concurrency/loop_helper.h"
 #include "rtcore/core/fixed_step_scheduler.h"
 #include "rtcore/core/simulation.h"
 #include "rtcore/core/thread_priority.h"
@@ -37,8 +47,15 @@ struct Floor {
   double missed_percent() const { return 100.0 * static_cast<double>(misses) / static_cast<double>(std::max<std::uint64_t>(ticks, 1)); }
 };
 /// What a floor's ticks do; the table lists the busy-waiting floors first.
-enum class TickKind { kBusyWaiting, kFixedWork };
-const char* name(TickKind kind) { return kind == TickKind::kBusyWaiting ? "busy waiting" : "fixed work"; }
+enum class TickKind { kBusyWaiting, kFixedWork, kSharedWork };
+const char* name(TickKind kind) {
+  switch (kind) {
+    case TickKind::kBusyWaiting: return "busy waiting";
+    case TickKind::kFixedWork: return "fixed work";
+    case TickKind::kSharedWork: return "fixed work on two threads";
+  }
+  return "";
+}
 /// Per kind of tick, busy time (us) and seconds: the floor measured.
 std::map<std::tuple<TickKind, std::int64_t, std::int64_t>, Floor>& floors() {
   static std::map<std::tuple<TickKind, std::int64_t, std::int64_t>, Floor> f;
@@ -50,13 +67,15 @@ void burn_until(std::int64_t until_ns) {
   }
 }
 
+using WorkArray = std::array<double, 1024>;
+WorkArray fresh_work_array() {
+  WorkArray v{};
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = 1.0 + 1e-3 * static_cast<double>(i);
+  return v;
+}
+
 /// A fixed amount of floating-point work over an L1-sized array: `rounds` passes.
-double work(std::int64_t rounds) {
-  static std::array<double, 1024> values = [] {
-    std::array<double, 1024> v{};
-    for (std::size_t i = 0; i < v.size(); ++i) v[i] = 1.0 + 1e-3 * static_cast<double>(i);
-    return v;
-  }();
+double work(WorkArray& values, std::int64_t rounds) {
   double sum = 0.0;
   for (std::int64_t r = 0; r < rounds; ++r) {
     for (double& v : values) {
@@ -66,6 +85,10 @@ double work(std::int64_t rounds) {
     benchmark::DoNotOptimize(values.data());
   }
   return sum;
+}
+double work(std::int64_t rounds) {
+  static WorkArray values = fresh_work_array();
+  return work(values, rounds);
 }
 
 /// The least time of `trials` runs of work(rounds): the machine at its quickest, whatever slow
@@ -87,8 +110,9 @@ std::int64_t rounds_for(std::int64_t busy_us) {
 }
 
 /// Runs `seconds` of ticks at the real-time settings, each calling `tick_work`.
+/// `helper`, if any, is called in whenever the core wakes for a tick, as the simulation calls in its own.
 template <typename TickWork>
-Floor run_floor(std::int64_t seconds, const TickWork& tick_work) {
+Floor run_floor(std::int64_t seconds, const TickWork& tick_work, LoopHelper* helper = nullptr) {
   // The default rates, rounded to a period as the headless runner rounds them.
   const double tick_s = SimulationConfig{}.tick_s();
   SchedulerConfig config;
@@ -97,11 +121,13 @@ Floor run_floor(std::int64_t seconds, const TickWork& tick_work) {
   config.spin_ns = kDefaultRealtimeSpinUs * 1000;
   FixedStepScheduler scheduler(config);
   const ScopedFifoPriority priority(kCoreFifoPriority);
+  if (helper != nullptr) scheduler.set_wake_hook([](void* h) { static_cast<LoopHelper*>(h)->call_in(); }, helper);
   const auto ticks = static_cast<std::uint64_t>(std::llround(static_cast<double>(seconds) / tick_s));
   scheduler.run(0, ticks, [&](std::uint64_t) {
     tick_work();
     return true;
   });
+  if (helper != nullptr) helper->send_home();
   const DeadlineReport& report = scheduler.report();
   return {report.ticks, report.misses, report.resynchronizations, report.max_late_us, priority.raised()};
 }
@@ -133,6 +159,37 @@ void BM_DeadlineFloorWork(benchmark::State& state) {
 }
 BENCHMARK(BM_DeadlineFloorWork)->Args({300, 10})->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 
+/// The physics step's shape: its loops cut into chunks the core and the helper claim from either end.
+constexpr std::uint32_t kSharedChunks = 16;
+
+void BM_DeadlineFloorShared(benchmark::State& state) {
+  const std::int64_t busy_us = state.range(0), seconds = state.range(1);
+  Floor& floor = floors()[{TickKind::kSharedWork, busy_us, seconds}];
+  // Each chunk a 1/kSharedChunks share of the single thread's busy time, on an array of its own.
+  const std::int64_t rounds = std::max<std::int64_t>(1, rounds_for(busy_us) / kSharedChunks);
+  std::array<WorkArray, kSharedChunks> arrays;
+  arrays.fill(fresh_work_array());
+  std::array<double, kSharedChunks> sums{};
+  LoopHelper helper;
+  const bool helper_raised = raise_to_fifo(helper.native_handle(), kCoreFifoPriority);
+  auto chunk = [&](std::uint32_t c) { sums[c] = work(arrays[c], rounds); };
+  cpu_set_t allowed;  // this thread's processors, given back after: the benchmarks after it may use them all
+  CPU_ZERO(&allowed);
+  const bool restorable = pthread_getaffinity_np(pthread_self(), sizeof allowed, &allowed) == 0;
+  for (auto _ : state) {
+    // The processors as raise_simulation_threads() gives them to a real-time run's core and helper.
+    const pthread_t others[] = {helper.native_handle()};
+    state.counters["core_cpu"] = keep_core_apart(pthread_self(), others);
+    floor = run_floor(seconds, [&] { helper.for_each_chunk(kSharedChunks, chunk); }, &helper);
+  }
+  if (restorable) (void)pthread_setaffinity_np(pthread_self(), sizeof allowed, &allowed);
+  benchmark::DoNotOptimize(sums.data());
+  floor.fifo = floor.fifo && helper_raised;
+  count(state, floor);
+  state.counters["helper_share"] = static_cast<double>(helper.chunks_helped()) / static_cast<double>(std::max<std::uint64_t>(1, helper.chunks_offered()));
+}
+BENCHMARK(BM_DeadlineFloorShared)->Args({300, 10})->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+
 }  // namespace
 }  // namespace resecto
 
@@ -142,7 +199,7 @@ int main(int argc, char** argv) {
   benchmark::Shutdown();
   std::printf("\n%10s %8s | %8s %8s %10s %12s %12s | %s\n", "busy us", "seconds", "ticks", "misses", "missed %", "worst late us",
               "re-anchored", "scheduling, ticks");
-  bool kinds[2] = {false, false};
+  bool kinds[3] = {false, false, false};
   for (const auto& [key, floor] : resecto::floors()) {
     const auto& [kind, busy_us, seconds] = key;
     kinds[static_cast<int>(kind)] = true;
@@ -157,6 +214,10 @@ int main(int argc, char** argv) {
   if (kinds[1]) {
     std::printf(
         "fixed work: a tick is late also when a stall or a slow stretch of the machine delays its work, as it delays a physics step\n");
+  }
+  if (kinds[2]) {
+    std::printf("fixed work on two threads: the same work in chunks shared with a helper on the other processor, as the physics step is:\n"
+                "  a stall of either processor while it holds a chunk delays the tick\n");
   }
   return 0;
 }
