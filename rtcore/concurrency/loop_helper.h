@@ -64,11 +64,20 @@ class LoopHelper {
 
   /// Owner: wakes the helper to take part in the loops that follow, until send_home().
   void call_in() {
+    when_ready_ = {};
     if (on_call_.exchange(1, std::memory_order_release) == 0) futex_wake_one(on_call_);
   }
   /// Owner: the helper goes back to sleep once it sees this (no loop is running: for_each_chunk has
   /// returned).
-  void send_home() { on_call_.store(0, std::memory_order_relaxed); }
+  void send_home() {
+    when_ready_ = {};
+    on_call_.store(0, std::memory_order_relaxed);
+  }
+  /// Owner: until call_in() or send_home(), the loops check `ready(context)` before and between their
+  /// chunks, and once it holds call the helper in, which joins the running loop's unclaimed chunks.
+  /// The core runs a step alone while its collision job has the second processor, and takes the
+  /// helper back as soon as the job ends rather than at the next step.
+  void call_in_when(bool (*ready)(const void*), const void* context) { when_ready_ = {ready, context}; }
   /// Whether the helper is on call (called in, and not yet sent or gone home).
   bool on_call() const { return on_call_.load(std::memory_order_relaxed) != 0; }
 
@@ -93,9 +102,11 @@ class LoopHelper {
     work_.store(loop, std::memory_order_release);
     alongside();
     std::uint32_t ran = 0;
+    call_in_if_ready();
     for (std::uint32_t chunk = 0; claim(generation_, true, chunk);) {
       body(chunk);
       ++ran;
+      call_in_if_ready();
     }
     // Only chunks the helper claimed are outstanding; it is running them now.
     std::uint32_t done = finished_.fetch_add(ran, std::memory_order_acq_rel) + ran;
@@ -137,6 +148,14 @@ class LoopHelper {
     }
   }
 
+  struct ReadyCheck {
+    bool (*ready)(const void*) = nullptr;
+    const void* context = nullptr;
+  };
+  void call_in_if_ready() {
+    if (when_ready_.ready != nullptr && when_ready_.ready(when_ready_.context)) call_in();
+  }
+
   template <class Body>
   static void call_body(void* context, std::uint32_t chunk) {
     (*static_cast<Body*>(context))(chunk);
@@ -169,6 +188,9 @@ class LoopHelper {
         spin_pause();
         continue;
       }
+      // Sent home as this loop came: the owner runs it alone. Not marked seen, so a helper called in
+      // again while it runs (call_in_when) still joins it.
+      if (on_call_.load(std::memory_order_acquire) == 0) continue;
       idle_spins = 0;
       seen = generation;
       std::uint32_t ran = 0;
@@ -187,6 +209,7 @@ class LoopHelper {
 
   std::uint32_t generation_ = 0;  // owner only
   std::uint64_t offered_ = 0;     // owner only
+  ReadyCheck when_ready_;         // owner only: call_in_when()
   alignas(64) std::atomic<std::uint64_t> work_{0};
   std::atomic<void (*)(void*, std::uint32_t)> body_{nullptr};
   std::atomic<void*> context_{nullptr};

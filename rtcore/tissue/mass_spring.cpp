@@ -445,7 +445,7 @@ void MassSpringTissue::step_implicit_euler(double h_s) {
 
 ToolReaction MassSpringTissue::physics_step(double h_s) {
   refresh_stepped_nodes();  // normally done by the editor already
-  if (helper_ != nullptr) helper_->call_in();
+  if (helper_ != nullptr && call_in_helper_) helper_->call_in();
   switch (config_.integrator) {
     case TissueIntegrator::kBoundedSymplectic: step_bounded_symplectic(h_s); break;  // checks finiteness itself
     case TissueIntegrator::kSubsteppedSymplectic:

@@ -163,7 +163,12 @@ class MassSpringTissue {
   ToolReaction physics_step(double h_s);
   /// Shares the physics step's spring and node loops with `helper` (nullptr: this thread alone).
   /// The state is the same bit for bit either way; the helper must outlive its use here.
-  void share_loops_with(LoopHelper* helper) { helper_ = helper; }
+  /// With `call_in` false the step does not call the helper in: it takes part only if its owner has
+  /// it called in during the step (LoopHelper::call_in_when: the collision job ending; Simulation::step).
+  void share_loops_with(LoopHelper* helper, bool call_in = true) {
+    helper_ = helper;
+    call_in_helper_ = call_in;
+  }
 
   /// 64-bit hash of positions, velocities and topology, bytes in index order. The topology's part is
   /// hashed once (about half the bytes at 8640 triangles); whatever changes the topology must renew it.
@@ -348,6 +353,7 @@ class MassSpringTissue {
   // helper_ if set.
   static constexpr std::size_t kNodesPerChunk = 512;
   LoopHelper* helper_ = nullptr;
+  bool call_in_helper_ = true;  // physics_step() calls helper_ in (share_loops_with)
   // The nodes those loops visit (stepped_nodes.h), relisted after edits by refresh_stepped_nodes().
   SteppedNodes stepped_;
   bool stepped_stale_ = true;

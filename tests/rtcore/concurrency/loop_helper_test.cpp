@@ -74,6 +74,56 @@ TEST(LoopHelper, TheHelperTakesChunksFromTheOtherEnd) {
   EXPECT_GT(helper.chunks_helped(), 0u);
 }
 
+TEST(LoopHelper, CalledInWhenReadyItJoinsTheRunningLoop) {
+  // The core runs a step alone while its collision job has the second processor, and takes the helper
+  // back once the job ends: the owner checks between chunks and calls it in, and it joins the loop
+  // already running. Here another thread plays the job: it ends while the owner runs chunk 0; chunk
+  // 1 then waits (up to 10 s, for a loaded machine) until some chunk has run on a thread not the owner's.
+  LoopHelper helper;
+  helper.send_home();
+  const std::thread::id owner = std::this_thread::get_id();
+  std::atomic<bool> started{false}, job_ended{false}, joined{false};
+  std::thread job([&] {
+    while (!started.load()) std::this_thread::yield();
+    job_ended.store(true);
+  });
+  helper.call_in_when([](const void* ended) { return static_cast<const std::atomic<bool>*>(ended)->load(); }, &job_ended);
+  std::atomic<std::uint32_t> runs{0};
+  auto body = [&](std::uint32_t chunk) {
+    runs.fetch_add(1);
+    if (std::this_thread::get_id() != owner) joined.store(true);
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    if (chunk == 0) {
+      EXPECT_FALSE(helper.on_call()) << "called in before the job ended";
+      started.store(true);
+      while (!job_ended.load() && std::chrono::steady_clock::now() < give_up) std::this_thread::yield();
+    } else if (chunk == 1) {
+      while (!joined.load() && std::chrono::steady_clock::now() < give_up) std::this_thread::yield();
+    }
+  };
+  helper.for_each_chunk(64, body);
+  job.join();
+  EXPECT_TRUE(helper.on_call()) << "the job's end called the helper in";
+  helper.send_home();
+  EXPECT_TRUE(joined.load()) << "the helper, called in during the loop, ran none of its chunks";
+  EXPECT_EQ(runs.load(), 64u) << "every chunk runs once";
+  EXPECT_GT(helper.chunks_helped(), 0u);
+}
+
+TEST(LoopHelper, NotReadyTheHelperStaysHome) {
+  // call_in_when() whose condition never holds: the owner runs every chunk, the helper none.
+  LoopHelper helper;
+  helper.send_home();
+  helper.call_in_when([](const void*) { return false; }, nullptr);
+  const std::thread::id owner = std::this_thread::get_id();
+  std::vector<int> by_owner(64, -1);
+  auto body = [&](std::uint32_t chunk) { by_owner[chunk] = std::this_thread::get_id() == owner ? 1 : 0; };
+  helper.for_each_chunk(64, body);
+  EXPECT_FALSE(helper.on_call());
+  EXPECT_EQ(std::count(by_owner.begin(), by_owner.end(), 1), 64);
+  EXPECT_EQ(helper.chunks_helped(), 0u);
+}
+
 TEST(LoopHelper, WithoutAHelperTheChunksRunInOrderOnTheCaller) {
   std::vector<std::uint32_t> order;
   auto body = [&](std::uint32_t chunk) { order.push_back(chunk); };

@@ -119,9 +119,10 @@ TEST(Simulation, ThePhysicsHelperChangesNoBit) {
 }
 
 TEST(Simulation, ABatchRunLeavesTheCollisionJobItsProcessor) {
-  // Batch ticks come back to back: a tick stepped while the collision job runs offers the helper no
-  // loop (the job keeps the second processor), and the others share theirs. A plain tick launches
-  // no job, so one running both before and after the step ran when the step chose.
+  // Batch ticks come back to back: a tick stepped while the collision job runs does not call the
+  // helper in (the job keeps the second processor), and the others share their loops. A plain tick
+  // launches no job, so one running both before and after the step ran throughout it: the helper,
+  // called in only by the job's end, ran none of that step's chunks.
   SimulationConfig config = small_config();
   config.collision_thread = true;
   config.physics_threads = 2;
@@ -133,11 +134,11 @@ TEST(Simulation, ABatchRunLeavesTheCollisionJobItsProcessor) {
   for (std::uint64_t tick = 0; tick < 2 * 960; ++tick) {
     const bool plain = !(*sim)->is_collision_tick(tick);
     const bool running_before = !job.idle();
-    const std::uint64_t offered = helper.chunks_offered();
+    const std::uint64_t helped = helper.chunks_helped();
     (*sim)->step(input_at(tick, config.tick_s()), {});
     if (plain && running_before && !job.idle()) {
       ++beside_job;
-      EXPECT_EQ(helper.chunks_offered(), offered) << "tick " << tick << " shared its loops beside the running job";
+      EXPECT_EQ(helper.chunks_helped(), helped) << "the helper ran chunks of tick " << tick << " beside the running job";
     }
   }
   EXPECT_GT(beside_job, 0) << "no tick ran beside the job: nothing was tested";
