@@ -104,7 +104,10 @@ else:
     # different lengths is no difference, as a full-precision comparison with a 0.000% floor made it.
     d = round(c - h, 3)
     verdict = 'within the floor' if abs(d) <= f else ('the console runs missed more' if d > 0 else 'the headless runs missed more')
-print(f'  {sys.argv[1]:>6} triangles at {sys.argv[2]:>3} Hz: console {cm} of {ct} ({c:.3f}%), headless {hm} of {ht} ({h:.3f}%), difference {c - h:+.3f} points: {verdict}')
+# Two standard deviations of the difference were misses a Poisson process at the measured rates:
+# how far apart two runs of the same kind would land by chance alone (said, not used in the verdict).
+noise = 2 * 100 * (cm / ct**2 + hm / ht**2) ** 0.5
+print(f'  {sys.argv[1]:>6} triangles at {sys.argv[2]:>3} Hz: console {cm} of {ct} ({c:.3f}%), headless {hm} of {ht} ({h:.3f}%), difference {c - h:+.3f} points (counting noise +-{noise:.3f}): {verdict}')
 " "${run%%:*}" "$((60 * ${run##*:}))" "${console_misses[$run]}" "${console_ticks[$run]}" "${headless_misses[$run]}" "${headless_ticks[$run]}" "$floor_miss"
 done
 echo "frame pacing (the core's miss % while the console drew frames slowed by 100 ms against while it drew the others, one run a rate):"
