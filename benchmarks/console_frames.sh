@@ -104,7 +104,7 @@ else:
     # different lengths is no difference, as a full-precision comparison with a 0.000% floor made it.
     d = round(c - h, 3)
     verdict = 'within the floor' if abs(d) <= f else ('the console runs missed more' if d > 0 else 'the headless runs missed more')
-# Two standard deviations of the difference were misses a Poisson process at the measured rates:
+# Two standard deviations of the difference, were the misses Poisson counts at the measured rates:
 # how far apart two runs of the same kind would land by chance alone (said, not used in the verdict).
 noise = 2 * 100 * (cm / ct**2 + hm / ht**2) ** 0.5
 print(f'  {sys.argv[1]:>6} triangles at {sys.argv[2]:>3} Hz: console {cm} of {ct} ({c:.3f}%), headless {hm} of {ht} ({h:.3f}%), difference {c - h:+.3f} points (counting noise +-{noise:.3f}): {verdict}')
