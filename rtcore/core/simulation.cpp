@@ -192,10 +192,8 @@ RaisedThreads raise_simulation_threads(Simulation& sim) {
   RaisedThreads raised;
   if (sim.collision_thread()) raised.collision = raise_to_fifo(sim.collision_thread()->native_handle(), kCollisionFifoPriority);
   if (sim.physics_helper()) raised.physics_helper = raise_to_fifo(sim.physics_helper()->native_handle(), kCoreFifoPriority);
-  pthread_t helper{};
-  const std::size_t helpers = sim.physics_helper() ? 1 : 0;
-  if (helpers > 0) helper = sim.physics_helper()->native_handle();
-  raised.core_cpu = keep_core_apart(pthread_self(), std::span<const pthread_t>(&helper, helpers));
+  const pthread_t helper = sim.physics_helper() ? sim.physics_helper()->native_handle() : pthread_t{};
+  raised.core_cpu = keep_core_apart(pthread_self(), std::span<const pthread_t>(&helper, sim.physics_helper() ? 1 : 0));
   return raised;
 }
 
@@ -293,18 +291,19 @@ void Simulation::step(const TickInput& input, std::span<const ParameterCommand> 
       const bool job_needs_processor = beside_job && (!paced_ || second_half);
       const bool allowed = physics_helper_allowed();
       const bool helped = allowed && !job_needs_processor;
-      const bool alone_for_job = allowed && job_needs_processor;
       waited_ticks_ = (waited_ticks_ << 1) | (waited_ ? 1u : 0u);
       waited_ = false;
       if (helped && beside_job) physics_helper_->call_in();
-      // A step alone for the job still shares its loops: the helper is called in between their chunks
-      // once the job has ended. At 34,560 triangles and 240 Hz such steps took 3-3.9 ms of the
-      // 4.17 ms tick (a cut's topology update running into the period's second half), the ticks the
-      // console's runs then missed (session 45).
-      tissue_->share_loops_with(helped || alone_for_job ? physics_helper_.get() : nullptr, helped);
-      if (!helped) physics_helper_->send_home();  // called in by prepare_for_tick(), not needed after all
-      if (alone_for_job) {
-        physics_helper_->call_in_when([](const void* job) { return static_cast<const JobThread*>(job)->idle(); }, collision_thread_.get());
+      // A step alone for the job still shares its loops, without calling the helper in: that happens
+      // between their chunks once the job has ended. At 34,560 triangles and 240 Hz such steps took
+      // 3-3.9 ms of the 4.17 ms tick (a cut's topology update running into the period's second
+      // half), the ticks the console's runs then missed (session 45).
+      tissue_->share_loops_with(allowed ? physics_helper_.get() : nullptr, helped);
+      if (!helped) {
+        physics_helper_->send_home();  // called in by prepare_for_tick(), not needed after all
+        if (allowed) {
+          physics_helper_->call_in_when([](const void* job) { return static_cast<const JobThread*>(job)->idle(); }, collision_thread_.get());
+        }
       }
     }
     reaction_ = tissue_->physics_step(config_.tick_s());
